@@ -1,0 +1,166 @@
+#include "profile/application_checks.hpp"
+
+#include <set>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "profile/profile_loader.hpp"
+#include "profile/property_binding.hpp"
+
+namespace rsca::profile {
+namespace {
+
+std::string file_name(const std::filesystem::path &p) { return p.filename().string(); }
+
+// Each override must name a property of the package and carry a value that fits it.
+void check_property_refs(const ResolvedSoftPkg &pkg, const std::vector<PropertyRef> &refs,
+                         std::string_view owner, Error &errors) {
+  for (const auto &ref : refs) {
+    const PropertyDefinition *definition = pkg.find_property(refid_of(ref));
+    if (definition == nullptr) {
+      errors.add({location_of(ref), "unknown-property",
+                  fmt::format("{}: property \"{}\" is not defined by {}", owner, refid_of(ref),
+                              pkg.properties ? file_name(pkg.properties->file)
+                                             : file_name(pkg.spd_path) + " (it has no PRF)")});
+      continue;
+    }
+    if (auto bound = bind_property(*definition, ref); !bound)
+      errors.append(bound.error());
+  }
+}
+
+class ApplicationChecker {
+public:
+  ApplicationChecker(const ResolvedApplication &app, Error &errors) : app_(app), errors_(errors) {}
+
+  // Wiring problems: reported as warnings (see Severity).
+  void warn(SourceLocation where, std::string rule, std::string message) {
+    errors_.add({std::move(where), std::move(rule), std::move(message), Severity::Warning});
+  }
+
+  void run() {
+    for (const auto &placement : app_.sad->placements)
+      for (const auto &ci : placement.instantiations)
+        if (const ResolvedSoftPkg *pkg = app_.softpkg_of(placement))
+          check_property_refs(*pkg, ci.properties,
+                              fmt::format("componentinstantiation \"{}\"", ci.id), errors_);
+    for (const auto &c : app_.sad->connections)
+      check_connection(c);
+    for (const auto &p : app_.sad->external_ports)
+      check_port(p.component_ref, p.port, p.uses ? PortDirection::Uses : PortDirection::Provides,
+                 p.where, fmt::format("external port \"{}\"", p.external_name));
+    for (const auto &p : app_.sad->external_properties)
+      check_external_property(p);
+  }
+
+private:
+  // The SCD of a component instantiation; reports and returns nullptr when there is none.
+  const SoftwareComponent *scd_of(const std::string &instance, const SourceLocation &where,
+                                  const std::string &what) {
+    const ComponentPlacement *placement = nullptr;
+    if (app_.sad->find_instantiation(instance, &placement) == nullptr)
+      return nullptr; // already reported by the SAD reader
+    const ResolvedSoftPkg *pkg = app_.softpkg_of(*placement);
+    if (pkg == nullptr)
+      return nullptr;
+    if (!pkg->scd)
+      warn(where, "missing-scd",
+                   fmt::format("{}: component \"{}\" ({}) has no SCD, so its ports are unknown",
+                               what, instance, file_name(pkg->spd_path)));
+    return pkg->scd.get();
+  }
+
+  const PortDefinition *check_port(const std::string &instance, const std::string &port,
+                                   PortDirection direction, const SourceLocation &where,
+                                   const std::string &what) {
+    const SoftwareComponent *scd = scd_of(instance, where, what);
+    if (scd == nullptr)
+      return nullptr;
+    const PortDefinition *def = scd->find_port(port, direction);
+    if (def != nullptr)
+      return def;
+    std::vector<std::string> names;
+    for (const auto &p : scd->ports)
+      if (p.direction == direction)
+        names.push_back(p.name);
+    const char *kind = direction == PortDirection::Uses ? "uses" : "provides";
+    warn(where, "unknown-port",
+                 fmt::format("{}: component \"{}\" has no {} port \"{}\" ({} ports: {})", what,
+                             instance, kind, port, kind,
+                             names.empty() ? std::string("none") : fmt::format("{}", fmt::join(names, ", "))));
+    return nullptr;
+  }
+
+  void check_connection(const Connection &c) {
+    const std::string what = c.id.empty() ? std::string("connection")
+                                          : fmt::format("connection \"{}\"", c.id);
+    const PortDefinition *uses = nullptr;
+    if (c.uses.target.kind == EndpointTarget::Kind::ComponentInstantiation)
+      uses = check_port(c.uses.target.refid, c.uses.port, PortDirection::Uses, c.uses.where, what);
+    if (c.provides.target.kind != EndpointTarget::Kind::ComponentInstantiation)
+      return;
+    if (c.provides.kind == ProvidesEnd::Kind::SupportedInterface) {
+      const SoftwareComponent *scd = scd_of(c.provides.target.refid, c.provides.where, what);
+      if (scd != nullptr && !scd->supports(c.provides.port))
+        warn(c.provides.where, "unknown-interface",
+                     fmt::format("{}: component \"{}\" does not support interface {}", what,
+                                 c.provides.target.refid, c.provides.port));
+      return;
+    }
+    const PortDefinition *provides = check_port(c.provides.target.refid, c.provides.port,
+                                                PortDirection::Provides, c.provides.where, what);
+    if (uses != nullptr && provides != nullptr && uses->repid != provides->repid)
+      warn(c.where, "port-type",
+                   fmt::format("{}: uses port {}.{} sends {}, but provides port {}.{} takes {}",
+                               what, c.uses.target.refid, uses->name, uses->repid,
+                               c.provides.target.refid, provides->name, provides->repid));
+  }
+
+  void check_external_property(const ExternalProperty &p) {
+    const ComponentPlacement *placement = nullptr;
+    if (app_.sad->find_instantiation(p.component_ref, &placement) == nullptr)
+      return;
+    const ResolvedSoftPkg *pkg = app_.softpkg_of(*placement);
+    if (pkg != nullptr && pkg->find_property(p.property_id) == nullptr)
+      errors_.add({p.where, "unknown-property",
+                   fmt::format("external property \"{}\": component \"{}\" has no property \"{}\"",
+                               p.external_id, p.component_ref, p.property_id)});
+  }
+
+  const ResolvedApplication &app_;
+  Error &errors_;
+};
+
+} // namespace
+
+std::vector<Diagnostic> check_application(const ResolvedApplication &app) {
+  Error findings;
+  ApplicationChecker(app, findings).run();
+  return findings.diagnostics();
+}
+
+std::vector<Diagnostic> check_node(const ResolvedNode &node) {
+  Error errors;
+  std::set<std::string> instance_ids;
+  for (const auto &device : node.devices)
+    for (const auto &ci : device.placement->instantiations)
+      instance_ids.insert(ci.id);
+  for (const auto &device : node.devices) {
+    const ComponentPlacement &placement = *device.placement;
+    for (const auto *parent : {&placement.deploy_on_device, &placement.composite_part_of_device})
+      if (!parent->empty() && instance_ids.count(*parent) == 0)
+        errors.add({placement.ref_where, "dangling-ref",
+                    fmt::format("the placement names device \"{}\", which this DCD does not define",
+                                *parent)});
+    if (!device.softpkg)
+      continue;
+    for (const auto &ci : placement.instantiations) {
+      check_property_refs(*device.softpkg, ci.properties,
+                          fmt::format("device \"{}\"", ci.id), errors);
+    }
+  }
+  return errors.diagnostics();
+}
+
+} // namespace rsca::profile

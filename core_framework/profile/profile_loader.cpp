@@ -1,0 +1,287 @@
+#include "profile/profile_loader.hpp"
+
+#include <algorithm>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "profile/application_checks.hpp"
+
+namespace rsca::profile {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// Splits checker findings: errors go to `errors`, warnings are returned.
+std::vector<Diagnostic> split_findings(std::vector<Diagnostic> findings, Error &errors) {
+  std::vector<Diagnostic> warnings;
+  for (auto &d : findings) {
+    if (d.severity == Severity::Warning)
+      warnings.push_back(std::move(d));
+    else
+      errors.add(std::move(d));
+  }
+  return warnings;
+}
+
+template <typename T>
+DescriptorType descriptor_type_for() {
+  return type_of(Descriptor(std::in_place_type<T>));
+}
+
+// A note at the place that referenced a file, added after the file's own diagnostics.
+Error with_reference_note(Error error, const SourceLocation &referenced_at, const fs::path &file) {
+  if (!referenced_at.file.empty())
+    error.add({referenced_at, "invalid-ref",
+               fmt::format("the file referenced here, {}, is invalid", file.string())});
+  return error;
+}
+
+// Under which tree an SPD's absolute names resolve: the tree it lives in.
+SdrTree tree_of(const SdrRoot &root, const fs::path &file) {
+  auto rel = file.lexically_relative(root.path());
+  return (!rel.empty() && *rel.begin() == "dev") ? SdrTree::Dev : SdrTree::Dom;
+}
+
+} // namespace
+
+const PropertyDefinition *ResolvedSoftPkg::find_property(std::string_view id) const {
+  if (properties)
+    if (const auto *d = properties->find(id))
+      return d;
+  for (const auto &impl : implementations)
+    if (impl.properties)
+      if (const auto *d = impl.properties->find(id))
+        return d;
+  return nullptr;
+}
+
+const ResolvedSoftPkg *ResolvedApplication::softpkg_of(const ComponentPlacement &placement) const {
+  auto it = component_files.find(placement.componentfile_ref);
+  return it == component_files.end() ? nullptr : it->second.get();
+}
+
+ProfileLoader::ProfileLoader(std::optional<fs::path> sdrroot) : sdrroot_(std::move(sdrroot)) {}
+
+Expected<SdrRoot> ProfileLoader::root_for(const fs::path &file) const {
+  if (sdrroot_)
+    return SdrRoot(fs::absolute(*sdrroot_).lexically_normal());
+  if (auto root = SdrRoot::find_for(file))
+    return *root;
+  return make_error({file.string(), 0, 0}, "sdrroot",
+                    "no SDR root found: no folder above this file holds dom/ or dev/ "
+                    "(give one with --sdrroot)");
+}
+
+Expected<std::shared_ptr<const Descriptor>>
+ProfileLoader::cached_descriptor(const fs::path &file, const SourceLocation &referenced_at) {
+  const fs::path key = fs::absolute(file).lexically_normal();
+  std::error_code ec;
+  if (!referenced_at.file.empty() && !fs::is_regular_file(key, ec))
+    return make_error(referenced_at, "missing-file",
+                      fmt::format("the file named here does not exist: {}", key.string()));
+  auto it = files_.find(key);
+  if (it == files_.end()) {
+    auto read = read_descriptor(key).map(
+        [](Descriptor d) { return std::make_shared<const Descriptor>(std::move(d)); });
+    it = files_.emplace(key, std::move(read)).first;
+  }
+  if (!it->second)
+    return tl::unexpected(with_reference_note(it->second.error(), referenced_at, key));
+  return *it->second;
+}
+
+template <typename T>
+Expected<std::shared_ptr<const T>> ProfileLoader::cached(const fs::path &file,
+                                                         const SourceLocation &referenced_at) {
+  auto descriptor = cached_descriptor(file, referenced_at);
+  if (!descriptor)
+    return tl::unexpected(descriptor.error());
+  const T *typed = std::get_if<T>(descriptor->get());
+  if (typed == nullptr)
+    return make_error(referenced_at.file.empty() ? SourceLocation{file.string(), 0, 0} : referenced_at,
+                      "wrong-descriptor",
+                      fmt::format("expected a {}, but {} is a {}", to_string(descriptor_type_for<T>()),
+                                  file.string(), to_string(type_of(**descriptor))));
+  return std::shared_ptr<const T>(*descriptor, typed);
+}
+
+Expected<std::shared_ptr<const ResolvedSoftPkg>>
+ProfileLoader::load_softpkg(const fs::path &spd_file) {
+  return softpkg(spd_file, {});
+}
+
+Expected<std::shared_ptr<const ResolvedSoftPkg>>
+ProfileLoader::softpkg(const fs::path &spd_file, const SourceLocation &referenced_at) {
+  const fs::path key = fs::absolute(spd_file).lexically_normal();
+  if (auto cycle = std::find(resolving_.begin(), resolving_.end(), key); cycle != resolving_.end()) {
+    std::vector<std::string> chain;
+    for (auto it = cycle; it != resolving_.end(); ++it)
+      chain.push_back(it->filename().string());
+    chain.push_back(key.filename().string());
+    return make_error(referenced_at, "dependency-cycle",
+                      fmt::format("softpkg dependency cycle: {}", fmt::join(chain, " -> ")));
+  }
+  if (auto it = softpkgs_.find(key); it != softpkgs_.end()) {
+    if (!it->second)
+      return tl::unexpected(with_reference_note(it->second.error(), referenced_at, key));
+    return it->second;
+  }
+
+  auto spd = cached<SoftPkg>(key, referenced_at);
+  if (!spd)
+    return tl::unexpected(spd.error());
+  auto root = root_for(key);
+  if (!root)
+    return tl::unexpected(root.error());
+
+  resolving_.push_back(key);
+  Error errors;
+  auto resolved = std::make_shared<ResolvedSoftPkg>();
+  resolved->spd_path = key;
+  resolved->spd = *spd;
+  const SdrTree own_tree = tree_of(*root, key);
+  auto file_of = [&](const LocalFile &f) { return root->resolve(f.name, key, own_tree); };
+  if (const auto &pf = (*spd)->property_file) {
+    auto prf = cached<Properties>(file_of(*pf), pf->where);
+    prf ? void(resolved->properties = *prf) : errors.append(prf.error());
+  }
+  if (const auto &d = (*spd)->descriptor) {
+    auto scd = cached<SoftwareComponent>(file_of(*d), d->where);
+    scd ? void(resolved->scd = *scd) : errors.append(scd.error());
+  }
+  for (const auto &impl : (*spd)->implementations) {
+    ResolvedImplementation ri{&impl, nullptr, {}};
+    if (impl.property_file) {
+      auto prf = cached<Properties>(file_of(*impl.property_file), impl.property_file->where);
+      prf ? void(ri.properties = *prf) : errors.append(prf.error());
+    }
+    for (const auto &ref : impl.softpkg_dependencies) {
+      // Shared libraries live in dom/deps whichever tree the package is in, as in REDHAWK.
+      auto dep = softpkg(root->resolve(ref.file.name, key, SdrTree::Dom), ref.file.where);
+      if (!dep) {
+        errors.append(dep.error());
+        continue;
+      }
+      if (ref.implref && (*dep)->spd->find_implementation(*ref.implref) == nullptr) {
+        std::vector<std::string> ids;
+        for (const auto &i : (*dep)->spd->implementations)
+          ids.push_back(i.id);
+        errors.add({ref.where, "dangling-ref",
+                    fmt::format("implref \"{}\" names no implementation of {} (it has: {})",
+                                *ref.implref, (*dep)->spd->name, fmt::join(ids, ", "))});
+      }
+      ri.dependencies.push_back({*dep, ref.implref});
+    }
+    resolved->implementations.push_back(std::move(ri));
+  }
+  resolving_.pop_back();
+
+  Expected<std::shared_ptr<const ResolvedSoftPkg>> result =
+      errors.empty() ? Expected<std::shared_ptr<const ResolvedSoftPkg>>(std::move(resolved))
+                     : tl::unexpected(errors);
+  softpkgs_.emplace(key, result);
+  if (!result)
+    return tl::unexpected(with_reference_note(result.error(), referenced_at, key));
+  return result;
+}
+
+Expected<ResolvedApplication> ProfileLoader::load_application(const fs::path &sad_file) {
+  auto root = root_for(sad_file);
+  if (!root)
+    return tl::unexpected(root.error());
+  auto sad = cached<SoftwareAssembly>(sad_file, {});
+  if (!sad)
+    return tl::unexpected(sad.error());
+  ResolvedApplication app{fs::absolute(sad_file).lexically_normal(), *sad, {}, {}};
+  Error errors;
+  for (const auto &cf : (*sad)->component_files) {
+    auto spd = softpkg(root->resolve(cf.file.name, app.sad_path, SdrTree::Dom), cf.file.where);
+    spd ? void(app.component_files.emplace(cf.id, *spd)) : errors.append(spd.error());
+  }
+  if (errors.empty())
+    app.warnings = split_findings(check_application(app), errors);
+  if (!errors.empty())
+    return tl::unexpected(errors);
+  return app;
+}
+
+Expected<ResolvedNode> ProfileLoader::load_node(const fs::path &dcd_file) {
+  auto root = root_for(dcd_file);
+  if (!root)
+    return tl::unexpected(root.error());
+  auto dcd = cached<DeviceConfiguration>(dcd_file, {});
+  if (!dcd)
+    return tl::unexpected(dcd.error());
+  ResolvedNode node{fs::absolute(dcd_file).lexically_normal(), *dcd, {}, {}};
+  Error errors;
+  if (const auto &mgr = (*dcd)->device_manager_softpkg; !mgr.name.empty()) {
+    auto spd = softpkg(root->resolve(mgr.name, node.dcd_path, SdrTree::Dev), mgr.where);
+    if (!spd)
+      errors.append(spd.error());
+  }
+  for (const auto &placement : (*dcd)->placements) {
+    ResolvedDevicePlacement device{&placement, nullptr, nullptr};
+    if (const ComponentFile *cf = (*dcd)->find_component_file(placement.componentfile_ref)) {
+      auto spd = softpkg(root->resolve(cf->file.name, node.dcd_path, SdrTree::Dev), cf->file.where);
+      spd ? void(device.softpkg = *spd) : errors.append(spd.error());
+    }
+    if (placement.device_pkg_file) {
+      const auto &f = *placement.device_pkg_file;
+      auto dpd = cached<DevicePkg>(root->resolve(f.name, node.dcd_path, SdrTree::Dev), f.where);
+      dpd ? void(device.device_pkg = *dpd) : errors.append(dpd.error());
+    }
+    node.devices.push_back(std::move(device));
+  }
+  if (errors.empty())
+    node.warnings = split_findings(check_node(node), errors);
+  if (!errors.empty())
+    return tl::unexpected(errors);
+  return node;
+}
+
+Expected<DomainManagerConfiguration> ProfileLoader::load_domain(const fs::path &dmd_file) {
+  auto root = root_for(dmd_file);
+  if (!root)
+    return tl::unexpected(root.error());
+  auto dmd = cached<DomainManagerConfiguration>(dmd_file, {});
+  if (!dmd)
+    return tl::unexpected(dmd.error());
+  const auto &mgr = (*dmd)->domain_manager_softpkg;
+  auto spd = softpkg(root->resolve(mgr.name, fs::absolute(dmd_file), SdrTree::Dom), mgr.where);
+  if (!spd)
+    return tl::unexpected(spd.error());
+  return **dmd;
+}
+
+Expected<ValidatedDescriptor> ProfileLoader::validate(const fs::path &file) {
+  auto descriptor = cached_descriptor(file, {});
+  if (!descriptor)
+    return tl::unexpected(descriptor.error());
+  ValidatedDescriptor result{**descriptor, {}};
+  auto keep = [&](auto loaded, auto warnings_of) -> Expected<ValidatedDescriptor> {
+    if (!loaded)
+      return tl::unexpected(loaded.error());
+    result.warnings = warnings_of(*loaded);
+    return result;
+  };
+  auto none = [](const auto &) { return std::vector<Diagnostic>{}; };
+  switch (type_of(**descriptor)) {
+  case DescriptorType::SAD:
+    return keep(load_application(file), [](const ResolvedApplication &a) { return a.warnings; });
+  case DescriptorType::DCD:
+    return keep(load_node(file), [](const ResolvedNode &n) { return n.warnings; });
+  case DescriptorType::SPD:
+    return keep(load_softpkg(file), none);
+  case DescriptorType::DMD:
+    return keep(load_domain(file), none);
+  case DescriptorType::SCD:
+  case DescriptorType::PRF:
+  case DescriptorType::DPD:
+    break;
+  }
+  return result;
+}
+
+} // namespace rsca::profile

@@ -1,0 +1,101 @@
+// Loads profiles with everything they reference — a SAD with its SPDs, SCDs, PRFs and softpkg
+// dependencies; a DCD with its device packages — checks references across files, and caches
+// each file so a package shared by many applications is read once.
+#pragma once
+
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "common/diagnostic.hpp"
+#include "profile/descriptor.hpp"
+#include "profile/sdr_root.hpp"
+
+namespace rsca::profile {
+
+struct ResolvedSoftPkg;
+
+struct ResolvedDependency {
+  std::shared_ptr<const ResolvedSoftPkg> softpkg;
+  std::optional<std::string> implref;
+};
+
+struct ResolvedImplementation {
+  const Implementation *implementation = nullptr;   // points into the SPD it belongs to
+  std::shared_ptr<const Properties> properties;     // implementation-specific PRF, may be null
+  std::vector<ResolvedDependency> dependencies;
+};
+
+struct ResolvedSoftPkg {
+  std::filesystem::path spd_path;
+  std::shared_ptr<const SoftPkg> spd;
+  std::shared_ptr<const Properties> properties;      // may be null
+  std::shared_ptr<const SoftwareComponent> scd;      // may be null (libraries have none)
+  std::vector<ResolvedImplementation> implementations;
+
+  // The definition of property `id` in the SPD's PRF or any implementation's PRF.
+  const PropertyDefinition *find_property(std::string_view id) const;
+};
+
+struct ResolvedApplication {
+  std::filesystem::path sad_path;
+  std::shared_ptr<const SoftwareAssembly> sad;
+  std::map<std::string, std::shared_ptr<const ResolvedSoftPkg>> component_files; // by id
+  std::vector<Diagnostic> warnings; // wiring findings; a launch treats them as errors
+
+  const ResolvedSoftPkg *softpkg_of(const ComponentPlacement &placement) const;
+};
+
+struct ResolvedDevicePlacement {
+  const ComponentPlacement *placement = nullptr; // points into the DCD
+  std::shared_ptr<const ResolvedSoftPkg> softpkg;
+  std::shared_ptr<const DevicePkg> device_pkg;     // when the placement names a DPD
+};
+
+struct ResolvedNode {
+  std::filesystem::path dcd_path;
+  std::shared_ptr<const DeviceConfiguration> dcd;
+  std::vector<ResolvedDevicePlacement> devices;
+  std::vector<Diagnostic> warnings;
+};
+
+// A descriptor that passed validation, with the warnings found on the way.
+struct ValidatedDescriptor {
+  Descriptor descriptor;
+  std::vector<Diagnostic> warnings;
+};
+
+class ProfileLoader {
+public:
+  // `sdrroot`: where absolute profile paths resolve; when empty, found from each file's location.
+  explicit ProfileLoader(std::optional<std::filesystem::path> sdrroot = std::nullopt);
+
+  Expected<ResolvedApplication> load_application(const std::filesystem::path &sad_file);
+  Expected<ResolvedNode> load_node(const std::filesystem::path &dcd_file);
+  Expected<std::shared_ptr<const ResolvedSoftPkg>> load_softpkg(const std::filesystem::path &spd_file);
+  Expected<DomainManagerConfiguration> load_domain(const std::filesystem::path &dmd_file);
+
+  // Reads any descriptor and resolves what it references (the whole check `rsca validate` does).
+  Expected<ValidatedDescriptor> validate(const std::filesystem::path &file);
+
+private:
+  Expected<SdrRoot> root_for(const std::filesystem::path &file) const;
+  Expected<std::shared_ptr<const ResolvedSoftPkg>> softpkg(const std::filesystem::path &spd_file,
+                                                           const SourceLocation &referenced_at);
+  Expected<std::shared_ptr<const Descriptor>> cached_descriptor(const std::filesystem::path &file,
+                                                                const SourceLocation &referenced_at);
+  template <typename T>
+  Expected<std::shared_ptr<const T>> cached(const std::filesystem::path &file,
+                                            const SourceLocation &referenced_at);
+
+  std::optional<std::filesystem::path> sdrroot_;
+  std::map<std::filesystem::path, Expected<std::shared_ptr<const Descriptor>>> files_;
+  std::map<std::filesystem::path, Expected<std::shared_ptr<const ResolvedSoftPkg>>> softpkgs_;
+  std::vector<std::filesystem::path> resolving_; // SPDs being resolved, to find cycles
+};
+
+} // namespace rsca::profile

@@ -1,0 +1,14 @@
+// Binding a property value written in a SAD, DCD or SPD (simpleref, structref, ...) to its PRF
+// definition: the id must exist, the form must match, and every value must fit its type and range.
+#pragma once
+
+#include "common/diagnostic.hpp"
+#include "profile/prf.hpp"
+#include "profile/property_refs.hpp"
+
+namespace rsca::profile {
+
+// The typed value of `ref` under `definition`. Errors are located at the ref.
+Expected<PropertyValue> bind_property(const PropertyDefinition &definition, const PropertyRef &ref);
+
+} // namespace rsca::profile

@@ -1,0 +1,348 @@
+// Readers of the parts SADs and DCDs share, and the checks of their internal references.
+#include <charconv>
+#include <map>
+
+#include <fmt/ranges.h>
+
+#include "profile/read_context.hpp"
+
+namespace rsca::profile::detail {
+namespace {
+
+template <typename Enum, std::size_t N>
+std::optional<Enum> enum_attr(ReadContext &ctx, const XmlElement &e, std::string_view name,
+                              const std::pair<std::string_view, Enum> (&table)[N]) {
+  const std::string *text = e.attribute(name);
+  if (text == nullptr)
+    return std::nullopt;
+  for (const auto &[key, value] : table)
+    if (key == *text)
+      return value;
+  // The schema enumerates these values; reaching here means schema and reader disagree.
+  ctx.fail(e, "value", fmt::format("attribute {}: \"{}\" is not a known value", name, *text));
+  return std::nullopt;
+}
+
+template <typename Int>
+tl::expected<Int, std::string> parse_int(std::string_view text) {
+  Int value{};
+  auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (ec != std::errc() || end != text.data() + text.size())
+    return tl::unexpected(fmt::format("\"{}\" is not a valid integer", text));
+  return value;
+}
+
+constexpr std::pair<std::string_view, Reliability> kReliability[] = {
+    {"besteffort", Reliability::BestEffort}, {"reliable", Reliability::Reliable}};
+constexpr std::pair<std::string_view, Durability> kDurability[] = {
+    {"volatile", Durability::Volatile},
+    {"transientlocal", Durability::TransientLocal},
+    {"transient", Durability::Transient},
+    {"persistent", Durability::Persistent}};
+constexpr std::pair<std::string_view, History> kHistory[] = {{"keeplast", History::KeepLast},
+                                                             {"keepall", History::KeepAll}};
+constexpr std::pair<std::string_view, Liveliness> kLiveliness[] = {
+    {"automatic", Liveliness::Automatic},
+    {"manualbyparticipant", Liveliness::ManualByParticipant},
+    {"manualbytopic", Liveliness::ManualByTopic}};
+constexpr std::pair<std::string_view, Ownership> kOwnership[] = {{"shared", Ownership::Shared},
+                                                                 {"exclusive", Ownership::Exclusive}};
+constexpr std::pair<std::string_view, Criticality> kCriticality[] = {
+    {"low", Criticality::Low},
+    {"medium", Criticality::Medium},
+    {"high", Criticality::High},
+    {"safety", Criticality::Safety}};
+
+SimpleRef read_simple_ref(ReadContext &ctx, const XmlElement &e) {
+  return {e.attr("refid"), e.attr("value"), ctx.at(e)};
+}
+
+SimpleSequenceRef read_simple_sequence_ref(ReadContext &ctx, const XmlElement &e) {
+  SimpleSequenceRef ref{e.attr("refid"), {}, ctx.at(e)};
+  if (const XmlElement *values = e.child("values"))
+    for (const auto &v : values->children)
+      ref.values.push_back(v.text); // sequence values are not trimmed: strings keep their spaces
+  return ref;
+}
+
+StructRef read_struct_members(ReadContext &ctx, const XmlElement &e, std::string refid) {
+  StructRef ref{std::move(refid), {}, ctx.at(e)};
+  for (const auto &c : e.children) {
+    if (c.name == "simpleref")
+      ref.members.emplace_back(read_simple_ref(ctx, c));
+    else if (c.name == "simplesequenceref")
+      ref.members.emplace_back(read_simple_sequence_ref(ctx, c));
+  }
+  return ref;
+}
+
+FindBy read_findby(const XmlElement &e) {
+  FindBy findby;
+  if (const XmlElement *ns = e.child("namingservice")) {
+    findby.kind = FindBy::Kind::NamingService;
+    findby.name = ns->attr("name");
+  } else if (const XmlElement *df = e.child("domainfinder")) {
+    findby.kind = FindBy::Kind::DomainFinder;
+    findby.type = df->attr("type");
+    findby.name = df->attr("name");
+  } else if (const XmlElement *so = e.child("stringifiedobjectref")) {
+    findby.kind = FindBy::Kind::StringifiedObjectRef;
+    findby.name = so->trimmed_text();
+  }
+  return findby;
+}
+
+// The object an end of a connection names: one of the children of usesport, providesport or
+// componentsupportedinterface.
+EndpointTarget read_target(const XmlElement &end) {
+  EndpointTarget target;
+  for (const auto &c : end.children) {
+    if (c.name == "componentinstantiationref") {
+      target.kind = EndpointTarget::Kind::ComponentInstantiation;
+      target.refid = c.attr("refid");
+    } else if (c.name == "devicethatloadedthiscomponentref") {
+      target.kind = EndpointTarget::Kind::DeviceThatLoadedThisComponent;
+      target.refid = c.attr("refid");
+    } else if (c.name == "deviceusedbythiscomponentref") {
+      target.kind = EndpointTarget::Kind::DeviceUsedByThisComponent;
+      target.refid = c.attr("refid");
+      target.usesrefid = c.attr("usesrefid");
+    } else if (c.name == "findby") {
+      target.kind = EndpointTarget::Kind::FindBy;
+      target.findby = read_findby(c);
+    }
+  }
+  return target;
+}
+
+ConnectionQos read_qos(ReadContext &ctx, const XmlElement &e) {
+  ConnectionQos qos;
+  qos.where = ctx.at(e);
+  qos.reliability = enum_attr(ctx, e, "reliability", kReliability);
+  qos.durability = enum_attr(ctx, e, "durability", kDurability);
+  qos.history = enum_attr(ctx, e, "history", kHistory);
+  qos.depth = ctx.optional_attr(e, "depth", parse_int<std::uint32_t>);
+  qos.deadline = ctx.duration_attr(e, "deadline");
+  qos.latency_budget = ctx.duration_attr(e, "latencybudget");
+  qos.transport_priority = ctx.optional_attr(e, "transportpriority", parse_int<std::int32_t>);
+  qos.liveliness = enum_attr(ctx, e, "liveliness", kLiveliness);
+  qos.lease = ctx.duration_attr(e, "lease");
+  qos.ownership = enum_attr(ctx, e, "ownership", kOwnership);
+  qos.strength = ctx.optional_attr(e, "strength", parse_int<std::int32_t>);
+  if (qos.depth && qos.history == History::KeepAll)
+    ctx.fail(e, "qos", "depth applies only to history=\"keeplast\", not to keepall");
+  if (qos.strength && qos.ownership != Ownership::Exclusive)
+    ctx.fail(e, "qos", "strength applies only to ownership=\"exclusive\"");
+  return qos;
+}
+
+Timing read_timing(ReadContext &ctx, const XmlElement &e) {
+  Timing timing;
+  timing.where = ctx.at(e);
+  timing.period = ctx.duration_attr(e, "period");
+  timing.deadline = ctx.duration_attr(e, "deadline");
+  timing.execution_time = ctx.duration_attr(e, "executiontime");
+  timing.priority = ctx.optional_attr(e, "priority", parse_int<std::uint32_t>);
+  timing.criticality = enum_attr(ctx, e, "criticality", kCriticality);
+  auto finite = [](const std::optional<Duration> &d) { return d && !d->infinite(); };
+  if (finite(timing.execution_time) && finite(timing.deadline) &&
+      *timing.execution_time->value > *timing.deadline->value)
+    ctx.fail(e, "timing", "executiontime is longer than the deadline: no schedule can meet it");
+  if (finite(timing.execution_time) && finite(timing.period) &&
+      *timing.execution_time->value > *timing.period->value)
+    ctx.fail(e, "timing", "executiontime is longer than the period: utilization above 100%");
+  return timing;
+}
+
+ComponentInstantiation read_instantiation(ReadContext &ctx, const XmlElement &e) {
+  ComponentInstantiation ci;
+  ci.id = e.attr("id");
+  ci.where = ctx.at(e);
+  ci.start_order = ctx.optional_attr(e, "startorder", parse_int<std::uint32_t>);
+  ci.usage_name = e.child_text("usagename");
+  ci.properties = read_property_refs(ctx, e.child("componentproperties"));
+  for (const auto &c : e.children) {
+    if (c.name == "findcomponent") {
+      if (const XmlElement *ns = c.child("namingservice"))
+        ci.naming_service_name = ns->attr("name");
+    } else if (c.name == "devicerequires" || c.name == "deployerrequires") {
+      for (const auto &r : c.children) {
+        if (r.name == "requiresproperty")
+          ci.device_requires.emplace_back(SimpleRef{r.attr("id"), r.attr("value"), ctx.at(r)});
+        else if (is_property_ref(r.name))
+          ci.device_requires.push_back(read_property_ref(ctx, r));
+      }
+    } else if (c.name == "timing") {
+      ci.timing = read_timing(ctx, c);
+    }
+  }
+  return ci;
+}
+
+std::string connection_label(const Connection &c) {
+  return c.id.empty() ? std::string("connection") : fmt::format("connection \"{}\"", c.id);
+}
+
+} // namespace
+
+LocalFile read_localfile(ReadContext &ctx, const XmlElement &holder) {
+  const XmlElement *lf = holder.child("localfile");
+  if (lf == nullptr)
+    return {{}, ctx.at(holder)};
+  return {lf->attr("name"), ctx.at(*lf)};
+}
+
+bool is_property_ref(std::string_view name) {
+  return name == "simpleref" || name == "simplesequenceref" || name == "structref" ||
+         name == "structsequenceref" || name == "propertyref";
+}
+
+PropertyRef read_property_ref(ReadContext &ctx, const XmlElement &e) {
+  if (e.name == "simplesequenceref")
+    return read_simple_sequence_ref(ctx, e);
+  if (e.name == "structref")
+    return read_struct_members(ctx, e, e.attr("refid"));
+  if (e.name == "structsequenceref") {
+    StructSequenceRef ref{e.attr("refid"), {}, ctx.at(e)};
+    for (const auto &c : e.children)
+      if (c.name == "structvalue")
+        ref.values.push_back(read_struct_members(ctx, c, {}));
+    return ref;
+  }
+  // simpleref, and SCA's propertyref (refid + value) in SPD dependencies.
+  return read_simple_ref(ctx, e);
+}
+
+std::vector<PropertyRef> read_property_refs(ReadContext &ctx, const XmlElement *holder) {
+  std::vector<PropertyRef> refs;
+  if (holder == nullptr)
+    return refs;
+  for (const auto &c : holder->children)
+    if (is_property_ref(c.name))
+      refs.push_back(read_property_ref(ctx, c));
+  return refs;
+}
+
+std::vector<ComponentFile> read_component_files(ReadContext &ctx, const XmlElement *holder) {
+  std::vector<ComponentFile> files;
+  if (holder == nullptr)
+    return files;
+  for (const auto &c : holder->children)
+    if (c.name == "componentfile")
+      files.push_back({c.attr("id"), c.attr("type"), read_localfile(ctx, c), ctx.at(c)});
+  return files;
+}
+
+ComponentPlacement read_component_placement(ReadContext &ctx, const XmlElement &e) {
+  ComponentPlacement placement;
+  for (const auto &c : e.children) {
+    if (c.name == "componentfileref") {
+      placement.componentfile_ref = c.attr("refid");
+      placement.ref_where = ctx.at(c);
+    } else if (c.name == "deployondevice") {
+      placement.deploy_on_device = c.attr("refid");
+    } else if (c.name == "compositepartofdevice") {
+      placement.composite_part_of_device = c.attr("refid");
+    } else if (c.name == "devicepkgfile") {
+      placement.device_pkg_file = read_localfile(ctx, c);
+    } else if (c.name == "componentinstantiation") {
+      placement.instantiations.push_back(read_instantiation(ctx, c));
+    }
+  }
+  return placement;
+}
+
+std::vector<Connection> read_connections(ReadContext &ctx, const XmlElement *holder) {
+  std::vector<Connection> connections;
+  if (holder == nullptr)
+    return connections;
+  for (const auto &e : holder->children) {
+    Connection c;
+    c.id = e.attr("id");
+    c.where = ctx.at(e);
+    for (const auto &part : e.children) {
+      if (part.name == "usesport") {
+        c.uses = {part.child_text("usesidentifier"), read_target(part), ctx.at(part)};
+      } else if (part.name == "providesport") {
+        c.provides = {ProvidesEnd::Kind::Port, part.child_text("providesidentifier"),
+                      read_target(part), ctx.at(part)};
+      } else if (part.name == "componentsupportedinterface") {
+        c.provides = {ProvidesEnd::Kind::SupportedInterface, part.child_text("supportedidentifier"),
+                      read_target(part), ctx.at(part)};
+      } else if (part.name == "findby") {
+        c.provides.kind = ProvidesEnd::Kind::FindBy;
+        c.provides.target.kind = EndpointTarget::Kind::FindBy;
+        c.provides.target.findby = read_findby(part);
+        c.provides.where = ctx.at(part);
+      } else if (part.name == "qos") {
+        c.qos = read_qos(ctx, part);
+      } else if (part.name == "filter") {
+        c.filter = part.trimmed_text();
+        if (!c.subscribes_to_channel())
+          ctx.fail(part, "filter",
+                   fmt::format("{} has a filter but does not subscribe to an event channel "
+                               "(usesport/findby/domainfinder type=\"eventchannel\")",
+                               connection_label(c)));
+      }
+    }
+    connections.push_back(std::move(c));
+  }
+  return connections;
+}
+
+void check_assembly_references(ReadContext &ctx, const std::vector<ComponentFile> &files,
+                               const std::vector<ComponentPlacement> &placements,
+                               const std::vector<Connection> &connections) {
+  std::set<std::string> file_ids;
+  for (const auto &f : files)
+    if (!file_ids.insert(f.id).second)
+      ctx.report({f.where, "duplicate-id",
+                  fmt::format("componentfile id \"{}\" is defined more than once", f.id)});
+
+  std::set<std::string> instance_ids;
+  for (const auto &p : placements) {
+    if (file_ids.count(p.componentfile_ref) == 0)
+      ctx.report({p.ref_where, "dangling-ref",
+                  fmt::format("componentfileref refid \"{}\" names no componentfile (known: {})",
+                              p.componentfile_ref, fmt::join(file_ids, ", "))});
+    for (const auto &ci : p.instantiations)
+      if (!instance_ids.insert(ci.id).second)
+        ctx.report({ci.where, "duplicate-id",
+                    fmt::format("componentinstantiation id \"{}\" is defined more than once",
+                                ci.id)});
+  }
+
+  auto check_target = [&](const EndpointTarget &t, const SourceLocation &where,
+                          const Connection &c) {
+    if (t.kind == EndpointTarget::Kind::FindBy || instance_ids.count(t.refid) != 0)
+      return;
+    ctx.report({where, "dangling-ref",
+                fmt::format("{} refers to componentinstantiation \"{}\", which this file does "
+                            "not define",
+                            connection_label(c), t.refid)});
+  };
+  std::set<std::string> connection_ids;
+  for (const auto &c : connections) {
+    if (!c.id.empty() && !connection_ids.insert(c.id).second)
+      ctx.report({c.where, "duplicate-id",
+                  fmt::format("connectinterface id \"{}\" is defined more than once", c.id)});
+    check_target(c.uses.target, c.uses.where, c);
+    check_target(c.provides.target, c.provides.where, c);
+    if (c.subscribes_to_channel() && c.publishes_to_channel())
+      ctx.report({c.where, "connection",
+                  fmt::format("{} joins two event channels; one end must be a component port",
+                              connection_label(c))});
+  }
+}
+
+std::optional<Scalar> read_scalar(ReadContext &ctx, const XmlElement &e, TypeSpec spec,
+                                  const std::string &text, std::string_view what) {
+  auto value = parse_scalar(spec, text);
+  if (!value) {
+    ctx.fail(e, "value", fmt::format("{}: {}", what, value.error()));
+    return std::nullopt;
+  }
+  return *value;
+}
+
+} // namespace rsca::profile::detail

@@ -1,0 +1,135 @@
+// SAD reader: the application and the references between its own parts.
+#include "profile/read_context.hpp"
+#include "profile/sad.hpp"
+
+namespace rsca::profile {
+namespace {
+
+using detail::ReadContext;
+
+void read_partitioning(ReadContext &ctx, const XmlElement &e, SoftwareAssembly &sad) {
+  for (const auto &c : e.children) {
+    if (c.name == "componentplacement") {
+      sad.placements.push_back(detail::read_component_placement(ctx, c));
+      continue;
+    }
+    if (c.name != "hostcollocation")
+      continue;
+    HostCollocation hc{c.attr("id"), c.attr("name"), ctx.at(c)};
+    for (const auto &p : c.children) {
+      if (p.name != "componentplacement")
+        continue;
+      sad.placements.push_back(detail::read_component_placement(ctx, p));
+      sad.placements.back().host_collocation = hc.id.empty() ? hc.name : hc.id;
+    }
+    sad.host_collocations.push_back(std::move(hc));
+  }
+}
+
+void read_external_ports(ReadContext &ctx, const XmlElement &e, SoftwareAssembly &sad) {
+  for (const auto &p : e.children) {
+    ExternalPort port;
+    port.where = ctx.at(p);
+    for (const auto &c : p.children) {
+      if (c.name == "usesidentifier") {
+        port.port = c.trimmed_text();
+        port.uses = true;
+      } else if (c.name == "providesidentifier" || c.name == "supportedidentifier") {
+        port.port = c.trimmed_text();
+        port.uses = false;
+      } else if (c.name == "componentinstantiationref") {
+        port.component_ref = c.attr("refid");
+      }
+    }
+    const std::string *external = p.attribute("externalname");
+    port.external_name = external != nullptr ? *external : port.port;
+    sad.external_ports.push_back(std::move(port));
+  }
+}
+
+void read_external_properties(ReadContext &ctx, const XmlElement &e, SoftwareAssembly &sad) {
+  for (const auto &p : e.children) {
+    const std::string *external = p.attribute("externalpropid");
+    sad.external_properties.push_back({p.attr("comprefid"), p.attr("propid"),
+                                       external != nullptr ? *external : p.attr("propid"),
+                                       ctx.at(p)});
+  }
+}
+
+void read_latency_paths(ReadContext &ctx, const XmlElement &e, SoftwareAssembly &sad) {
+  for (const auto &p : e.children) {
+    LatencyPath path;
+    path.id = p.attr("id");
+    path.where = ctx.at(p);
+    path.bound = ctx.duration_attr(p, "bound").value_or(Duration{});
+    for (const auto &c : p.children)
+      if (c.name == "componentinstantiationref")
+        path.components.push_back(c.attr("refid"));
+    sad.latency_paths.push_back(std::move(path));
+  }
+}
+
+// References from the SAD's tail sections to component instantiations.
+void check_instance_refs(ReadContext &ctx, const SoftwareAssembly &sad) {
+  auto require = [&](const std::string &refid, const SourceLocation &where, std::string_view what) {
+    if (sad.find_instantiation(refid) == nullptr)
+      ctx.report({where, "dangling-ref",
+                  fmt::format("{} names componentinstantiation \"{}\", which this SAD does not "
+                              "define",
+                              what, refid)});
+  };
+  require(sad.assembly_controller, sad.assembly_controller_where, "assemblycontroller");
+  for (const auto &p : sad.external_ports)
+    require(p.component_ref, p.where, fmt::format("external port \"{}\"", p.external_name));
+  std::set<std::string> external_ids;
+  for (const auto &p : sad.external_properties) {
+    require(p.component_ref, p.where, fmt::format("external property \"{}\"", p.external_id));
+    if (!external_ids.insert(p.external_id).second)
+      ctx.report({p.where, "duplicate-id",
+                  fmt::format("external property \"{}\" is defined more than once", p.external_id)});
+  }
+  for (const auto &path : sad.latency_paths)
+    for (const auto &c : path.components)
+      require(c, path.where, fmt::format("latency path \"{}\"", path.id));
+}
+
+} // namespace
+
+Expected<SoftwareAssembly> read_sad(const XmlDocument &document) {
+  ReadContext ctx(document.file);
+  const XmlElement &root = document.root;
+  SoftwareAssembly sad;
+  sad.file = document.file;
+  sad.id = root.attr("id");
+  sad.name = root.attr("name");
+  sad.version = root.attr("version");
+  sad.description = root.child_text("description");
+  sad.component_files = detail::read_component_files(ctx, root.child("componentfiles"));
+  for (const auto &c : root.children) {
+    if (c.name == "partitioning") {
+      read_partitioning(ctx, c, sad);
+    } else if (c.name == "assemblycontroller") {
+      if (const XmlElement *ref = c.child("componentinstantiationref")) {
+        sad.assembly_controller = ref->attr("refid");
+        sad.assembly_controller_where = ctx.at(*ref);
+      }
+    } else if (c.name == "connections") {
+      sad.connections = detail::read_connections(ctx, &c);
+    } else if (c.name == "externalports") {
+      read_external_ports(ctx, c, sad);
+    } else if (c.name == "externalproperties") {
+      read_external_properties(ctx, c, sad);
+    } else if (c.name == "usesdevicedependencies") {
+      for (const auto &u : c.children)
+        sad.uses_device_dependencies.push_back(
+            {u.attr("id"), u.attr("type"), detail::read_property_refs(ctx, &u), ctx.at(u)});
+    } else if (c.name == "latencyconstraints") {
+      read_latency_paths(ctx, c, sad);
+    }
+  }
+  detail::check_assembly_references(ctx, sad.component_files, sad.placements, sad.connections);
+  check_instance_refs(ctx, sad);
+  return detail::finish(ctx, std::move(sad));
+}
+
+} // namespace rsca::profile

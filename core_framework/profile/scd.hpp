@@ -1,0 +1,49 @@
+// SCD: a component's interfaces and ports.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "common/diagnostic.hpp"
+
+namespace rsca::profile {
+
+enum class PortDirection : std::uint8_t { Uses, Provides };
+
+struct PortDefinition {
+  std::string name;
+  std::string repid;
+  PortDirection direction = PortDirection::Uses;
+  std::vector<std::string> port_types; // "data", "control", "responses", "test"
+  std::string description;
+  SourceLocation where;
+};
+
+struct SupportedInterface {
+  std::string repid;
+  std::string name;
+};
+
+struct InterfaceDefinition {
+  std::string name;
+  std::string repid;
+  std::vector<std::string> inherits; // repids
+};
+
+struct SoftwareComponent {
+  std::string file;
+  std::string corba_version;
+  std::string component_repid;
+  std::string component_type; // resource, device, executabledevice, ...
+  std::optional<std::string> property_file;
+  std::vector<SupportedInterface> supported_interfaces;
+  std::vector<PortDefinition> ports;
+  std::vector<InterfaceDefinition> interfaces;
+
+  const PortDefinition *find_port(std::string_view name, PortDirection direction) const;
+  // True when `repid` names this component's own interface or one it supports or inherits.
+  bool supports(std::string_view repid) const;
+};
+
+} // namespace rsca::profile

@@ -1,0 +1,355 @@
+#include "profile/xml_document.hpp"
+
+#include <algorithm>
+#include <fstream>
+#include <memory>
+#include <mutex>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <xercesc/framework/MemBufInputSource.hpp>
+#include <xercesc/framework/XMLGrammarPoolImpl.hpp>
+#include <xercesc/sax/Locator.hpp>
+#include <xercesc/sax/SAXParseException.hpp>
+#include <xercesc/sax2/Attributes.hpp>
+#include <xercesc/sax2/DefaultHandler.hpp>
+#include <xercesc/sax2/SAX2XMLReader.hpp>
+#include <xercesc/sax2/XMLReaderFactory.hpp>
+#include <xercesc/util/OutOfMemoryException.hpp>
+#include <xercesc/util/PlatformUtils.hpp>
+#include <xercesc/util/SecurityManager.hpp>
+#include <xercesc/util/TransService.hpp>
+#include <xercesc/sax/EntityResolver.hpp>
+#include <xercesc/util/XMLUni.hpp>
+#include <xercesc/validators/common/Grammar.hpp>
+
+namespace rsca::profile {
+
+// Generated from schemas/*.xsd by cmake/RscaEmbed.cmake.
+namespace schemas {
+std::pair<std::string_view, std::string_view> const *embedded_files(std::size_t &count);
+}
+
+namespace {
+
+namespace x = xercesc;
+
+constexpr std::string_view kRootSchema = "rsca.xsd";
+constexpr std::size_t kMaxDiagnosticsPerFile = 20;
+// Entity expansions allowed in one document: plenty for any profile, and a "billion laughs"
+// document fails fast instead of exhausting memory.
+constexpr XMLSize_t kEntityExpansionLimit = 10000;
+
+// Xerces needs one process-wide initialisation before any use and a termination after the last.
+struct XercesRuntime {
+  XercesRuntime() { x::XMLPlatformUtils::Initialize(); }
+  ~XercesRuntime() { x::XMLPlatformUtils::Terminate(); }
+  XercesRuntime(const XercesRuntime &) = delete;
+  XercesRuntime &operator=(const XercesRuntime &) = delete;
+};
+
+void ensure_xerces() { static XercesRuntime runtime; }
+
+class Utf8 {
+public:
+  Utf8() {
+    x::XMLTransService::Codes code;
+    transcoder_.reset(x::XMLPlatformUtils::fgTransService->makeNewTranscoderFor(
+        "UTF-8", code, 16 * 1024, x::XMLPlatformUtils::fgMemoryManager));
+  }
+  std::string operator()(const XMLCh *text, XMLSize_t length) const {
+    if (text == nullptr || length == 0)
+      return {};
+    x::TranscodeToStr out(text, length, transcoder_.get());
+    return {reinterpret_cast<const char *>(out.str()), out.length()};
+  }
+  std::string operator()(const XMLCh *text) const {
+    return (*this)(text, text == nullptr ? 0 : x::XMLString::stringLen(text));
+  }
+
+private:
+  std::unique_ptr<x::XMLTranscoder> transcoder_;
+};
+
+// Serves the embedded schemas by file name and an empty document for anything else, so that
+// DOCTYPE system ids and schema locations are resolved locally and nothing is ever fetched.
+class LocalOnlyResolver final : public x::EntityResolver {
+public:
+  x::InputSource *resolveEntity(const XMLCh *const, const XMLCh *const system_id_text) override {
+    std::string system_id = utf8_(system_id_text);
+    std::string_view name = system_id;
+    if (auto slash = name.find_last_of('/'); slash != std::string_view::npos)
+      name.remove_prefix(slash + 1);
+    std::string_view text = embedded_schema(name);
+    // Xerces takes ownership of the returned source.
+    return std::make_unique<x::MemBufInputSource>(reinterpret_cast<const XMLByte *>(text.data()),
+                                                  text.size(), std::string(name).c_str())
+        .release();
+  }
+
+private:
+  Utf8 utf8_;
+};
+
+// Collects located diagnostics; Xerces reports the position it had reached, which for element
+// problems is the end of the start tag.
+class DiagnosticCollector final : public x::ErrorHandler {
+public:
+  explicit DiagnosticCollector(std::string file) : file_(std::move(file)) {}
+
+  void warning(const x::SAXParseException &) override {}
+  void error(const x::SAXParseException &e) override { add(e, "schema"); }
+  void fatalError(const x::SAXParseException &e) override { add(e, "xml"); }
+  void resetErrors() override { error_ = Error(); }
+
+  const Error &error() const { return error_; }
+  void add(Diagnostic d) {
+    if (error_.diagnostics().size() < kMaxDiagnosticsPerFile)
+      error_.add(std::move(d));
+  }
+
+private:
+  void add(const x::SAXParseException &e, const char *rule) {
+    add(Diagnostic{{file_, static_cast<int>(e.getLineNumber()), static_cast<int>(e.getColumnNumber())},
+                   rule,
+                   utf8_(e.getMessage())});
+  }
+
+  std::string file_;
+  Error error_;
+  Utf8 utf8_;
+};
+
+// Builds the XmlElement tree from SAX events.
+class TreeBuilder final : public x::DefaultHandler {
+public:
+  void setDocumentLocator(const x::Locator *const locator) override { locator_ = locator; }
+
+  void startElement(const XMLCh *const, const XMLCh *const local_name, const XMLCh *const,
+                    const x::Attributes &attributes) override {
+    XmlElement element;
+    element.name = utf8_(local_name);
+    if (locator_ != nullptr) {
+      element.line = static_cast<int>(locator_->getLineNumber());
+      element.column = static_cast<int>(locator_->getColumnNumber());
+    }
+    element.attributes.reserve(attributes.getLength());
+    for (XMLSize_t i = 0; i < attributes.getLength(); ++i)
+      element.attributes.emplace_back(utf8_(attributes.getLocalName(i)),
+                                      utf8_(attributes.getValue(i)));
+    if (open_.empty()) {
+      root_ = std::move(element);
+      open_.push_back(&root_);
+      return;
+    }
+    // Only the innermost open element grows, so pointers to its ancestors stay valid.
+    open_.back()->children.push_back(std::move(element));
+    open_.push_back(&open_.back()->children.back());
+  }
+
+  void endElement(const XMLCh *const, const XMLCh *const, const XMLCh *const) override {
+    open_.pop_back();
+  }
+
+  void characters(const XMLCh *const chars, const XMLSize_t length) override {
+    if (!open_.empty())
+      open_.back()->text += utf8_(chars, length);
+  }
+
+  XmlElement take_root() { return std::move(root_); }
+  void reset() {
+    root_ = XmlElement();
+    open_.clear();
+  }
+
+private:
+  const x::Locator *locator_ = nullptr;
+  XmlElement root_;
+  std::vector<XmlElement *> open_;
+  Utf8 utf8_;
+};
+
+void set_validating_features(x::SAX2XMLReader &reader) {
+  reader.setFeature(x::XMLUni::fgSAX2CoreNameSpaces, true);
+  reader.setFeature(x::XMLUni::fgSAX2CoreValidation, true);
+  reader.setFeature(x::XMLUni::fgXercesDynamic, false);
+  reader.setFeature(x::XMLUni::fgXercesSchema, true);
+  reader.setFeature(x::XMLUni::fgXercesIdentityConstraintChecking, true);
+  // REDHAWK's profiles carry SCA DOCTYPE lines; the DTD is neither fetched nor used, the
+  // schemas are the only grammar.
+  reader.setFeature(x::XMLUni::fgXercesLoadExternalDTD, false);
+  reader.setFeature(x::XMLUni::fgXercesSkipDTDValidation, true);
+  reader.setFeature(x::XMLUni::fgXercesDisableDefaultEntityResolution, true);
+}
+
+// The schemas, compiled once per process and shared read-only by every reader.
+class SchemaCache {
+public:
+  SchemaCache() {
+    ensure_xerces();
+    pool_ = std::make_unique<x::XMLGrammarPoolImpl>(x::XMLPlatformUtils::fgMemoryManager);
+    std::unique_ptr<x::SAX2XMLReader> loader(
+        x::XMLReaderFactory::createXMLReader(x::XMLPlatformUtils::fgMemoryManager, pool_.get()));
+    set_validating_features(*loader);
+    loader->setFeature(x::XMLUni::fgXercesSchemaFullChecking, true);
+    LocalOnlyResolver resolver;
+    DiagnosticCollector collector{std::string(kRootSchema)};
+    loader->setEntityResolver(&resolver);
+    loader->setErrorHandler(&collector);
+    std::string_view text = embedded_schema(kRootSchema);
+    x::MemBufInputSource source(reinterpret_cast<const XMLByte *>(text.data()), text.size(),
+                                std::string(kRootSchema).c_str());
+    try {
+      if (loader->loadGrammar(source, x::Grammar::SchemaGrammarType, true) == nullptr)
+        collector.add({{std::string(kRootSchema), 0, 0}, "schema", "the schema did not load"});
+    } catch (...) {
+      collector.add({{std::string(kRootSchema), 0, 0}, "schema", "the schema did not load"});
+    }
+    load_error_ = collector.error();
+    pool_->lockPool();
+  }
+
+  x::XMLGrammarPool *pool() const { return pool_.get(); }
+  // Non-empty when the built-in schemas themselves are broken (a build defect).
+  const Error &load_error() const { return load_error_; }
+
+private:
+  std::unique_ptr<x::XMLGrammarPool> pool_;
+  Error load_error_;
+};
+
+const SchemaCache &schema_cache() {
+  static SchemaCache cache;
+  return cache;
+}
+
+// One validating reader per thread: creating a Xerces reader costs more than a small parse.
+class ProfileReader {
+public:
+  ProfileReader() : cache_(schema_cache()) {
+    reader_.reset(x::XMLReaderFactory::createXMLReader(x::XMLPlatformUtils::fgMemoryManager,
+                                                       cache_.pool()));
+    set_validating_features(*reader_);
+    reader_->setFeature(x::XMLUni::fgXercesUseCachedGrammarInParse, true);
+    reader_->setFeature(x::XMLUni::fgXercesLoadSchema, false);
+    security_.setEntityExpansionLimit(kEntityExpansionLimit);
+    reader_->setProperty(x::XMLUni::fgXercesSecurityManager, &security_);
+    reader_->setEntityResolver(&resolver_);
+    reader_->setContentHandler(&builder_);
+  }
+
+  Expected<XmlDocument> read(std::string_view text, const std::string &file) {
+    if (!cache_.load_error().empty())
+      return tl::unexpected(cache_.load_error());
+    if (text.find_first_not_of(" \t\r\n") == std::string_view::npos)
+      return make_error({file, 1, 1}, "xml", "the file is empty: expected an XML profile");
+
+    DiagnosticCollector collector(file);
+    reader_->setErrorHandler(&collector);
+    builder_.reset();
+    x::MemBufInputSource source(reinterpret_cast<const XMLByte *>(text.data()), text.size(),
+                                file.c_str());
+    try {
+      reader_->parse(source);
+    } catch (const x::SAXParseException &) {
+      // Already reported through the collector.
+    } catch (const x::OutOfMemoryException &) {
+      collector.add({{file, 0, 0}, "xml", "out of memory while parsing"});
+    } catch (const x::XMLException &e) {
+      collector.add({{file, static_cast<int>(e.getSrcLine()), 0}, "xml", utf8_(e.getMessage())});
+    } catch (...) {
+      collector.add({{file, 0, 0}, "xml", "the parser failed for an unknown reason"});
+    }
+    reader_->setErrorHandler(nullptr);
+    if (!collector.error().empty())
+      return tl::unexpected(collector.error());
+    return XmlDocument{file, builder_.take_root()};
+  }
+
+private:
+  const SchemaCache &cache_;
+  std::unique_ptr<x::SAX2XMLReader> reader_;
+  x::SecurityManager security_;
+  LocalOnlyResolver resolver_;
+  TreeBuilder builder_;
+  Utf8 utf8_;
+};
+
+ProfileReader &thread_reader() {
+  thread_local ProfileReader reader;
+  return reader;
+}
+
+std::string_view trim(std::string_view s) {
+  auto first = s.find_first_not_of(" \t\r\n");
+  if (first == std::string_view::npos)
+    return {};
+  auto last = s.find_last_not_of(" \t\r\n");
+  return s.substr(first, last - first + 1);
+}
+
+} // namespace
+
+const std::string *XmlElement::attribute(std::string_view attribute_name) const {
+  for (const auto &[key, value] : attributes)
+    if (key == attribute_name)
+      return &value;
+  return nullptr;
+}
+
+const std::string &XmlElement::attr(std::string_view attribute_name) const {
+  static const std::string empty;
+  const std::string *value = attribute(attribute_name);
+  return value != nullptr ? *value : empty;
+}
+
+const XmlElement *XmlElement::child(std::string_view child_name) const {
+  for (const auto &c : children)
+    if (c.name == child_name)
+      return &c;
+  return nullptr;
+}
+
+std::string XmlElement::child_text(std::string_view child_name) const {
+  const XmlElement *c = child(child_name);
+  return c != nullptr ? c->trimmed_text() : std::string();
+}
+
+std::string XmlElement::trimmed_text() const { return std::string(trim(text)); }
+
+std::string_view embedded_schema(std::string_view file_name) {
+  std::size_t count = 0;
+  const auto *files = schemas::embedded_files(count);
+  for (std::size_t i = 0; i < count; ++i)
+    if (files[i].first == file_name)
+      return files[i].second;
+  return {};
+}
+
+Expected<XmlDocument> read_xml_profile_text(std::string_view text, std::string file_name) {
+  return thread_reader().read(text, file_name);
+}
+
+Expected<XmlDocument> read_xml_profile(const std::filesystem::path &file) {
+  const std::string name = file.string();
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec))
+    return make_error({name, 0, 0}, "missing-file", "no such file");
+  auto size = std::filesystem::file_size(file, ec);
+  if (ec)
+    return make_error({name, 0, 0}, "io", ec.message());
+  if (size > kMaxProfileBytes)
+    return make_error({name, 0, 0}, "too-large",
+                      fmt::format("the file is {} bytes; profiles are limited to {} bytes", size,
+                                  kMaxProfileBytes));
+  std::ifstream in(file, std::ios::binary);
+  if (!in)
+    return make_error({name, 0, 0}, "io", "cannot open the file for reading");
+  std::string text(static_cast<std::size_t>(size), '\0');
+  in.read(text.data(), static_cast<std::streamsize>(size));
+  if (!in)
+    return make_error({name, 0, 0}, "io", "cannot read the file");
+  return read_xml_profile_text(text, name);
+}
+
+} // namespace rsca::profile
