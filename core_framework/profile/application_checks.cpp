@@ -48,8 +48,7 @@ public:
     for (const auto &c : app_.sad->connections)
       check_connection(c);
     for (const auto &p : app_.sad->external_ports)
-      check_port(p.component_ref, p.port, p.uses ? PortDirection::Uses : PortDirection::Provides,
-                 p.where, fmt::format("external port \"{}\"", p.external_name));
+      check_external_port(p);
     for (const auto &p : app_.sad->external_properties)
       check_external_property(p);
   }
@@ -101,11 +100,7 @@ private:
     if (c.provides.target.kind != EndpointTarget::Kind::ComponentInstantiation)
       return;
     if (c.provides.kind == ProvidesEnd::Kind::SupportedInterface) {
-      const SoftwareComponent *scd = scd_of(c.provides.target.refid, c.provides.where, what);
-      if (scd != nullptr && !scd->supports(c.provides.port))
-        warn(c.provides.where, "unknown-interface",
-                     fmt::format("{}: component \"{}\" does not support interface {}", what,
-                                 c.provides.target.refid, c.provides.port));
+      check_supported_interface(c.provides.target.refid, c.provides.port, c.provides.where, what);
       return;
     }
     const PortDefinition *provides = check_port(c.provides.target.refid, c.provides.port,
@@ -115,6 +110,25 @@ private:
                    fmt::format("{}: uses port {}.{} sends {}, but provides port {}.{} takes {}",
                                what, c.uses.target.refid, uses->name, uses->repid,
                                c.provides.target.refid, provides->name, provides->repid));
+  }
+
+  void check_external_port(const ExternalPort &p) {
+    const std::string what = fmt::format("external port \"{}\"", p.external_name);
+    if (p.kind == ExternalPort::Kind::SupportedInterface) {
+      check_supported_interface(p.component_ref, p.port, p.where, what);
+      return;
+    }
+    check_port(p.component_ref, p.port,
+               p.kind == ExternalPort::Kind::Uses ? PortDirection::Uses : PortDirection::Provides,
+               p.where, what);
+  }
+
+  void check_supported_interface(const std::string &instance, const std::string &repid,
+                                 const SourceLocation &where, const std::string &what) {
+    const SoftwareComponent *scd = scd_of(instance, where, what);
+    if (scd != nullptr && !scd->supports(repid))
+      warn(where, "unknown-interface",
+           fmt::format("{}: component \"{}\" does not support interface {}", what, instance, repid));
   }
 
   void check_external_property(const ExternalProperty &p) {

@@ -145,6 +145,9 @@ Timing read_timing(ReadContext &ctx, const XmlElement &e) {
   timing.priority = ctx.optional_attr(e, "priority", parse_int<std::uint32_t>);
   timing.criticality = enum_attr(ctx, e, "criticality", kCriticality);
   auto finite = [](const std::optional<Duration> &d) { return d && !d->infinite(); };
+  if (timing.execution_time && timing.execution_time->infinite() &&
+      (finite(timing.deadline) || finite(timing.period)))
+    ctx.fail(e, "timing", "executiontime is infinite: no finite deadline or period can be met");
   if (finite(timing.execution_time) && finite(timing.deadline) &&
       *timing.execution_time->value > *timing.deadline->value)
     ctx.fail(e, "timing", "executiontime is longer than the deadline: no schedule can meet it");

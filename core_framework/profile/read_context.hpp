@@ -59,6 +59,21 @@ public:
     return optional_attr(e, name, parse_duration);
   }
 
+  // The value parsed by `parse` from the text of child `name`, or nullopt (reported when invalid).
+  template <typename Parse>
+  auto optional_child(const XmlElement &e, std::string_view name, Parse parse)
+      -> std::optional<typename decltype(parse(std::string_view{}))::value_type> {
+    const XmlElement *c = e.child(name);
+    if (c == nullptr)
+      return std::nullopt;
+    auto parsed = parse(c->trimmed_text());
+    if (!parsed) {
+      fail(*c, "value", fmt::format("{}: {}", name, parsed.error()));
+      return std::nullopt;
+    }
+    return *parsed;
+  }
+
 private:
   std::string file_;
   Error error_;

@@ -33,10 +33,13 @@ void read_external_ports(ReadContext &ctx, const XmlElement &e, SoftwareAssembly
     for (const auto &c : p.children) {
       if (c.name == "usesidentifier") {
         port.port = c.trimmed_text();
-        port.uses = true;
-      } else if (c.name == "providesidentifier" || c.name == "supportedidentifier") {
+        port.kind = ExternalPort::Kind::Uses;
+      } else if (c.name == "providesidentifier") {
         port.port = c.trimmed_text();
-        port.uses = false;
+        port.kind = ExternalPort::Kind::Provides;
+      } else if (c.name == "supportedidentifier") {
+        port.port = c.trimmed_text();
+        port.kind = ExternalPort::Kind::SupportedInterface;
       } else if (c.name == "componentinstantiationref") {
         port.component_ref = c.attr("refid");
       }

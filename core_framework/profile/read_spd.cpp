@@ -85,10 +85,8 @@ Implementation read_implementation(ReadContext &ctx, const XmlElement &e) {
       impl.code.type = read_code_type(c.attr("type"));
       impl.code.file = detail::read_localfile(ctx, c);
       impl.code.entrypoint = c.child_text("entrypoint");
-      if (const XmlElement *s = c.child("stacksize"))
-        impl.code.stack_size = ctx.optional_attr(*s, "value", parse_count);
-      if (const XmlElement *p = c.child("priority"))
-        impl.code.priority = ctx.optional_attr(*p, "value", parse_count);
+      impl.code.stack_size = ctx.optional_child(c, "stacksize", parse_count);
+      impl.code.priority = ctx.optional_child(c, "priority", parse_count);
     } else if (c.name == "compiler") {
       impl.compiler = {c.attr("name"), c.attr("version")};
     } else if (c.name == "programminglanguage") {

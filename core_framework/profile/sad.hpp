@@ -9,9 +9,10 @@
 namespace rsca::profile {
 
 struct ExternalPort {
+  enum class Kind : std::uint8_t { Uses, Provides, SupportedInterface };
   std::string external_name; // defaults to the port name
-  std::string port;
-  bool uses = true;
+  std::string port;          // port name, or the supported interface's repid
+  Kind kind = Kind::Uses;
   std::string component_ref;
   SourceLocation where;
 };

@@ -6,14 +6,15 @@ namespace fs = std::filesystem;
 
 SdrRoot::SdrRoot(fs::path root) : root_(std::move(root)) {}
 
+// The file must lie inside the root's dom/ or dev/: merely having such a folder beside it is not
+// enough, or every file on Linux would find "/" (which holds /dev).
 std::optional<SdrRoot> SdrRoot::find_for(const fs::path &file) {
   std::error_code ec;
   fs::path dir = fs::absolute(file, ec).lexically_normal().parent_path();
-  for (; !dir.empty(); dir = dir.parent_path()) {
-    if (fs::is_directory(dir / "dom", ec) || fs::is_directory(dir / "dev", ec))
-      return SdrRoot(dir);
-    if (dir == dir.root_path())
-      break;
+  for (; dir.has_relative_path(); dir = dir.parent_path()) {
+    const auto name = dir.filename();
+    if ((name == "dom" || name == "dev") && dir.parent_path().has_relative_path())
+      return SdrRoot(dir.parent_path());
   }
   return std::nullopt;
 }

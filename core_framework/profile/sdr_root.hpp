@@ -14,7 +14,7 @@ class SdrRoot {
 public:
   explicit SdrRoot(std::filesystem::path root);
 
-  // The nearest ancestor of `file` that holds dom/ or dev/.
+  // The nearest ancestor of `file` whose dom/ or dev/ holds the file.
   static std::optional<SdrRoot> find_for(const std::filesystem::path &file);
 
   const std::filesystem::path &path() const { return root_; }

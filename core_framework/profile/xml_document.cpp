@@ -1,6 +1,7 @@
 #include "profile/xml_document.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <fstream>
 #include <memory>
 #include <mutex>
@@ -275,6 +276,51 @@ private:
   Utf8 utf8_;
 };
 
+// Blanks the DOCTYPE declaration, if the prolog has one, keeping line breaks so every position
+// Xerces reports stays where it was. rsca never uses DTDs, and Xerces 3.2 leaks the DTD grammar it
+// builds for a DOCTYPE when parsing with a cached schema grammar (once per file), so the
+// declaration is removed before Xerces sees it. A text whose prolog this does not understand (an
+// unterminated DOCTYPE, a non-ASCII-compatible encoding) is left as it is for Xerces to judge.
+void blank_doctype(std::string &text) {
+  std::size_t i = text.rfind("\xEF\xBB\xBF", 0) == 0 ? 3 : 0;
+  auto skip_past = [&](std::string_view end) {
+    auto at = text.find(end, i);
+    i = at == std::string::npos ? text.size() : at + end.size();
+  };
+  while (i < text.size()) {
+    if (std::isspace(static_cast<unsigned char>(text[i]))) {
+      ++i;
+    } else if (text.compare(i, 2, "<?") == 0) {
+      skip_past("?>");
+    } else if (text.compare(i, 4, "<!--") == 0) {
+      skip_past("-->");
+    } else {
+      break;
+    }
+  }
+  if (text.compare(i, 9, "<!DOCTYPE") != 0)
+    return;
+  char quote = 0;
+  int depth = 0;
+  for (std::size_t j = i; j < text.size(); ++j) {
+    char c = text[j];
+    if (quote != 0) {
+      quote = c == quote ? 0 : quote;
+    } else if (c == '"' || c == '\'') {
+      quote = c;
+    } else if (c == '[') {
+      ++depth;
+    } else if (c == ']') {
+      --depth;
+    } else if (c == '>' && depth == 0) {
+      for (std::size_t k = i; k <= j; ++k)
+        if (text[k] != '\n' && text[k] != '\r')
+          text[k] = ' ';
+      return;
+    }
+  }
+}
+
 ProfileReader &thread_reader() {
   thread_local ProfileReader reader;
   return reader;
@@ -327,7 +373,9 @@ std::string_view embedded_schema(std::string_view file_name) {
 }
 
 Expected<XmlDocument> read_xml_profile_text(std::string_view text, std::string file_name) {
-  return thread_reader().read(text, file_name);
+  std::string without_doctype(text);
+  blank_doctype(without_doctype);
+  return thread_reader().read(without_doctype, file_name);
 }
 
 Expected<XmlDocument> read_xml_profile(const std::filesystem::path &file) {
@@ -349,7 +397,8 @@ Expected<XmlDocument> read_xml_profile(const std::filesystem::path &file) {
   in.read(text.data(), static_cast<std::streamsize>(size));
   if (!in)
     return make_error({name, 0, 0}, "io", "cannot read the file");
-  return read_xml_profile_text(text, name);
+  blank_doctype(text);
+  return thread_reader().read(text, name);
 }
 
 } // namespace rsca::profile
