@@ -1,7 +1,8 @@
 # Warnings and sanitizers for every rsca target: call rsca_target_options(<target>).
 add_library(rsca_compile_options INTERFACE)
 target_compile_options(rsca_compile_options INTERFACE
-  -Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor -Woverloaded-virtual -Wimplicit-fallthrough
+  -Wall -Wextra -Wpedantic -Wshadow -Wimplicit-fallthrough
+  $<$<COMPILE_LANGUAGE:CXX>:-Wnon-virtual-dtor -Woverloaded-virtual>
   $<$<BOOL:${RSCA_WERROR}>:-Werror>)
 
 if(RSCA_SANITIZE)

@@ -1,0 +1,566 @@
+#include "control/endpoint.hpp"
+
+#include <atomic>
+#include <condition_variable>
+#include <deque>
+#include <map>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include "control.h" // generated from dds/control.idl
+
+namespace rsca::control {
+
+std::string_view to_string(Status status) {
+  switch (status) {
+  case Status::Ok:
+    return "ok";
+  case Status::BadRequest:
+    return "bad request";
+  case Status::NotFound:
+    return "not found";
+  case Status::Failed:
+    return "failed";
+  case Status::Timeout:
+    return "timeout";
+  case Status::Unavailable:
+    return "unavailable";
+  case Status::Rejected:
+    return "rejected";
+  }
+  return "unknown";
+}
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using dds::Entity;
+
+constexpr const char *kRequestTopic = "rsca_ctl_Request";
+constexpr const char *kReplyTopic = "rsca_ctl_Reply";
+constexpr const char *kAnnouncementTopic = "rsca_ctl_Announcement";
+constexpr std::uint32_t kTakeBatch = 64;
+
+// A fixed set of threads running queued tasks in order of arrival.
+class WorkerPool {
+public:
+  explicit WorkerPool(std::size_t threads) {
+    for (std::size_t i = 0; i < threads; ++i)
+      threads_.emplace_back([this] { run(); });
+  }
+  ~WorkerPool() {
+    {
+      std::lock_guard lock(mutex_);
+      stopping_ = true;
+    }
+    wake_.notify_all();
+    for (auto &t : threads_)
+      t.join();
+  }
+  void post(std::function<void()> task) {
+    {
+      std::lock_guard lock(mutex_);
+      tasks_.push_back(std::move(task));
+    }
+    wake_.notify_one();
+  }
+
+private:
+  void run() {
+    for (;;) {
+      std::function<void()> task;
+      {
+        std::unique_lock lock(mutex_);
+        wake_.wait(lock, [this] { return stopping_ || !tasks_.empty(); });
+        if (tasks_.empty())
+          return;
+        task = std::move(tasks_.front());
+        tasks_.pop_front();
+      }
+      task();
+    }
+  }
+
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  std::deque<std::function<void()>> tasks_;
+  bool stopping_ = false;
+  std::vector<std::thread> threads_;
+};
+
+dds::Qos control_qos() {
+  auto qos = dds::make_qos();
+  dds_qset_reliability(qos.get(), DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
+  dds_qset_history(qos.get(), DDS_HISTORY_KEEP_ALL, 0);
+  dds_qset_durability(qos.get(), DDS_DURABILITY_VOLATILE);
+  return qos;
+}
+
+dds::Qos announcement_qos() {
+  auto qos = dds::make_qos();
+  dds_qset_reliability(qos.get(), DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
+  dds_qset_history(qos.get(), DDS_HISTORY_KEEP_LAST, 1);
+  dds_qset_durability(qos.get(), DDS_DURABILITY_TRANSIENT_LOCAL);
+  return qos;
+}
+
+dds::Qos partition_qos(const std::string &partition) {
+  auto qos = dds::make_qos();
+  const char *names[] = {partition.c_str()};
+  dds_qset_partition(qos.get(), 1, names);
+  return qos;
+}
+
+// A writer into one partition, with the publisher that carries the partition.
+struct PartitionWriter {
+  Entity publisher;
+  Entity writer;
+};
+
+Json parse_body(const char *text) {
+  if (text == nullptr || *text == '\0')
+    return Json::object();
+  return Json::parse(text, nullptr, /*allow_exceptions=*/false);
+}
+
+std::string str(const char *text) { return text != nullptr ? std::string(text) : std::string(); }
+
+} // namespace
+
+struct Endpoint::Impl {
+  struct Pending {
+    std::promise<CallResult<Json>> promise;
+    Clock::time_point deadline;
+    std::string target;
+    std::string operation;
+  };
+
+  std::shared_ptr<dds::Participant> participant;
+  std::string address;
+  EndpointOptions options;
+
+  Entity request_topic, reply_topic, announcement_topic;
+  Entity subscriber; // in this endpoint's partition
+  Entity request_reader, reply_reader, announcement_reader;
+  Entity waitset, guard;
+  Entity announcement_writer;
+
+  std::mutex writers_mutex;
+  std::map<std::string, PartitionWriter> request_writers, reply_writers;
+
+  std::mutex state_mutex;
+  std::map<std::string, Handler> handlers;
+  AnnouncementHandler announcement_handler;
+  std::map<std::string, Pending> pending;
+  std::uint64_t next_id = 0;
+
+  std::atomic<bool> stopping{false};
+  std::unique_ptr<WorkerPool> handler_pool; // runs request handlers
+  std::unique_ptr<WorkerPool> send_pool;    // writes requests, so callers never wait on discovery
+  std::thread receiver;
+
+  Expected<void> create_entities();
+  void receive_loop();
+  void take_requests();
+  void take_replies();
+  void take_announcements();
+  void expire_calls();
+  void serve(RequestContext context, Json body);
+  void send_request(std::string id, std::string target, std::string operation, std::string body);
+  void complete(const std::string &id, CallResult<Json> result);
+  CallResult<dds_entity_t> writer_to(std::map<std::string, PartitionWriter> &cache,
+                                     dds_entity_t topic, const std::string &partition,
+                                     Clock::time_point deadline);
+  void wake() { dds_set_guardcondition(guard.get(), true); }
+};
+
+Expected<void> Endpoint::Impl::create_entities() {
+  const dds_entity_t pp = participant->get();
+  auto make = [](dds_entity_t handle, std::string_view what, Entity &into) -> Expected<void> {
+    auto e = dds::checked(handle, what);
+    if (!e)
+      return tl::unexpected(e.error());
+    into = std::move(*e);
+    return {};
+  };
+  auto qos = control_qos();
+  auto aqos = announcement_qos();
+  auto own_partition = partition_qos(address);
+  Expected<void> ok =
+      make(dds_create_topic(pp, &rsca_ctl_Request_desc, kRequestTopic, qos.get(), nullptr),
+           "creating the request topic", request_topic)
+          .and_then([&] {
+            return make(dds_create_topic(pp, &rsca_ctl_Reply_desc, kReplyTopic, qos.get(), nullptr),
+                        "creating the reply topic", reply_topic);
+          })
+          .and_then([&] {
+            return make(dds_create_topic(pp, &rsca_ctl_Announcement_desc, kAnnouncementTopic,
+                                         aqos.get(), nullptr),
+                        "creating the announcement topic", announcement_topic);
+          })
+          .and_then([&] {
+            return make(dds_create_subscriber(pp, own_partition.get(), nullptr),
+                        "creating the subscriber", subscriber);
+          })
+          .and_then([&] {
+            return make(dds_create_reader(subscriber.get(), request_topic.get(), qos.get(), nullptr),
+                        "creating the request reader", request_reader);
+          })
+          .and_then([&] {
+            return make(dds_create_reader(subscriber.get(), reply_topic.get(), qos.get(), nullptr),
+                        "creating the reply reader", reply_reader);
+          })
+          .and_then([&] {
+            return make(dds_create_waitset(pp), "creating the waitset", waitset);
+          })
+          .and_then([&] {
+            return make(dds_create_guardcondition(pp), "creating the guard condition", guard);
+          });
+  if (!ok)
+    return ok;
+  dds_set_status_mask(request_reader.get(), DDS_DATA_AVAILABLE_STATUS);
+  dds_set_status_mask(reply_reader.get(), DDS_DATA_AVAILABLE_STATUS);
+  dds_waitset_attach(waitset.get(), request_reader.get(), request_reader.get());
+  dds_waitset_attach(waitset.get(), reply_reader.get(), reply_reader.get());
+  dds_waitset_attach(waitset.get(), guard.get(), guard.get());
+  if (!options.follow_announcements)
+    return {};
+  // Announcements are not partitioned: whoever follows them sees every endpoint's.
+  auto reader = make(dds_create_reader(pp, announcement_topic.get(), aqos.get(), nullptr),
+                     "creating the announcement reader", announcement_reader);
+  if (!reader)
+    return reader;
+  dds_set_status_mask(announcement_reader.get(), DDS_DATA_AVAILABLE_STATUS);
+  dds_waitset_attach(waitset.get(), announcement_reader.get(), announcement_reader.get());
+  return {};
+}
+
+void Endpoint::Impl::receive_loop() {
+  while (!stopping.load()) {
+    dds_duration_t timeout = DDS_SECS(1);
+    {
+      std::lock_guard lock(state_mutex);
+      const auto now = Clock::now();
+      for (const auto &[id, p] : pending)
+        timeout = std::min<dds_duration_t>(
+            timeout, std::max<dds_duration_t>(
+                         0, std::chrono::duration_cast<std::chrono::nanoseconds>(p.deadline - now)
+                                .count()));
+    }
+    dds_waitset_wait(waitset.get(), nullptr, 0, timeout);
+    bool triggered = false;
+    dds_take_guardcondition(guard.get(), &triggered);
+    take_requests();
+    take_replies();
+    if (announcement_reader)
+      take_announcements();
+    expire_calls();
+  }
+}
+
+void Endpoint::Impl::take_requests() {
+  void *samples[kTakeBatch] = {nullptr};
+  dds_sample_info_t infos[kTakeBatch];
+  for (;;) {
+    const dds_return_t n = dds_take(request_reader.get(), samples, infos, kTakeBatch, kTakeBatch);
+    if (n <= 0)
+      return;
+    for (dds_return_t i = 0; i < n; ++i) {
+      if (!infos[i].valid_data)
+        continue;
+      const auto *r = static_cast<const rsca_ctl_Request *>(samples[i]);
+      RequestContext context{str(r->id), str(r->sender), str(r->operation)};
+      Json body = parse_body(r->body);
+      handler_pool->post([this, context = std::move(context), body = std::move(body)]() mutable {
+        serve(std::move(context), std::move(body));
+      });
+    }
+    dds_return_loan(request_reader.get(), samples, n);
+  }
+}
+
+void Endpoint::Impl::serve(RequestContext context, Json body) {
+  Handler handler;
+  {
+    std::lock_guard lock(state_mutex);
+    auto it = handlers.find(context.operation);
+    if (it != handlers.end())
+      handler = it->second;
+  }
+  CallResult<Json> result =
+      body.is_discarded()
+          ? call_error(Status::BadRequest, "the request body is not valid JSON")
+      : handler ? handler(body, context)
+                : call_error(Status::BadRequest, fmt::format("{} does not serve operation \"{}\"",
+                                                             address, context.operation));
+  const std::string reply_body = result ? result->dump() : std::string();
+  const std::string error = result ? std::string() : result.error().message;
+  rsca_ctl_Reply reply{};
+  reply.id = const_cast<char *>(context.id.c_str());
+  reply.status = static_cast<std::int32_t>(result ? Status::Ok : result.error().status);
+  reply.error = const_cast<char *>(error.c_str());
+  reply.body = const_cast<char *>(reply_body.c_str());
+  auto writer = writer_to(reply_writers, reply_topic.get(), context.sender,
+                          Clock::now() + std::chrono::seconds(5));
+  if (!writer) {
+    spdlog::warn("{}: cannot reply to {} for {}: {}", address, context.sender, context.operation,
+                 writer.error().message);
+    return;
+  }
+  if (dds_return_t rc = dds_write(*writer, &reply); rc < 0)
+    spdlog::warn("{}: reply to {} failed: {}", address, context.sender, dds_strretcode(rc));
+}
+
+void Endpoint::Impl::take_replies() {
+  void *samples[kTakeBatch] = {nullptr};
+  dds_sample_info_t infos[kTakeBatch];
+  for (;;) {
+    const dds_return_t n = dds_take(reply_reader.get(), samples, infos, kTakeBatch, kTakeBatch);
+    if (n <= 0)
+      return;
+    for (dds_return_t i = 0; i < n; ++i) {
+      if (!infos[i].valid_data)
+        continue;
+      const auto *r = static_cast<const rsca_ctl_Reply *>(samples[i]);
+      const auto status = static_cast<Status>(r->status);
+      if (status != Status::Ok) {
+        complete(str(r->id), call_error(status, str(r->error)));
+        continue;
+      }
+      Json body = parse_body(r->body);
+      complete(str(r->id), body.is_discarded()
+                               ? CallResult<Json>(call_error(Status::Failed, "the reply is not JSON"))
+                               : CallResult<Json>(std::move(body)));
+    }
+    dds_return_loan(reply_reader.get(), samples, n);
+  }
+}
+
+void Endpoint::Impl::take_announcements() {
+  void *samples[kTakeBatch] = {nullptr};
+  dds_sample_info_t infos[kTakeBatch];
+  for (;;) {
+    const dds_return_t n =
+        dds_take(announcement_reader.get(), samples, infos, kTakeBatch, kTakeBatch);
+    if (n <= 0)
+      return;
+    AnnouncementHandler handler;
+    {
+      std::lock_guard lock(state_mutex);
+      handler = announcement_handler;
+    }
+    for (dds_return_t i = 0; i < n && handler; ++i) {
+      const auto *a = static_cast<const rsca_ctl_Announcement *>(samples[i]);
+      AnnouncementEvent event;
+      event.address = str(a->address);
+      if (infos[i].valid_data && infos[i].instance_state == DDS_IST_ALIVE) {
+        event.kind = AnnouncementEvent::Kind::Alive;
+        event.endpoint_kind = str(a->kind);
+        event.body = parse_body(a->body);
+      } else if (infos[i].instance_state != DDS_IST_ALIVE) {
+        event.kind = AnnouncementEvent::Kind::Gone;
+      } else {
+        continue;
+      }
+      handler(event);
+    }
+    dds_return_loan(announcement_reader.get(), samples, n);
+  }
+}
+
+void Endpoint::Impl::complete(const std::string &id, CallResult<Json> result) {
+  std::unique_lock lock(state_mutex);
+  auto it = pending.find(id);
+  if (it == pending.end())
+    return; // already timed out, or not ours
+  auto promise = std::move(it->second.promise);
+  pending.erase(it);
+  lock.unlock();
+  promise.set_value(std::move(result));
+}
+
+void Endpoint::Impl::expire_calls() {
+  std::vector<std::pair<std::promise<CallResult<Json>>, std::string>> expired;
+  {
+    std::lock_guard lock(state_mutex);
+    const auto now = Clock::now();
+    for (auto it = pending.begin(); it != pending.end();) {
+      if (it->second.deadline > now) {
+        ++it;
+        continue;
+      }
+      expired.emplace_back(std::move(it->second.promise),
+                           fmt::format("no reply from {} to \"{}\" before the deadline",
+                                       it->second.target, it->second.operation));
+      it = pending.erase(it);
+    }
+  }
+  for (auto &[promise, message] : expired)
+    promise.set_value(call_error(Status::Timeout, message));
+}
+
+CallResult<dds_entity_t> Endpoint::Impl::writer_to(std::map<std::string, PartitionWriter> &cache,
+                                                   dds_entity_t topic, const std::string &partition,
+                                                   Clock::time_point deadline) {
+  dds_entity_t writer = 0;
+  {
+    std::lock_guard lock(writers_mutex);
+    auto it = cache.find(partition);
+    if (it == cache.end()) {
+      auto pqos = partition_qos(partition);
+      auto publisher = dds::checked(dds_create_publisher(participant->get(), pqos.get(), nullptr),
+                                    "creating a publisher");
+      if (!publisher)
+        return call_error(Status::Failed, publisher.error().to_string());
+      auto qos = control_qos();
+      auto w = dds::checked(dds_create_writer(publisher->get(), topic, qos.get(), nullptr),
+                            "creating a writer");
+      if (!w)
+        return call_error(Status::Failed, w.error().to_string());
+      dds_set_status_mask(w->get(), DDS_PUBLICATION_MATCHED_STATUS);
+      it = cache.emplace(partition, PartitionWriter{std::move(*publisher), std::move(*w)}).first;
+    }
+    writer = it->second.writer.get();
+  }
+  // Volatile data written before the reader is matched is lost: wait for the match first.
+  Entity ws(dds_create_waitset(participant->get()));
+  dds_waitset_attach(ws.get(), writer, writer);
+  for (;;) {
+    dds_publication_matched_status_t status{};
+    if (dds_get_publication_matched_status(writer, &status) == 0 && status.current_count > 0)
+      return writer;
+    const auto left = deadline - Clock::now();
+    if (left <= Clock::duration::zero() || stopping.load())
+      return call_error(Status::Unavailable, fmt::format("no endpoint at address {}", partition));
+    dds_waitset_wait(ws.get(), nullptr, 0,
+                     std::min<dds_duration_t>(
+                         DDS_MSECS(100),
+                         std::chrono::duration_cast<std::chrono::nanoseconds>(left).count()));
+  }
+}
+
+void Endpoint::Impl::send_request(std::string id, std::string target, std::string operation,
+                                  std::string body) {
+  Clock::time_point deadline;
+  {
+    std::lock_guard lock(state_mutex);
+    auto it = pending.find(id);
+    if (it == pending.end())
+      return; // expired before it could be sent
+    deadline = it->second.deadline;
+  }
+  auto writer = writer_to(request_writers, request_topic.get(), target, deadline);
+  if (!writer) {
+    complete(id, tl::unexpected(writer.error()));
+    return;
+  }
+  rsca_ctl_Request request{};
+  request.id = id.data();
+  request.sender = address.data();
+  request.operation = operation.data();
+  request.body = body.data();
+  if (dds_return_t rc = dds_write(*writer, &request); rc < 0)
+    complete(id, call_error(Status::Failed, fmt::format("sending to {} failed: {}", target,
+                                                        dds_strretcode(rc))));
+}
+
+Endpoint::Endpoint(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+
+Expected<std::unique_ptr<Endpoint>> Endpoint::open(std::shared_ptr<dds::Participant> participant,
+                                                   std::string address, EndpointOptions options) {
+  if (address.empty() || address.find_first_of("*?[]\\") != std::string::npos)
+    return make_error({"control", 0, 0}, "address",
+                      fmt::format("\"{}\" is not a valid endpoint address", address));
+  auto impl = std::make_unique<Impl>();
+  impl->participant = std::move(participant);
+  impl->address = std::move(address);
+  impl->options = options;
+  if (auto ok = impl->create_entities(); !ok)
+    return tl::unexpected(ok.error());
+  impl->handler_pool = std::make_unique<WorkerPool>(std::max<std::size_t>(1, options.workers));
+  impl->send_pool = std::make_unique<WorkerPool>(4);
+  Impl *raw = impl.get();
+  impl->receiver = std::thread([raw] { raw->receive_loop(); });
+  return std::unique_ptr<Endpoint>(new Endpoint(std::move(impl)));
+}
+
+Endpoint::~Endpoint() {
+  impl_->stopping = true;
+  impl_->wake();
+  impl_->receiver.join();
+  impl_->send_pool.reset();
+  impl_->handler_pool.reset();
+  std::map<std::string, Impl::Pending> left;
+  {
+    std::lock_guard lock(impl_->state_mutex);
+    left.swap(impl_->pending);
+  }
+  for (auto &[id, p] : left)
+    p.promise.set_value(call_error(Status::Unavailable, "the endpoint is shutting down"));
+}
+
+const std::string &Endpoint::address() const { return impl_->address; }
+
+void Endpoint::on(const std::string &operation, Handler handler) {
+  std::lock_guard lock(impl_->state_mutex);
+  impl_->handlers[operation] = std::move(handler);
+}
+
+void Endpoint::on_announcement(AnnouncementHandler handler) {
+  std::lock_guard lock(impl_->state_mutex);
+  impl_->announcement_handler = std::move(handler);
+}
+
+std::future<CallResult<Json>> Endpoint::call(const std::string &target, const std::string &operation,
+                                             Json body, std::chrono::milliseconds timeout) {
+  std::future<CallResult<Json>> future;
+  std::string id;
+  {
+    std::lock_guard lock(impl_->state_mutex);
+    id = fmt::format("{}#{}", impl_->address, ++impl_->next_id);
+    Impl::Pending pending{{}, Clock::now() + timeout, target, operation};
+    future = pending.promise.get_future();
+    impl_->pending.emplace(id, std::move(pending));
+  }
+  impl_->wake(); // the receiver recomputes its timeout
+  impl_->send_pool->post([impl = impl_.get(), id, target, operation, text = body.dump()]() mutable {
+    impl->send_request(std::move(id), std::move(target), std::move(operation), std::move(text));
+  });
+  return future;
+}
+
+Expected<void> Endpoint::announce(const std::string &kind, const Json &body) {
+  if (!impl_->announcement_writer) {
+    auto qos = announcement_qos();
+    auto w = dds::checked(dds_create_writer(impl_->participant->get(),
+                                            impl_->announcement_topic.get(), qos.get(), nullptr),
+                          "creating the announcement writer");
+    if (!w)
+      return tl::unexpected(w.error());
+    impl_->announcement_writer = std::move(*w);
+  }
+  const std::string text = body.dump();
+  rsca_ctl_Announcement a{};
+  a.address = impl_->address.data();
+  a.kind = const_cast<char *>(kind.c_str());
+  a.body = const_cast<char *>(text.c_str());
+  if (dds_return_t rc = dds_write(impl_->announcement_writer.get(), &a); rc < 0)
+    return tl::unexpected(dds::dds_error(rc, "announcing"));
+  return {};
+}
+
+void Endpoint::withdraw() {
+  if (!impl_->announcement_writer)
+    return;
+  rsca_ctl_Announcement a{};
+  a.address = impl_->address.data();
+  a.kind = const_cast<char *>("");
+  a.body = const_cast<char *>("");
+  dds_dispose(impl_->announcement_writer.get(), &a);
+}
+
+} // namespace rsca::control

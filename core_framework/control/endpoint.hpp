@@ -1,0 +1,104 @@
+// The control plane: every rsca process (domain daemon, node daemons, components, the CLI) owns
+// one Endpoint, named by an address. Requests to an address are written into the DDS partition
+// of that name, so only the addressed process receives them; replies go back into the sender's
+// partition. Every call has a deadline. Handlers run on worker threads, never on the thread that
+// takes samples, so a handler may itself call other endpoints and wait.
+#pragma once
+
+#include <chrono>
+#include <functional>
+#include <future>
+#include <memory>
+#include <string>
+
+#include <nlohmann/json.hpp>
+#include <tl/expected.hpp>
+
+#include "common/diagnostic.hpp"
+#include "dds/participant.hpp"
+
+namespace rsca::control {
+
+using Json = nlohmann::json;
+
+// Why a call failed. Travels in replies, so the values are part of the wire protocol.
+enum class Status : std::int32_t {
+  Ok = 0,
+  BadRequest = 1,  // the request makes no sense (unknown operation, malformed body)
+  NotFound = 2,    // the thing named does not exist
+  Failed = 3,      // the operation was tried and failed; the message says where and why
+  Timeout = 4,     // no reply before the deadline
+  Unavailable = 5, // nobody at the address, or the endpoint is shutting down
+  Rejected = 6,    // refused by policy (admission control, conflicting state)
+};
+std::string_view to_string(Status status);
+
+struct CallError {
+  Status status = Status::Failed;
+  std::string message;
+};
+
+template <typename T>
+using CallResult = tl::expected<T, CallError>;
+
+inline tl::unexpected<CallError> call_error(Status status, std::string message) {
+  return tl::unexpected(CallError{status, std::move(message)});
+}
+
+struct RequestContext {
+  std::string id;
+  std::string sender;
+  std::string operation;
+};
+
+using Handler = std::function<CallResult<Json>(const Json &body, const RequestContext &context)>;
+
+// An endpoint's announcement as others see it.
+struct AnnouncementEvent {
+  enum class Kind : std::uint8_t { Alive, Gone };
+  Kind kind = Kind::Alive;
+  std::string address;
+  std::string endpoint_kind; // "node", "component", "domain"; empty when Gone
+  Json body;                 // empty when Gone
+};
+using AnnouncementHandler = std::function<void(const AnnouncementEvent &)>;
+
+struct EndpointOptions {
+  std::size_t workers = 8;
+  bool follow_announcements = false; // receive other endpoints' announcements
+};
+
+class Endpoint {
+public:
+  static Expected<std::unique_ptr<Endpoint>> open(std::shared_ptr<dds::Participant> participant,
+                                                  std::string address, EndpointOptions options = {});
+  ~Endpoint();
+  Endpoint(const Endpoint &) = delete;
+  Endpoint &operator=(const Endpoint &) = delete;
+
+  const std::string &address() const;
+
+  // Serves `operation`; a later registration replaces an earlier one.
+  void on(const std::string &operation, Handler handler);
+  // Called for every announcement change; runs on the receiving thread and must not block.
+  void on_announcement(AnnouncementHandler handler);
+
+  std::future<CallResult<Json>> call(const std::string &target, const std::string &operation,
+                                     Json body, std::chrono::milliseconds timeout);
+  CallResult<Json> call_sync(const std::string &target, const std::string &operation, Json body,
+                             std::chrono::milliseconds timeout) {
+    return call(target, operation, std::move(body), timeout).get();
+  }
+
+  // Publishes (or updates) this endpoint's announcement; `withdraw` removes it.
+  Expected<void> announce(const std::string &kind, const Json &body);
+  void withdraw();
+
+  struct Impl;
+
+private:
+  explicit Endpoint(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+} // namespace rsca::control

@@ -1,0 +1,133 @@
+// The control plane between real DDS participants in one process, on a DDS domain of its own.
+#include <atomic>
+#include <condition_variable>
+#include <mutex>
+#include <unistd.h>
+
+#include <catch2/catch.hpp>
+
+#include "control/endpoint.hpp"
+#include "test_domain.hpp"
+
+using namespace rsca;
+using namespace std::chrono_literals;
+using control::Endpoint;
+using control::Json;
+using control::Status;
+
+namespace {
+
+std::unique_ptr<Endpoint> open(const std::shared_ptr<dds::Participant> &pp, const std::string &address,
+                               control::EndpointOptions options = {}) {
+  auto endpoint = Endpoint::open(pp, address, options);
+  REQUIRE(endpoint.has_value());
+  return std::move(*endpoint);
+}
+
+} // namespace
+
+TEST_CASE("a call reaches the addressed endpoint and its reply comes back", "[control]") {
+  auto pp = test::participant();
+  auto server = open(pp, "test/server");
+  auto other = open(pp, "test/other");
+  std::atomic<int> other_calls{0};
+  server->on("add", [](const Json &body, const control::RequestContext &ctx) -> control::CallResult<Json> {
+    return Json{{"sum", body.at("a").get<int>() + body.at("b").get<int>()}, {"from", ctx.sender}};
+  });
+  other->on("add", [&](const Json &, const control::RequestContext &) -> control::CallResult<Json> {
+    ++other_calls;
+    return Json{};
+  });
+  auto client = open(pp, "test/client");
+  auto reply = client->call_sync("test/server", "add", Json{{"a", 2}, {"b", 40}}, 5s);
+  REQUIRE(reply.has_value());
+  CHECK(reply->at("sum") == 42);
+  CHECK(reply->at("from") == "test/client");
+  CHECK(other_calls == 0); // partitions keep requests to their addressee
+}
+
+TEST_CASE("errors travel back with their status", "[control]") {
+  auto pp = test::participant();
+  auto server = open(pp, "test/server");
+  server->on("fail", [](const Json &, const control::RequestContext &) -> control::CallResult<Json> {
+    return control::call_error(Status::Rejected, "not enough memory on gpp@node2");
+  });
+  auto client = open(pp, "test/client");
+  auto reply = client->call_sync("test/server", "fail", Json::object(), 5s);
+  REQUIRE_FALSE(reply.has_value());
+  CHECK(reply.error().status == Status::Rejected);
+  CHECK(reply.error().message == "not enough memory on gpp@node2");
+
+  auto unknown = client->call_sync("test/server", "nope", Json::object(), 5s);
+  REQUIRE_FALSE(unknown.has_value());
+  CHECK(unknown.error().status == Status::BadRequest);
+  CHECK_THAT(unknown.error().message, Catch::Contains("does not serve operation \"nope\""));
+}
+
+TEST_CASE("a call to nobody fails when its deadline passes", "[control]") {
+  auto pp = test::participant();
+  auto client = open(pp, "test/client");
+  const auto start = std::chrono::steady_clock::now();
+  auto reply = client->call_sync("test/nobody", "x", Json::object(), 300ms);
+  REQUIRE_FALSE(reply.has_value());
+  CHECK((reply.error().status == Status::Unavailable || reply.error().status == Status::Timeout));
+  CHECK(std::chrono::steady_clock::now() - start < 5s);
+}
+
+TEST_CASE("a slow handler times out the caller but does not block other calls", "[control]") {
+  auto pp = test::participant();
+  auto server = open(pp, "test/server");
+  std::mutex m;
+  std::condition_variable cv;
+  bool release = false;
+  server->on("slow", [&](const Json &, const control::RequestContext &) -> control::CallResult<Json> {
+    std::unique_lock lock(m);
+    cv.wait(lock, [&] { return release; });
+    return Json{};
+  });
+  server->on("fast", [](const Json &, const control::RequestContext &) -> control::CallResult<Json> {
+    return Json{{"ok", true}};
+  });
+  auto client = open(pp, "test/client");
+  auto slow = client->call("test/server", "slow", Json::object(), 300ms);
+  auto fast = client->call_sync("test/server", "fast", Json::object(), 5s);
+  CHECK(fast.has_value());
+  auto slow_result = slow.get();
+  REQUIRE_FALSE(slow_result.has_value());
+  CHECK(slow_result.error().status == Status::Timeout);
+  {
+    std::lock_guard lock(m);
+    release = true;
+  }
+  cv.notify_all();
+}
+
+TEST_CASE("announcements are seen, updated and withdrawn", "[control]") {
+  auto pp = test::participant();
+  std::mutex m;
+  std::condition_variable cv;
+  std::vector<control::AnnouncementEvent> events;
+  auto watcher = open(pp, "test/watcher", {.workers = 1, .follow_announcements = true});
+  watcher->on_announcement([&](const control::AnnouncementEvent &e) {
+    std::lock_guard lock(m);
+    events.push_back(e);
+    cv.notify_all();
+  });
+  auto wait_for = [&](auto predicate) {
+    std::unique_lock lock(m);
+    return cv.wait_for(lock, 5s, [&] { return predicate(events); });
+  };
+  {
+    auto node = open(pp, "test/node1");
+    REQUIRE(node->announce("node", Json{{"devices", 1}}).has_value());
+    CHECK(wait_for([](const auto &ev) {
+      return !ev.empty() && ev.back().address == "test/node1" &&
+             ev.back().kind == control::AnnouncementEvent::Kind::Alive && ev.back().body.at("devices") == 1;
+    }));
+    REQUIRE(node->announce("node", Json{{"devices", 2}}).has_value());
+    CHECK(wait_for([](const auto &ev) { return ev.back().body.value("devices", 0) == 2; }));
+  } // the endpoint goes: its announcement is disposed
+  CHECK(wait_for([](const auto &ev) {
+    return ev.back().address == "test/node1" && ev.back().kind == control::AnnouncementEvent::Kind::Gone;
+  }));
+}

@@ -1,0 +1,32 @@
+// DDS isolation for tests: each test process joins a DDS domain of its own, so tests running in
+// parallel (and leftovers of a crashed run) never see each other.
+#pragma once
+
+#include <memory>
+#include <unistd.h>
+
+#include <catch2/catch.hpp>
+
+#include "dds/participant.hpp"
+
+namespace rsca::test {
+
+// A domain id from 1 to 230 derived from the process id: ctest runs each test case in its own
+// process, so concurrent tests get different ids (Cyclone maps ids above 232 to invalid ports).
+inline std::uint32_t isolated_domain_id() {
+  return 1 + static_cast<std::uint32_t>(::getpid()) % 230;
+}
+
+inline dds::DdsSettings isolated_settings() {
+  auto settings = dds::DdsSettings::from_environment();
+  settings.domain_id = isolated_domain_id();
+  return settings;
+}
+
+inline std::shared_ptr<dds::Participant> participant() {
+  auto pp = dds::Participant::create(isolated_settings());
+  REQUIRE(pp.has_value());
+  return *pp;
+}
+
+} // namespace rsca::test
