@@ -83,6 +83,7 @@ struct EndpointTarget {
   std::string refid;     // the component instantiation (for device refs: the component)
   std::string usesrefid; // DeviceUsedByThisComponent: the usesdevice id
   FindBy findby;
+  SourceLocation where;  // the reference element itself
 };
 
 struct UsesEnd {

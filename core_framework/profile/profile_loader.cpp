@@ -25,6 +25,12 @@ std::vector<Diagnostic> split_findings(std::vector<Diagnostic> findings, Error &
   return warnings;
 }
 
+// The descriptor name with its article: "ess" sounds a vowel, so "an SPD" but "a PRF".
+std::string with_article(DescriptorType type) {
+  const std::string_view name = to_string(type);
+  return fmt::format("{} {}", name.front() == 'S' ? "an" : "a", name);
+}
+
 template <typename T>
 DescriptorType descriptor_type_for() {
   return type_of(Descriptor(std::in_place_type<T>));
@@ -78,6 +84,13 @@ Expected<std::shared_ptr<const Descriptor>>
 ProfileLoader::cached_descriptor(const fs::path &file, const SourceLocation &referenced_at) {
   const fs::path key = fs::absolute(file).lexically_normal();
   std::error_code ec;
+  if (!referenced_at.file.empty()) {
+    auto root = root_for(referenced_at.file);
+    if (root && !root->contains(key))
+      return make_error(referenced_at, "outside-sdrroot",
+                        fmt::format("the file named here, {}, lies outside the SDR root {}",
+                                    key.string(), root->path().string()));
+  }
   if (!referenced_at.file.empty() && !fs::is_regular_file(key, ec))
     return make_error(referenced_at, "missing-file",
                       fmt::format("the file named here does not exist: {}", key.string()));
@@ -102,8 +115,8 @@ Expected<std::shared_ptr<const T>> ProfileLoader::cached(const fs::path &file,
   if (typed == nullptr)
     return make_error(referenced_at.file.empty() ? SourceLocation{file.string(), 0, 0} : referenced_at,
                       "wrong-descriptor",
-                      fmt::format("expected a {}, but {} is a {}", to_string(descriptor_type_for<T>()),
-                                  file.string(), to_string(type_of(**descriptor))));
+                      fmt::format("expected {}, but {} is {}", with_article(descriptor_type_for<T>()),
+                                  file.string(), with_article(type_of(**descriptor))));
   return std::shared_ptr<const T>(*descriptor, typed);
 }
 
@@ -168,7 +181,7 @@ ProfileLoader::softpkg(const fs::path &spd_file, const SourceLocation &reference
         std::vector<std::string> ids;
         for (const auto &i : (*dep)->spd->implementations)
           ids.push_back(i.id);
-        errors.add({ref.where, "dangling-ref",
+        errors.add({ref.implref_where, "dangling-ref",
                     fmt::format("implref \"{}\" names no implementation of {} (it has: {})",
                                 *ref.implref, (*dep)->spd->name, fmt::join(ids, ", "))});
       }

@@ -5,6 +5,17 @@
 namespace rsca::profile {
 namespace {
 
+// Binding errors carry the rule they break, as the PRF reader's own errors do.
+struct BindError {
+  std::string rule;
+  std::string message;
+};
+template <typename T>
+using Bound = tl::expected<T, BindError>;
+tl::unexpected<BindError> bind_error(std::string rule, std::string message) {
+  return tl::unexpected(BindError{std::move(rule), std::move(message)});
+}
+
 std::string_view form_name(const PropertyDefinition &d) {
   constexpr std::string_view names[] = {"simple", "simplesequence", "struct", "structsequence"};
   return names[d.index()];
@@ -17,26 +28,26 @@ std::string_view ref_form_name(const PropertyRef &r) {
 }
 
 // Checks one value against a simple definition's type, enumerations and range.
-tl::expected<Scalar, std::string> bind_scalar(const std::string &id, TypeSpec type,
-                                              const std::optional<ValueRange> &range,
-                                              const std::vector<Enumeration> &enumerations,
-                                              const std::string &text) {
+Bound<Scalar> bind_scalar(const std::string &id, TypeSpec type,
+                          const std::optional<ValueRange> &range,
+                          const std::vector<Enumeration> &enumerations, const std::string &text) {
   // REDHAWK lets a value name an enumeration label instead of the value itself.
   for (const auto &e : enumerations)
     if (e.label == text)
       return e.value;
   auto value = parse_scalar(type, text);
   if (!value)
-    return tl::unexpected(fmt::format("property \"{}\": {}", id, value.error()));
+    return bind_error("value", fmt::format("property \"{}\": {}", id, value.error()));
   if (range && !(satisfies(Action::Ge, *value, range->min).value_or(true) &&
                  satisfies(Action::Le, *value, range->max).value_or(true)))
-    return tl::unexpected(fmt::format("property \"{}\": {} is outside its range {}..{}", id, text,
-                                      format_scalar(range->min), format_scalar(range->max)));
-  return value;
+    return bind_error("range", fmt::format("property \"{}\": {} is outside its range {}..{}", id,
+                                           text, format_scalar(range->min),
+                                           format_scalar(range->max)));
+  return *value;
 }
 
-tl::expected<std::vector<Scalar>, std::string> bind_sequence(const SimpleSequenceProperty &d,
-                                                             const SimpleSequenceRef &r) {
+Bound<std::vector<Scalar>> bind_sequence(const SimpleSequenceProperty &d,
+                                         const SimpleSequenceRef &r) {
   std::vector<Scalar> values;
   values.reserve(r.values.size());
   for (const auto &text : r.values) {
@@ -48,18 +59,19 @@ tl::expected<std::vector<Scalar>, std::string> bind_sequence(const SimpleSequenc
   return values;
 }
 
-tl::expected<StructValue, std::string> bind_struct(const StructProperty &d, const StructRef &r) {
+Bound<StructValue> bind_struct(const StructProperty &d, const StructRef &r) {
   StructValue value;
   for (const auto &member_ref : r.members) {
     const std::string &refid =
         std::visit([](const auto &m) -> const std::string & { return m.refid; }, member_ref);
     const StructMember *member = d.find_member(refid);
     if (member == nullptr)
-      return tl::unexpected(fmt::format("struct \"{}\" has no member \"{}\"", d.id, refid));
+      return bind_error("unknown-property",
+                        fmt::format("struct \"{}\" has no member \"{}\"", d.id, refid));
     if (const auto *simple = std::get_if<SimpleProperty>(member)) {
       const auto *simple_ref = std::get_if<SimpleRef>(&member_ref);
       if (simple_ref == nullptr)
-        return tl::unexpected(fmt::format("member \"{}\" is a simple: use simpleref", refid));
+        return bind_error("value", fmt::format("member \"{}\" is a simple: use simpleref", refid));
       auto v = bind_scalar(refid, simple->type, simple->range, simple->enumerations,
                            simple_ref->value);
       if (!v)
@@ -69,7 +81,8 @@ tl::expected<StructValue, std::string> bind_struct(const StructProperty &d, cons
     }
     const auto *seq_ref = std::get_if<SimpleSequenceRef>(&member_ref);
     if (seq_ref == nullptr)
-      return tl::unexpected(fmt::format("member \"{}\" is a simplesequence: use simplesequenceref", refid));
+      return bind_error("value",
+                        fmt::format("member \"{}\" is a simplesequence: use simplesequenceref", refid));
     auto v = bind_sequence(std::get<SimpleSequenceProperty>(*member), *seq_ref);
     if (!v)
       return tl::unexpected(v.error());
@@ -79,14 +92,13 @@ tl::expected<StructValue, std::string> bind_struct(const StructProperty &d, cons
 }
 
 template <typename T>
-tl::expected<PropertyValue, std::string> widen(tl::expected<T, std::string> v) {
+Bound<PropertyValue> widen(Bound<T> v) {
   if (!v)
     return tl::unexpected(v.error());
   return PropertyValue(std::move(*v));
 }
 
-tl::expected<PropertyValue, std::string> bind(const PropertyDefinition &definition,
-                                              const PropertyRef &ref) {
+Bound<PropertyValue> bind(const PropertyDefinition &definition, const PropertyRef &ref) {
   if (const auto *d = std::get_if<SimpleProperty>(&definition))
     if (const auto *r = std::get_if<SimpleRef>(&ref))
       return widen(bind_scalar(d->id, d->type, d->range, d->enumerations, r->value));
@@ -108,9 +120,9 @@ tl::expected<PropertyValue, std::string> bind(const PropertyDefinition &definiti
       return PropertyValue(std::move(values));
     }
   }
-  return tl::unexpected(fmt::format("property \"{}\" is a {}, but is given as a {}",
-                                    common_of(definition).id, form_name(definition),
-                                    ref_form_name(ref)));
+  return bind_error("value", fmt::format("property \"{}\" is a {}, but is given as a {}",
+                                         common_of(definition).id, form_name(definition),
+                                         ref_form_name(ref)));
 }
 
 } // namespace
@@ -118,7 +130,7 @@ tl::expected<PropertyValue, std::string> bind(const PropertyDefinition &definiti
 Expected<PropertyValue> bind_property(const PropertyDefinition &definition, const PropertyRef &ref) {
   auto value = bind(definition, ref);
   if (!value)
-    return make_error(location_of(ref), "value", value.error());
+    return make_error(location_of(ref), value.error().rule, value.error().message);
   return std::move(*value);
 }
 

@@ -94,9 +94,12 @@ FindBy read_findby(const XmlElement &e) {
 
 // The object an end of a connection names: one of the children of usesport, providesport or
 // componentsupportedinterface.
-EndpointTarget read_target(const XmlElement &end) {
+EndpointTarget read_target(ReadContext &ctx, const XmlElement &end) {
   EndpointTarget target;
   for (const auto &c : end.children) {
+    if (c.name != "usesidentifier" && c.name != "providesidentifier" &&
+        c.name != "supportedidentifier")
+      target.where = ctx.at(c);
     if (c.name == "componentinstantiationref") {
       target.kind = EndpointTarget::Kind::ComponentInstantiation;
       target.refid = c.attr("refid");
@@ -265,17 +268,18 @@ std::vector<Connection> read_connections(ReadContext &ctx, const XmlElement *hol
     c.where = ctx.at(e);
     for (const auto &part : e.children) {
       if (part.name == "usesport") {
-        c.uses = {part.child_text("usesidentifier"), read_target(part), ctx.at(part)};
+        c.uses = {part.child_text("usesidentifier"), read_target(ctx, part), ctx.at(part)};
       } else if (part.name == "providesport") {
         c.provides = {ProvidesEnd::Kind::Port, part.child_text("providesidentifier"),
-                      read_target(part), ctx.at(part)};
+                      read_target(ctx, part), ctx.at(part)};
       } else if (part.name == "componentsupportedinterface") {
         c.provides = {ProvidesEnd::Kind::SupportedInterface, part.child_text("supportedidentifier"),
-                      read_target(part), ctx.at(part)};
+                      read_target(ctx, part), ctx.at(part)};
       } else if (part.name == "findby") {
         c.provides.kind = ProvidesEnd::Kind::FindBy;
         c.provides.target.kind = EndpointTarget::Kind::FindBy;
         c.provides.target.findby = read_findby(part);
+        c.provides.target.where = ctx.at(part);
         c.provides.where = ctx.at(part);
       } else if (part.name == "qos") {
         c.qos = read_qos(ctx, part);
@@ -315,11 +319,10 @@ void check_assembly_references(ReadContext &ctx, const std::vector<ComponentFile
                                 ci.id)});
   }
 
-  auto check_target = [&](const EndpointTarget &t, const SourceLocation &where,
-                          const Connection &c) {
+  auto check_target = [&](const EndpointTarget &t, const Connection &c) {
     if (t.kind == EndpointTarget::Kind::FindBy || instance_ids.count(t.refid) != 0)
       return;
-    ctx.report({where, "dangling-ref",
+    ctx.report({t.where, "dangling-ref",
                 fmt::format("{} refers to componentinstantiation \"{}\", which this file does "
                             "not define",
                             connection_label(c), t.refid)});
@@ -329,8 +332,8 @@ void check_assembly_references(ReadContext &ctx, const std::vector<ComponentFile
     if (!c.id.empty() && !connection_ids.insert(c.id).second)
       ctx.report({c.where, "duplicate-id",
                   fmt::format("connectinterface id \"{}\" is defined more than once", c.id)});
-    check_target(c.uses.target, c.uses.where, c);
-    check_target(c.provides.target, c.provides.where, c);
+    check_target(c.uses.target, c);
+    check_target(c.provides.target, c);
     if (c.subscribes_to_channel() && c.publishes_to_channel())
       ctx.report({c.where, "connection",
                   fmt::format("{} joins two event channels; one end must be a component port",

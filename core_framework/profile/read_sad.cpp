@@ -65,9 +65,12 @@ void read_latency_paths(ReadContext &ctx, const XmlElement &e, SoftwareAssembly 
     path.id = p.attr("id");
     path.where = ctx.at(p);
     path.bound = ctx.duration_attr(p, "bound").value_or(Duration{});
-    for (const auto &c : p.children)
-      if (c.name == "componentinstantiationref")
-        path.components.push_back(c.attr("refid"));
+    for (const auto &c : p.children) {
+      if (c.name != "componentinstantiationref")
+        continue;
+      path.components.push_back(c.attr("refid"));
+      path.component_where.push_back(ctx.at(c));
+    }
     sad.latency_paths.push_back(std::move(path));
   }
 }
@@ -92,8 +95,9 @@ void check_instance_refs(ReadContext &ctx, const SoftwareAssembly &sad) {
                   fmt::format("external property \"{}\" is defined more than once", p.external_id)});
   }
   for (const auto &path : sad.latency_paths)
-    for (const auto &c : path.components)
-      require(c, path.where, fmt::format("latency path \"{}\"", path.id));
+    for (std::size_t i = 0; i < path.components.size(); ++i)
+      require(path.components[i], path.component_where[i],
+              fmt::format("latency path \"{}\"", path.id));
 }
 
 } // namespace

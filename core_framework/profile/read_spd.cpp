@@ -63,9 +63,11 @@ CodeType read_code_type(const std::string &type) {
 void read_dependency(ReadContext &ctx, const XmlElement &e, Implementation &impl) {
   for (const auto &c : e.children) {
     if (c.name == "softpkgref") {
-      SoftPkgRef ref{detail::read_localfile(ctx, c), std::nullopt, ctx.at(c)};
-      if (const XmlElement *implref = c.child("implref"))
+      SoftPkgRef ref{detail::read_localfile(ctx, c), std::nullopt, {}, ctx.at(c)};
+      if (const XmlElement *implref = c.child("implref")) {
         ref.implref = implref->attr("refid");
+        ref.implref_where = ctx.at(*implref);
+      }
       impl.softpkg_dependencies.push_back(std::move(ref));
     } else if (detail::is_property_ref(c.name)) {
       impl.property_dependencies.push_back({e.attr("type"), detail::read_property_ref(ctx, c)});

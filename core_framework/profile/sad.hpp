@@ -29,6 +29,7 @@ struct LatencyPath {
   std::string id;
   Duration bound;
   std::vector<std::string> components;
+  std::vector<SourceLocation> component_where; // where each component is named
   SourceLocation where;
 };
 

@@ -19,6 +19,11 @@ std::optional<SdrRoot> SdrRoot::find_for(const fs::path &file) {
   return std::nullopt;
 }
 
+bool SdrRoot::contains(const fs::path &file) const {
+  const auto rel = file.lexically_normal().lexically_relative(root_);
+  return !rel.empty() && *rel.begin() != "..";
+}
+
 fs::path SdrRoot::resolve(std::string_view name, const fs::path &referencing_file,
                           SdrTree tree) const {
   if (!name.empty() && name.front() == '/') {

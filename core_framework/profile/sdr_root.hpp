@@ -24,6 +24,9 @@ public:
   std::filesystem::path resolve(std::string_view name, const std::filesystem::path &referencing_file,
                                 SdrTree tree) const;
 
+  // Whether `file` (normalised) lies inside this SDR root.
+  bool contains(const std::filesystem::path &file) const;
+
 private:
   std::filesystem::path root_;
 };

@@ -39,6 +39,7 @@ struct NamedVersion {
 struct SoftPkgRef {
   LocalFile file;
   std::optional<std::string> implref;
+  SourceLocation implref_where;
   SourceLocation where;
 };
 

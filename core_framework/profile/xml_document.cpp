@@ -37,6 +37,44 @@ namespace x = xercesc;
 
 constexpr std::string_view kRootSchema = "rsca.xsd";
 constexpr std::size_t kMaxDiagnosticsPerFile = 20;
+// No profile nests deeper than about ten levels; a deeper document is refused before its depth
+// can cost time (Xerces' namespace lookups grow with depth) or stack (the tree is recursive).
+constexpr std::size_t kMaxDepth = 64;
+
+// The schema's own pattern facets, and what to tell a user whose value does not match one.
+struct PatternMeaning {
+  std::string_view facet;
+  std::string_view expected;
+};
+constexpr PatternMeaning kPatternMeanings[] = {
+    {"[0-9]+(\\.[0-9]+)?(ns|us|ms|s)", "a duration such as 10ms, 1.5s or 250us, or infinite"},
+    {"[0-9]+(\\.[0-9]+)?(B|KiB|MiB|GiB|kB|MB|GB)", "a size such as 64MiB or 512kB"},
+    {"[0-9]+(\\.[0-9]+)?(bps|kbps|Mbps|Gbps)", "a bit rate such as 10Mbps"},
+    {"[+\\-]?[0-9]+", "an integer"},
+};
+
+// Xerces states some rules as the regular expression behind them; say what they mean instead.
+std::string explain(std::string message) {
+  constexpr std::string_view kFacet = "does not match regular expression facet '";
+  const auto at = message.find(kFacet);
+  if (at == std::string::npos)
+    return message;
+  const std::string_view facet =
+      std::string_view(message).substr(at + kFacet.size(), message.size() - at - kFacet.size() - 1);
+  for (const auto &meaning : kPatternMeanings)
+    if (facet.find(meaning.facet) != std::string_view::npos)
+      return message.substr(0, at) + "is not " + std::string(meaning.expected);
+  return message;
+}
+
+constexpr std::string_view kProfileRoots =
+    "softwareassembly (SAD), softpkg (SPD), softwarecomponent (SCD), properties (PRF), "
+    "deviceconfiguration (DCD), domainmanagerconfiguration (DMD) or devicepkg (DPD)";
+
+// Thrown from the content handler to stop a parse that must not go on; caught in read().
+struct ParseStopped {
+  Diagnostic diagnostic;
+};
 // Entity expansions allowed in one document: plenty for any profile, and a "billion laughs"
 // document fails fast instead of exhausting memory.
 constexpr XMLSize_t kEntityExpansionLimit = 10000;
@@ -101,7 +139,12 @@ public:
   void warning(const x::SAXParseException &) override {}
   void error(const x::SAXParseException &e) override { add(e, "schema"); }
   void fatalError(const x::SAXParseException &e) override { add(e, "xml"); }
-  void resetErrors() override { error_ = Error(); }
+  void resetErrors() override {
+    error_ = Error();
+    undeclared_.clear();
+  }
+  // Whether the root element has been seen yet: a problem before it is a problem with the root.
+  void set_root_seen(bool seen) { root_seen_ = seen; }
 
   const Error &error() const { return error_; }
   void add(Diagnostic d) {
@@ -111,23 +154,52 @@ public:
 
 private:
   void add(const x::SAXParseException &e, const char *rule) {
+    std::string message = explain(utf8_(e.getMessage()));
+    constexpr std::string_view kUndeclared = "no declaration found for element '";
+    if (message.starts_with(kUndeclared)) {
+      std::string name = message.substr(kUndeclared.size(), message.find('\'', kUndeclared.size()) - kUndeclared.size());
+      if (!root_seen_)
+        message = fmt::format("<{}> is not the root of a domain profile: expected {}", name, kProfileRoots);
+      else
+        message = fmt::format("<{}> is not an element rsca knows here", name);
+      undeclared_.push_back(std::move(name));
+    } else if (is_consequence_of_undeclared(message)) {
+      return; // the parent's content model fails only because of a child already reported
+    }
     add(Diagnostic{{file_, static_cast<int>(e.getLineNumber()), static_cast<int>(e.getColumnNumber())},
-                   rule,
-                   utf8_(e.getMessage())});
+                   rule, std::move(message)});
+  }
+
+  bool is_consequence_of_undeclared(const std::string &message) const {
+    if (message.find("is not allowed for content model") == std::string::npos)
+      return false;
+    for (const auto &name : undeclared_)
+      if (message.find("'" + name + "'") != std::string::npos)
+        return true;
+    return false;
   }
 
   std::string file_;
   Error error_;
   Utf8 utf8_;
+  bool root_seen_ = false;
+  std::vector<std::string> undeclared_;
 };
 
 // Builds the XmlElement tree from SAX events.
 class TreeBuilder final : public x::DefaultHandler {
 public:
   void setDocumentLocator(const x::Locator *const locator) override { locator_ = locator; }
+  void set_collector(DiagnosticCollector *collector) { collector_ = collector; }
 
   void startElement(const XMLCh *const, const XMLCh *const local_name, const XMLCh *const,
                     const x::Attributes &attributes) override {
+    if (collector_ != nullptr)
+      collector_->set_root_seen(true);
+    if (open_.size() >= kMaxDepth)
+      throw ParseStopped{{{file_, line(), column()},
+                          "xml",
+                          fmt::format("elements nest deeper than {} levels; no profile does", kMaxDepth)}};
     XmlElement element;
     element.name = utf8_(local_name);
     if (locator_ != nullptr) {
@@ -158,13 +230,21 @@ public:
   }
 
   XmlElement take_root() { return std::move(root_); }
-  void reset() {
+  void reset(std::string file) {
     root_ = XmlElement();
     open_.clear();
+    file_ = std::move(file);
   }
 
 private:
+  int line() const { return locator_ != nullptr ? static_cast<int>(locator_->getLineNumber()) : 0; }
+  int column() const {
+    return locator_ != nullptr ? static_cast<int>(locator_->getColumnNumber()) : 0;
+  }
+
   const x::Locator *locator_ = nullptr;
+  DiagnosticCollector *collector_ = nullptr;
+  std::string file_;
   XmlElement root_;
   std::vector<XmlElement *> open_;
   Utf8 utf8_;
@@ -182,6 +262,7 @@ void set_validating_features(x::SAX2XMLReader &reader) {
   reader.setFeature(x::XMLUni::fgXercesSkipDTDValidation, true);
   reader.setFeature(x::XMLUni::fgXercesDisableDefaultEntityResolution, true);
 }
+
 
 // The schemas, compiled once per process and shared read-only by every reader.
 class SchemaCache {
@@ -244,14 +325,22 @@ public:
       return tl::unexpected(cache_.load_error());
     if (text.find_first_not_of(" \t\r\n") == std::string_view::npos)
       return make_error({file, 1, 1}, "xml", "the file is empty: expected an XML profile");
+    // Profiles are UTF-8 (as every SCA tool writes them). Refusing UTF-16/32 up front also means
+    // every DOCTYPE reaches blank_doctype, so no entity declaration survives to be expanded.
+    if (text.find('\0') != std::string_view::npos)
+      return make_error({file, 1, 1}, "encoding",
+                        "the file is not UTF-8 (it holds NUL bytes): profiles must be UTF-8 text");
 
     DiagnosticCollector collector(file);
     reader_->setErrorHandler(&collector);
-    builder_.reset();
+    builder_.reset(file);
+    builder_.set_collector(&collector);
     x::MemBufInputSource source(reinterpret_cast<const XMLByte *>(text.data()), text.size(),
                                 file.c_str());
     try {
       reader_->parse(source);
+    } catch (const ParseStopped &stopped) {
+      collector.add(stopped.diagnostic);
     } catch (const x::SAXParseException &) {
       // Already reported through the collector.
     } catch (const x::OutOfMemoryException &) {
@@ -262,8 +351,11 @@ public:
       collector.add({{file, 0, 0}, "xml", "the parser failed for an unknown reason"});
     }
     reader_->setErrorHandler(nullptr);
-    if (!collector.error().empty())
+    builder_.set_collector(nullptr);
+    if (!collector.error().empty()) {
+      builder_.reset({});
       return tl::unexpected(collector.error());
+    }
     return XmlDocument{file, builder_.take_root()};
   }
 

@@ -231,7 +231,7 @@ TEST_CASE("SAD: the rate_hz override binds to a typed double", "[descriptors][sa
   const auto refused = bind_property(*rate, PropertyRef(too_fast));
   REQUIRE_FALSE(refused.has_value());
   const Diagnostic &d = refused.error().diagnostics().front();
-  CHECK(d.rule == "value");
+  CHECK(d.rule == "range");
   CHECK(d.where.line == 19);
   CHECK_THAT(d.message, Contains("outside its range"));
 }

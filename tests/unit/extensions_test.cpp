@@ -609,6 +609,6 @@ TEST_CASE("a latency path naming an unknown instance is an error", "[extensions]
   </latencyconstraints>)");
   const Diagnostic d = sad_error(text);
   CHECK(d.rule == "dangling-ref");
-  CHECK(d.where.line == line_of(text, "<latencypath id=\"p\""));
+  CHECK(d.where.line == line_of(text, "refid=\"Ghost_1\""));
   CHECK_THAT(d.message, Contains("latency path \"p\"") && Contains("Ghost_1"));
 }
