@@ -154,7 +154,6 @@ struct Endpoint::Impl {
 
   std::mutex state_mutex;
   std::map<std::string, Handler> handlers;
-  AnnouncementHandler announcement_handler;
   std::map<std::string, Pending> pending;
   std::uint64_t next_id = 0;
 
@@ -227,7 +226,7 @@ Expected<void> Endpoint::Impl::create_entities() {
   dds_waitset_attach(waitset.get(), request_reader.get(), request_reader.get());
   dds_waitset_attach(waitset.get(), reply_reader.get(), reply_reader.get());
   dds_waitset_attach(waitset.get(), guard.get(), guard.get());
-  if (!options.follow_announcements)
+  if (!options.on_announcement)
     return {};
   // Announcements are not partitioned: whoever follows them sees every endpoint's.
   auto reader = make(dds_create_reader(pp, announcement_topic.get(), aqos.get(), nullptr),
@@ -348,12 +347,8 @@ void Endpoint::Impl::take_announcements() {
         dds_take(announcement_reader.get(), samples, infos, kTakeBatch, kTakeBatch);
     if (n <= 0)
       return;
-    AnnouncementHandler handler;
-    {
-      std::lock_guard lock(state_mutex);
-      handler = announcement_handler;
-    }
-    for (dds_return_t i = 0; i < n && handler; ++i) {
+    const AnnouncementHandler &handler = options.on_announcement;
+    for (dds_return_t i = 0; i < n; ++i) {
       const auto *a = static_cast<const rsca_ctl_Announcement *>(samples[i]);
       AnnouncementEvent event;
       event.address = str(a->address);
@@ -508,11 +503,6 @@ const std::string &Endpoint::address() const { return impl_->address; }
 void Endpoint::on(const std::string &operation, Handler handler) {
   std::lock_guard lock(impl_->state_mutex);
   impl_->handlers[operation] = std::move(handler);
-}
-
-void Endpoint::on_announcement(AnnouncementHandler handler) {
-  std::lock_guard lock(impl_->state_mutex);
-  impl_->announcement_handler = std::move(handler);
 }
 
 std::future<CallResult<Json>> Endpoint::call(const std::string &target, const std::string &operation,

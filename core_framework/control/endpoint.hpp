@@ -65,7 +65,9 @@ using AnnouncementHandler = std::function<void(const AnnouncementEvent &)>;
 
 struct EndpointOptions {
   std::size_t workers = 8;
-  bool follow_announcements = false; // receive other endpoints' announcements
+  // Follows every endpoint's announcements when set: called for each change on the receiving
+  // thread, so it must not block. Given at open so that no announcement arrives before it.
+  AnnouncementHandler on_announcement;
 };
 
 class Endpoint {
@@ -80,8 +82,6 @@ public:
 
   // Serves `operation`; a later registration replaces an earlier one.
   void on(const std::string &operation, Handler handler);
-  // Called for every announcement change; runs on the receiving thread and must not block.
-  void on_announcement(AnnouncementHandler handler);
 
   std::future<CallResult<Json>> call(const std::string &target, const std::string &operation,
                                      Json body, std::chrono::milliseconds timeout);

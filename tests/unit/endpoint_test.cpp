@@ -107,12 +107,12 @@ TEST_CASE("announcements are seen, updated and withdrawn", "[control]") {
   std::mutex m;
   std::condition_variable cv;
   std::vector<control::AnnouncementEvent> events;
-  auto watcher = open(pp, "test/watcher", {.workers = 1, .follow_announcements = true});
-  watcher->on_announcement([&](const control::AnnouncementEvent &e) {
-    std::lock_guard lock(m);
-    events.push_back(e);
-    cv.notify_all();
-  });
+  auto watcher = open(pp, "test/watcher",
+                      {.workers = 1, .on_announcement = [&](const control::AnnouncementEvent &e) {
+                         std::lock_guard lock(m);
+                         events.push_back(e);
+                         cv.notify_all();
+                       }});
   auto wait_for = [&](auto predicate) {
     std::unique_lock lock(m);
     return cv.wait_for(lock, 5s, [&] { return predicate(events); });

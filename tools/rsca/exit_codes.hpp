@@ -5,9 +5,12 @@ namespace rsca::cli {
 
 enum ExitCode : int {
   kOk = 0,
-  kInvalidProfile = 1, // a profile is malformed or inconsistent
+  kInvalidProfile = 1, // a profile is malformed or inconsistent, or a request was malformed
   kUsage = 2,          // the command line itself is wrong
-  kNotFound = 3,       // a path given on the command line does not exist
+  kNotFound = 3,       // a path, application, component or node that does not exist
+  kUnreachable = 4,    // no domain daemon answered in time
+  kRejected = 5,       // the domain refused (admission control, conflicting state)
+  kFailed = 6,         // the operation was tried and failed (e.g. a launch, rolled back)
 };
 
 } // namespace rsca::cli

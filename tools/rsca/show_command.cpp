@@ -236,10 +236,8 @@ void show_node(Tree &t, const ResolvedNode &node) {
 }
 
 int run(const std::string &path, const GlobalOptions &global) {
-  if (!fs::exists(path)) {
-    fmt::print(stderr, "rsca show: {}: no such file\n", path);
-    return kNotFound;
-  }
+  if (!fs::exists(path))
+    return show_application(path, global); // not a profile: a running application's name
   std::optional<fs::path> sdrroot;
   if (!global.sdrroot.empty())
     sdrroot = global.sdrroot;
@@ -287,9 +285,10 @@ int run(const std::string &path, const GlobalOptions &global) {
 } // namespace
 
 void add_show_command(CLI::App &app, const GlobalOptions &global, int &exit_code) {
-  auto *cmd = app.add_subcommand("show", "Show the resolved model of a profile as a tree");
+  auto *cmd = app.add_subcommand("show", "Show a profile's resolved model, or a running application");
   auto path = std::make_shared<std::string>();
-  cmd->add_option("path", *path, "Profile file (SAD, SPD, SCD, PRF, DCD, DMD or DPD)")->required();
+  cmd->add_option("what", *path, "Profile file (SAD, SPD, SCD, PRF, DCD, DMD or DPD) or application name")
+      ->required();
   cmd->callback([path, &global, &exit_code] { exit_code = run(*path, global); });
 }
 

@@ -1,0 +1,72 @@
+// rsca-producer: publishes sample sequences on samples_out at rate_hz, each of payload_size
+// samples of a 10 Hz sine at the stream's sample_rate, stamped with the time of publication.
+#include <cmath>
+#include <numbers>
+
+#include "component/runtime.hpp"
+
+namespace {
+
+using rsca::component::Clock;
+using rsca::component::Component;
+using rsca::component::Context;
+using rsca::component::Result;
+
+struct Stream {
+  std::string stream_id;
+  double sample_rate = 0;
+};
+
+class Producer final : public Component {
+public:
+  explicit Producer(const Context &context)
+      : Component(context), out_(uses_port<rsca::port::Samples>("samples_out")) {
+    property("rate_hz", rate_hz_);
+    property("payload_size", payload_size_);
+    property("message", message_);
+    struct_property("stream", stream_,
+                    {{"stream_id", &Stream::stream_id}, {"sample_rate", &Stream::sample_rate}});
+  }
+
+private:
+  static constexpr double kToneHz = 10.0;
+
+  Result start() override {
+    log().info("{}: publishing {} samples at {} Hz on stream {}", message_, payload_size_,
+               rate_hz_, stream_.stream_id);
+    return {};
+  }
+
+  std::optional<Clock::duration> service() override {
+    fill();
+    if (auto written = out_.write(samples_); !written && failures_++ % 100 == 0)
+      log().warn("{} (failures so far: {})", written.error(), failures_);
+    ++samples_.sequence;
+    return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / rate_hz_));
+  }
+
+  // The next sequence, in the buffers of the last (no allocation unless payload_size grew).
+  void fill() {
+    samples_.stream_id = stream_.stream_id;
+    samples_.sample_rate = stream_.sample_rate;
+    samples_.samples.resize(payload_size_);
+    const double first = static_cast<double>(samples_.sequence) * payload_size_;
+    const double step = stream_.sample_rate > 0 ? 1.0 / stream_.sample_rate : 0.0;
+    for (std::size_t i = 0; i < samples_.samples.size(); ++i)
+      samples_.samples[i] =
+          std::sin(2 * std::numbers::pi * kToneHz * (first + static_cast<double>(i)) * step);
+    samples_.timestamp_ns = rsca::port::now_ns();
+  }
+
+  rsca::component::UsesPort<rsca::port::Samples> &out_;
+  double rate_hz_ = 100.0;
+  std::uint32_t payload_size_ = 64;
+  std::string message_;
+  Stream stream_;
+  rsca::port::Samples samples_;
+  std::uint64_t failures_ = 0;
+};
+
+} // namespace
+
+int main(int argc, char **argv) { return rsca::component::run<Producer>(argc, argv); }

@@ -1,0 +1,204 @@
+#include "component/ports.hpp"
+
+#include <atomic>
+#include <mutex>
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include "component/port_wire.hpp"
+#include "component/receive_loop.hpp"
+
+namespace rsca::component {
+
+namespace detail {
+
+// One connection of a port: its topic and its writer or reader. Members are destroyed in reverse
+// order: the read condition, then the reader or writer, then the topic.
+struct DataConnection {
+  std::string topic_name;
+  dds::Entity topic;
+  dds::Entity entity;         // the writer (uses) or reader (provides)
+  dds::Entity read_condition; // provides only: attached to the receive loop
+  ReceiveLoop *loop = nullptr;
+  std::atomic<std::uint64_t> samples{0};
+
+  ~DataConnection() {
+    if (loop != nullptr && read_condition)
+      loop->detach(read_condition.get());
+  }
+};
+
+} // namespace detail
+
+namespace {
+
+using detail::DataConnection;
+
+constexpr std::uint32_t kTakeBatch = 32;
+
+Expected<std::unique_ptr<DataConnection>> open_writer(dds_entity_t participant,
+                                                      std::unique_ptr<DataConnection> c,
+                                                      const dds_qos_t *qos) {
+  auto writer = dds::checked(dds_create_writer(participant, c->topic.get(), qos, nullptr),
+                             fmt::format("creating a writer on topic \"{}\"", c->topic_name));
+  if (!writer)
+    return tl::unexpected(writer.error());
+  c->entity = std::move(*writer);
+  return c;
+}
+
+Expected<std::unique_ptr<DataConnection>> open_reader(dds_entity_t participant,
+                                                      detail::ReceiveLoop *loop,
+                                                      std::unique_ptr<DataConnection> c,
+                                                      const dds_qos_t *qos) {
+  if (loop == nullptr)
+    return make_error({"port", 0, 0}, "port", "no receive loop for a provides port");
+  auto reader = dds::checked(dds_create_reader(participant, c->topic.get(), qos, nullptr),
+                             fmt::format("creating a reader on topic \"{}\"", c->topic_name));
+  if (!reader)
+    return tl::unexpected(reader.error());
+  c->entity = std::move(*reader);
+  auto condition = dds::checked(dds_create_readcondition(c->entity.get(), DDS_ANY_STATE),
+                                "creating a read condition");
+  if (!condition)
+    return tl::unexpected(condition.error());
+  c->read_condition = std::move(*condition);
+  if (auto attached = loop->attach(c->read_condition.get()); !attached)
+    return tl::unexpected(attached.error());
+  c->loop = loop;
+  return c;
+}
+
+std::int32_t matched_count(dds_entity_t entity, profile::PortDirection direction) {
+  if (direction == profile::PortDirection::Uses) {
+    dds_publication_matched_status_t status{};
+    return dds_get_publication_matched_status(entity, &status) == 0
+               ? static_cast<std::int32_t>(status.current_count)
+               : 0;
+  }
+  dds_subscription_matched_status_t status{};
+  return dds_get_subscription_matched_status(entity, &status) == 0
+             ? static_cast<std::int32_t>(status.current_count)
+             : 0;
+}
+
+} // namespace
+
+PortBase::PortBase(std::string name, profile::PortDirection direction, port::PortType type)
+    : name_(std::move(name)), direction_(direction), type_(type) {}
+
+PortBase::~PortBase() { disconnect_all(); }
+
+std::size_t PortBase::connection_count() const {
+  std::shared_lock lock(mutex_);
+  return connections_.size();
+}
+
+Expected<void> PortBase::connect(dds_entity_t participant, detail::ReceiveLoop *loop,
+                                 const std::string &connection, const std::string &topic,
+                                 const dds_qos_t *qos) {
+  auto c = std::make_unique<DataConnection>();
+  c->topic_name = topic;
+  auto created = dds::checked(
+      dds_create_topic(participant, port::wire::descriptor(type_), topic.c_str(), nullptr, nullptr),
+      fmt::format("creating topic \"{}\"", topic));
+  if (!created)
+    return tl::unexpected(created.error());
+  c->topic = std::move(*created);
+  auto opened = direction_ == profile::PortDirection::Uses
+                    ? open_writer(participant, std::move(c), qos)
+                    : open_reader(participant, loop, std::move(c), qos);
+  if (!opened)
+    return tl::unexpected(opened.error());
+  std::unique_lock lock(mutex_);
+  connections_[connection] = std::move(*opened); // an earlier one of that id goes
+  return {};
+}
+
+bool PortBase::disconnect(const std::string &connection) {
+  std::unique_lock lock(mutex_);
+  return connections_.erase(connection) > 0;
+}
+
+void PortBase::disconnect_all() {
+  std::unique_lock lock(mutex_);
+  connections_.clear();
+}
+
+std::vector<ConnectionStatus> PortBase::status() const {
+  std::shared_lock lock(mutex_);
+  std::vector<ConnectionStatus> out;
+  out.reserve(connections_.size());
+  for (const auto &[id, c] : connections_)
+    out.push_back({id, c->topic_name, matched_count(c->entity.get(), direction_), c->samples.load()});
+  return out;
+}
+
+void PortBase::take_all(bool) {}
+
+void PortBase::quiesce() { std::unique_lock lock(mutex_); }
+
+WriteResult PortBase::write_wire(const void *sample) {
+  std::shared_lock lock(mutex_);
+  std::size_t written = 0;
+  std::string error;
+  for (const auto &[id, c] : connections_) {
+    const dds_return_t rc = dds_write(c->entity.get(), sample);
+    if (rc < 0) {
+      if (error.empty())
+        error = fmt::format("port {}: writing to connection {} failed: {}", name_, id,
+                            dds_strretcode(rc));
+      continue;
+    }
+    c->samples.fetch_add(1, std::memory_order_relaxed);
+    ++written;
+  }
+  if (!error.empty())
+    return tl::unexpected(std::move(error));
+  return written;
+}
+
+template <typename T>
+WriteResult UsesPort<T>::write(const T &value) {
+  const auto sample = port::wire::to_wire(value);
+  return write_wire(&sample);
+}
+
+template <typename T>
+void ProvidesPort<T>::take_all(bool deliver) {
+  using Wire = typename port::wire::Traits<T>::C;
+  std::shared_lock lock(mutex_);
+  for (const auto &[id, c] : connections_) {
+    for (;;) {
+      void *samples[kTakeBatch] = {nullptr};
+      dds_sample_info_t infos[kTakeBatch];
+      const dds_return_t n = dds_take(c->entity.get(), samples, infos, kTakeBatch, kTakeBatch);
+      if (n <= 0)
+        break;
+      for (dds_return_t i = 0; i < n; ++i) {
+        if (!infos[i].valid_data)
+          continue;
+        c->samples.fetch_add(1, std::memory_order_relaxed);
+        if (!deliver || !callback_)
+          continue;
+        port::wire::from_wire(*static_cast<const Wire *>(samples[i]), scratch_);
+        try {
+          callback_(scratch_);
+        } catch (const std::exception &e) {
+          spdlog::error("port {}: the sample callback failed: {}", name(), e.what());
+        }
+      }
+      dds_return_loan(c->entity.get(), samples, n);
+    }
+  }
+}
+
+template class UsesPort<port::Samples>;
+template class UsesPort<port::PropertyEvent>;
+template class UsesPort<port::Command>;
+template class ProvidesPort<port::Samples>;
+template class ProvidesPort<port::PropertyEvent>;
+template class ProvidesPort<port::Command>;
+
+} // namespace rsca::component

@@ -1,0 +1,111 @@
+// Data ports of a component. A uses port writes, a provides port receives; each has zero or more
+// connections, made and removed by the domain (component.connect/disconnect). A connection is a
+// DDS writer (uses) or reader (provides) on the topic the domain names, with the QoS it gives.
+// Writing to an unconnected uses port does nothing; with several connections a write goes to
+// each. A provides port's callback runs on the component's receive thread.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <shared_mutex>
+#include <string>
+#include <vector>
+
+#include <tl/expected.hpp>
+
+#include "common/diagnostic.hpp"
+#include "component/port_types.hpp"
+#include "dds/entity.hpp"
+#include "profile/scd.hpp"
+
+namespace rsca::component {
+
+namespace detail {
+struct DataConnection;
+class ReceiveLoop;
+} // namespace detail
+
+struct ConnectionStatus {
+  std::string connection;
+  std::string topic;
+  std::int32_t matched = 0;  // readers (uses) or writers (provides) matched on the topic
+  std::uint64_t samples = 0; // written (uses) or received (provides)
+};
+
+// How many connections a write reached, or why one failed (the others were still written).
+using WriteResult = tl::expected<std::size_t, std::string>;
+
+class PortBase {
+public:
+  PortBase(std::string name, profile::PortDirection direction, port::PortType type);
+  virtual ~PortBase();
+  PortBase(const PortBase &) = delete;
+  PortBase &operator=(const PortBase &) = delete;
+
+  const std::string &name() const { return name_; }
+  profile::PortDirection direction() const { return direction_; }
+  port::PortType type() const { return type_; }
+  std::size_t connection_count() const;
+
+  // For the runtime. `connect` replaces a connection of the same id. A provides port's reader
+  // is attached to `loop`, which must outlive the connection.
+  Expected<void> connect(dds_entity_t participant, detail::ReceiveLoop *loop,
+                         const std::string &connection, const std::string &topic,
+                         const dds_qos_t *qos);
+  bool disconnect(const std::string &connection);
+  void disconnect_all();
+  std::vector<ConnectionStatus> status() const;
+  // Takes what every connection received; hands it to the callback when `deliver`.
+  virtual void take_all(bool deliver);
+  // Returns once no callback of this port is running (one that starts later sees the caller's
+  // earlier writes, e.g. a cleared delivery flag).
+  void quiesce();
+
+protected:
+  WriteResult write_wire(const void *sample);
+
+  mutable std::shared_mutex mutex_; // shared: writing, taking; exclusive: (dis)connecting
+  std::map<std::string, std::unique_ptr<detail::DataConnection>> connections_;
+
+private:
+  std::string name_;
+  profile::PortDirection direction_;
+  port::PortType type_;
+};
+
+template <typename T>
+class UsesPort final : public PortBase {
+public:
+  explicit UsesPort(std::string name)
+      : PortBase(std::move(name), profile::PortDirection::Uses, port::PortTypeOf<T>::value) {}
+  // Safe from any thread. The value is serialized before write returns.
+  WriteResult write(const T &value);
+};
+
+template <typename T>
+class ProvidesPort final : public PortBase {
+public:
+  // Runs on the receive thread for each sample, while the component is started; `value` is
+  // valid only during the call (its buffers are reused for the next sample).
+  using Callback = std::function<void(const T &value)>;
+
+  ProvidesPort(std::string name, Callback callback)
+      : PortBase(std::move(name), profile::PortDirection::Provides, port::PortTypeOf<T>::value),
+        callback_(std::move(callback)) {}
+  void take_all(bool deliver) override;
+
+private:
+  Callback callback_;
+  T scratch_; // receives every sample: its buffers grow once and are reused
+};
+
+extern template class UsesPort<port::Samples>;
+extern template class UsesPort<port::PropertyEvent>;
+extern template class UsesPort<port::Command>;
+extern template class ProvidesPort<port::Samples>;
+extern template class ProvidesPort<port::PropertyEvent>;
+extern template class ProvidesPort<port::Command>;
+
+} // namespace rsca::component

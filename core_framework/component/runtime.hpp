@@ -1,0 +1,57 @@
+// The process around a component: what `main` of a component executable calls.
+//
+//   int main(int argc, char **argv) { return rsca::component::run<MyComponent>(argc, argv); }
+//
+// run parses the exec parameters (docs/architecture.md, "Component protocol"), loads the SPD
+// named by PROFILE_NAME with its PRF and SCD, constructs the component, checks its property
+// bindings against the PRF and its ports against the SCD, applies the PRF defaults and the
+// execparams, joins DDS (RSCA_DDS_* environment), opens the control endpoint at CONTROL_ADDRESS,
+// serves the component.* operations and announces itself (kind "component"). It returns after
+// component.release, SIGTERM or SIGINT, once the component is stopped and released and its DDS
+// entities are gone.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <tl/expected.hpp>
+
+#include "component/component.hpp"
+
+namespace rsca::component {
+
+// What run returns, the process's exit status.
+enum ExitStatus : int {
+  kExitOk = 0,        // released, or stopped by SIGTERM/SIGINT
+  kExitFailure = 1,   // DDS, the endpoint or the component's constructor failed
+  kExitUsage = 2,     // the exec parameters are wrong
+  kExitProfile = 3,   // the profile cannot be loaded or does not fit the component
+};
+
+struct ExecParams {
+  std::string identifier;      // COMPONENT_IDENTIFIER (required)
+  std::string name_binding;    // NAME_BINDING (the identifier when absent)
+  std::string profile;         // PROFILE_NAME (required)
+  std::string domain;          // DOMAIN_NAME
+  std::string application;     // APPLICATION
+  std::string control_address; // CONTROL_ADDRESS (required)
+  std::vector<std::pair<std::string, std::string>> others; // execparam properties and the rest
+};
+
+// The exec parameters of argv[1..], in pairs.
+tl::expected<ExecParams, std::string> parse_exec_params(int argc, const char *const *argv);
+
+using Factory = std::function<std::unique_ptr<Component>(const Context &)>;
+int run_component(int argc, char **argv, const Factory &factory);
+
+template <typename T>
+int run(int argc, char **argv) {
+  static_assert(std::is_base_of_v<Component, T>, "a component derives from Component");
+  return run_component(argc, argv,
+                       [](const Context &context) { return std::make_unique<T>(context); });
+}
+
+} // namespace rsca::component

@@ -1,0 +1,63 @@
+#include "domain/application.hpp"
+
+namespace rsca::domain {
+
+std::string_view to_string(ApplicationState state) {
+  switch (state) {
+  case ApplicationState::Created:
+    return "created";
+  case ApplicationState::Running:
+    return "running";
+  case ApplicationState::Stopped:
+    return "stopped";
+  case ApplicationState::Failed:
+    return "failed";
+  }
+  return "unknown";
+}
+
+ComponentInstance *Application::find_component(std::string_view id) {
+  for (auto &c : components)
+    if (c.id == id)
+      return &c;
+  return nullptr;
+}
+
+const ComponentInstance *Application::find_component(std::string_view id) const {
+  for (const auto &c : components)
+    if (c.id == id)
+      return &c;
+  return nullptr;
+}
+
+nlohmann::json to_json(const Application &app) {
+  nlohmann::json components = nlohmann::json::array();
+  for (const auto &c : app.components)
+    components.push_back({{"id", c.id},
+                          {"usage_name", c.usage_name},
+                          {"node", c.node},
+                          {"device", c.device},
+                          {"implementation", c.implementation},
+                          {"address", c.address},
+                          {"pid", c.pid},
+                          {"state", c.state},
+                          {"assembly_controller", c.assembly_controller}});
+  nlohmann::json connections = nlohmann::json::array();
+  for (const auto &c : app.connections)
+    connections.push_back({{"id", c.id},
+                           {"uses", c.uses.component.empty() ? "" : c.uses.component + "." + c.uses.port},
+                           {"provides", c.provides.component.empty()
+                                            ? ""
+                                            : c.provides.component + "." + c.provides.port},
+                           {"repid", c.repid},
+                           {"topic", c.topic},
+                           {"qos", c.qos}});
+  return {{"name", app.name},
+          {"installed", app.installed},
+          {"sad", app.sad},
+          {"state", to_string(app.state)},
+          {"components", components},
+          {"connections", connections}};
+}
+
+} // namespace rsca::domain

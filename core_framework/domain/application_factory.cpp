@@ -1,0 +1,488 @@
+#include "domain/application_factory.hpp"
+
+#include <algorithm>
+#include <future>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+#include <spdlog/spdlog.h>
+
+#include "dds/port_qos.hpp"
+#include "profile/property_binding.hpp"
+#include "profile/property_json.hpp"
+
+namespace rsca::domain {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using control::CallResult;
+using control::Json;
+using control::Status;
+
+double ms_since(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+// One call of many made at once.
+struct Call {
+  std::string target;
+  std::string operation;
+  Json body;
+  std::string what; // for messages: "Producer_1"
+};
+
+// Makes every call at once and waits for all; the first failure, prefixed with its `what`.
+CallResult<std::vector<Json>> call_all(control::Endpoint &endpoint, const std::vector<Call> &calls,
+                                       std::chrono::milliseconds timeout) {
+  std::vector<std::future<CallResult<Json>>> futures;
+  futures.reserve(calls.size());
+  for (const auto &c : calls)
+    futures.push_back(endpoint.call(c.target, c.operation, c.body, timeout));
+  std::vector<Json> replies;
+  std::optional<control::CallError> first_error;
+  for (std::size_t i = 0; i < futures.size(); ++i) {
+    auto reply = futures[i].get();
+    if (reply) {
+      replies.push_back(std::move(*reply));
+      continue;
+    }
+    if (!first_error)
+      first_error = control::CallError{reply.error().status,
+                                       fmt::format("{}: {}", calls[i].what, reply.error().message)};
+    replies.emplace_back();
+  }
+  if (first_error)
+    return tl::unexpected(*first_error);
+  return replies;
+}
+
+std::string sanitize(std::string_view text) {
+  std::string out;
+  for (char c : text)
+    out += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
+  return out;
+}
+
+bool is_execparam_only(const profile::PropertyDefinition &d) {
+  const auto &c = profile::common_of(d);
+  return c.has_kind(profile::PropertyKind::ExecParam) &&
+         !c.has_kind(profile::PropertyKind::Configure) &&
+         !c.has_kind(profile::PropertyKind::Property);
+}
+
+} // namespace
+
+std::string ApplicationFactory::topic_name(const std::string &domain, const std::string &app,
+                                           const std::string &connection) {
+  return fmt::format("rsca_{}_{}_{}", sanitize(domain), sanitize(app), sanitize(connection));
+}
+
+// The state of one launch, step by step, and how to undo it.
+class ApplicationFactory::Launch {
+public:
+  Launch(const DomainServices &services, const LaunchRequest &request, const ProgressSink &progress)
+      : s_(services), request_(request), progress_(progress), app_(std::make_shared<Application>()),
+        launch_(s_.next_launch ? s_.next_launch() : 0) {
+    app_->name = request.name;
+    app_->installed = request.installed;
+    app_->profile = request.profile;
+    app_->sad = request.profile->sad_path.string();
+  }
+
+  CallResult<std::shared_ptr<Application>> run() {
+    using Step = CallResult<void> (Launch::*)();
+    const std::pair<const char *, Step> steps[] = {
+        {"check", &Launch::check},           {"allocate", &Launch::allocate},
+        {"execute", &Launch::execute},       {"register", &Launch::await_registration},
+        {"initialize", &Launch::initialize}, {"configure", &Launch::configure},
+        {"connect", &Launch::connect},       {"start", &Launch::start},
+    };
+    for (const auto &[name, step] : steps) {
+      if (std::string_view(name) == "start" && !request_.start)
+        break;
+      const auto began = Clock::now();
+      detail_.clear();
+      if (auto ok = (this->*step)(); !ok)
+        return fail(name, ok.error());
+      progress_({name, detail_, ms_since(began)});
+    }
+    app_->state = request_.start ? ApplicationState::Running : ApplicationState::Created;
+    spdlog::info("application {} launched: {} components on {}", app_->name, app_->components.size(),
+                 fmt::join(nodes_used(), ", "));
+    return app_;
+  }
+
+private:
+  // Wiring problems found while loading (unknown ports, mismatched port types) stop a launch.
+  CallResult<void> check() {
+    if (request_.profile->warnings.empty()) {
+      detail_ = fmt::format("{} components, {} connections", count_instances(),
+                            request_.profile->sad->connections.size());
+      return {};
+    }
+    std::vector<std::string> problems;
+    for (const auto &w : request_.profile->warnings)
+      problems.push_back(to_string(w));
+    return control::call_error(Status::BadRequest, fmt::format("{}", fmt::join(problems, "\n")));
+  }
+
+  CallResult<void> allocate() {
+    std::vector<allocator::Request> requests;
+    for (const auto &placement : request_.profile->sad->placements) {
+      const auto *pkg = request_.profile->softpkg_of(placement);
+      for (const auto &ci : placement.instantiations) {
+        allocator::Request r{ci.id, pkg, std::nullopt};
+        if (auto it = request_.assignments.find(ci.id); it != request_.assignments.end())
+          r.device = it->second;
+        requests.push_back(std::move(r));
+      }
+    }
+    auto placements = s_.allocator->allocate(requests);
+    if (!placements)
+      return control::call_error(Status::Rejected, allocator::to_string(placements.error()));
+    app_->placements = std::move(*placements);
+    allocated_ = true;
+    build_components();
+    std::vector<std::string> where;
+    for (const auto &p : app_->placements)
+      where.push_back(fmt::format("{}→{}", p.instance, p.device));
+    detail_ = fmt::format("{}", fmt::join(where, ", "));
+    for (const auto &p : app_->placements)
+      spdlog::info("placing {}/{} on {} (implementation {})", app_->name, p.instance, p.device,
+                   p.implementation->id);
+    return {};
+  }
+
+  CallResult<void> execute() {
+    std::vector<Call> calls;
+    for (auto &c : app_->components)
+      s_.components->expect(c.address);
+    for (auto &c : app_->components) {
+      auto node = s_.node_address(c.node);
+      if (!node)
+        return control::call_error(Status::Unavailable, fmt::format("node {} is gone", c.node));
+      calls.push_back({*node, "node.execute", execute_body(c), c.id});
+    }
+    auto replies = call_all(*s_.endpoint, calls, s_.call_timeout);
+    // Record every process that did start, even when another failed, so rollback finds it.
+    for (std::size_t i = 0; i < app_->components.size(); ++i) {
+      if (replies && (*replies)[i].contains("pid")) {
+        app_->components[i].pid = (*replies)[i]["pid"].get<long>();
+        app_->components[i].state = "executed";
+      }
+    }
+    if (!replies)
+      return tl::unexpected(replies.error());
+    detail_ = fmt::format("{} processes", app_->components.size());
+    return {};
+  }
+
+  CallResult<void> await_registration() {
+    std::vector<std::string> addresses;
+    for (const auto &c : app_->components)
+      addresses.push_back(c.address);
+    auto ok = s_.components->wait_registered(addresses, Clock::now() + s_.registration_timeout);
+    if (!ok)
+      return ok;
+    for (auto &c : app_->components)
+      c.state = "registered";
+    return {};
+  }
+
+  CallResult<void> initialize() { return call_each("component.initialize", [](auto &) { return Json::object(); }); }
+
+  CallResult<void> configure() {
+    std::vector<Call> calls;
+    for (const auto &placement : request_.profile->sad->placements) {
+      const auto *pkg = request_.profile->softpkg_of(placement);
+      for (const auto &ci : placement.instantiations) {
+        Json properties = Json::object();
+        for (const auto &ref : ci.properties) {
+          const auto *definition = pkg->find_property(profile::refid_of(ref));
+          if (definition == nullptr || is_execparam_only(*definition))
+            continue;
+          auto value = profile::bind_property(*definition, ref);
+          if (!value)
+            return control::call_error(Status::BadRequest,
+                                       fmt::format("{}: {}", ci.id, value.error().to_string()));
+          properties[profile::refid_of(ref)] = profile::to_json(*value);
+        }
+        if (properties.empty())
+          continue;
+        calls.push_back({app_->find_component(ci.id)->address, "component.configure",
+                         Json{{"properties", properties}}, ci.id});
+      }
+    }
+    detail_ = fmt::format("{} components configured", calls.size());
+    return call_all(*s_.endpoint, calls, s_.call_timeout).map([](auto &&) {});
+  }
+
+  CallResult<void> connect() {
+    const auto &sad = *request_.profile->sad;
+    std::vector<Call> provides_side, uses_side;
+    for (std::size_t i = 0; i < sad.connections.size(); ++i) {
+      const auto &c = sad.connections[i];
+      const std::string id = c.id.empty() ? fmt::format("connection_{}", i + 1) : c.id;
+      ConnectionInstance ci;
+      ci.id = id;
+      ci.qos = dds::qos_to_json(c.qos.value_or(profile::ConnectionQos{}));
+      ci.topic = c.publishes_to_channel() || c.subscribes_to_channel()
+                     ? channel_topic(c)
+                     : topic_name(s_.domain_name, fmt::format("{}_{}", app_->name, launch_), id);
+      ci.repid = repid_of(c);
+      if (c.uses.target.kind == profile::EndpointTarget::Kind::ComponentInstantiation) {
+        ci.uses = {c.uses.target.refid, c.uses.port};
+        uses_side.push_back(connect_call(ci, ci.uses, "uses"));
+      }
+      if (c.provides.target.kind == profile::EndpointTarget::Kind::ComponentInstantiation &&
+          c.provides.kind == profile::ProvidesEnd::Kind::Port) {
+        ci.provides = {c.provides.target.refid, c.provides.port};
+        provides_side.push_back(connect_call(ci, ci.provides, "provides"));
+      }
+      app_->connections.push_back(std::move(ci));
+    }
+    // Readers first, so the first samples written find them.
+    auto ok = call_all(*s_.endpoint, provides_side, s_.call_timeout);
+    if (!ok)
+      return tl::unexpected(ok.error());
+    ok = call_all(*s_.endpoint, uses_side, s_.call_timeout);
+    if (!ok)
+      return tl::unexpected(ok.error());
+    detail_ = fmt::format("{} connections", app_->connections.size());
+    return {};
+  }
+
+  CallResult<void> start() {
+    ApplicationFactory factory(s_);
+    auto ok = factory.start(*app_);
+    if (ok)
+      detail_ = fmt::format("{} components running", app_->components.size());
+    return ok;
+  }
+
+  // --- helpers ---
+
+  template <typename Body>
+  CallResult<void> call_each(const std::string &operation, Body body) {
+    std::vector<Call> calls;
+    for (auto &c : app_->components)
+      calls.push_back({c.address, operation, body(c), c.id});
+    return call_all(*s_.endpoint, calls, s_.call_timeout).map([](auto &&) {});
+  }
+
+  Call connect_call(const ConnectionInstance &ci, const ConnectionEnd &end, const char *direction) {
+    return {app_->find_component(end.component)->address,
+            "component.connect",
+            Json{{"connection", ci.id},
+                 {"port", end.port},
+                 {"direction", direction},
+                 {"topic", ci.topic},
+                 {"repid", ci.repid},
+                 {"qos", ci.qos}},
+            fmt::format("{} ({}.{})", ci.id, end.component, end.port)};
+  }
+
+  std::string channel_topic(const profile::Connection &c) const {
+    const auto &findby = c.publishes_to_channel() ? c.provides.target.findby : c.uses.target.findby;
+    return fmt::format("rsca_{}_channel_{}", sanitize(s_.domain_name), sanitize(findby.name));
+  }
+
+  std::string repid_of(const profile::Connection &c) const {
+    const auto &sad = *request_.profile->sad;
+    for (const auto *end : {&c.uses.target, &c.provides.target}) {
+      if (end->kind != profile::EndpointTarget::Kind::ComponentInstantiation)
+        continue;
+      const profile::ComponentPlacement *placement = nullptr;
+      if (sad.find_instantiation(end->refid, &placement) == nullptr)
+        continue;
+      const auto *pkg = request_.profile->softpkg_of(*placement);
+      if (pkg == nullptr || !pkg->scd)
+        continue;
+      const bool uses = end == &c.uses.target;
+      const auto *port = pkg->scd->find_port(uses ? c.uses.port : c.provides.port,
+                                             uses ? profile::PortDirection::Uses
+                                                  : profile::PortDirection::Provides);
+      if (port != nullptr)
+        return port->repid;
+    }
+    return {};
+  }
+
+  Json execute_body(const ComponentInstance &c) const {
+    std::vector<std::string> args = {"COMPONENT_IDENTIFIER", c.id,         "NAME_BINDING",
+                                     c.usage_name,           "PROFILE_NAME", c.spd,
+                                     "DOMAIN_NAME",          s_.domain_name, "APPLICATION",
+                                     app_->name,             "CONTROL_ADDRESS", c.address};
+    append_execparams(c, args);
+    const auto *impl = placement_of(c.id)->implementation;
+    const auto spd_dir = std::filesystem::path(c.spd).parent_path();
+    return Json{{"application", app_->name},
+                {"component", c.id},
+                {"device", c.device},
+                {"entrypoint", impl->code.entrypoint.empty() ? impl->code.file.name : impl->code.entrypoint},
+                {"spd_dir", spd_dir.string()},
+                {"args", args}};
+  }
+
+  void append_execparams(const ComponentInstance &c, std::vector<std::string> &args) const {
+    const profile::ComponentPlacement *placement = nullptr;
+    const auto *ci = request_.profile->sad->find_instantiation(c.id, &placement);
+    const auto *pkg = request_.profile->softpkg_of(*placement);
+    for (const auto &ref : ci->properties) {
+      const auto *definition = pkg->find_property(profile::refid_of(ref));
+      if (definition == nullptr || !is_execparam_only(*definition))
+        continue;
+      if (auto value = profile::bind_property(*definition, ref)) {
+        args.push_back(profile::refid_of(ref));
+        args.push_back(profile::format_value(*value));
+      }
+    }
+  }
+
+  const allocator::Placement *placement_of(const std::string &instance) const {
+    for (const auto &p : app_->placements)
+      if (p.instance == instance)
+        return &p;
+    return nullptr;
+  }
+
+  void build_components() {
+    const auto &sad = *request_.profile->sad;
+    for (const auto &p : app_->placements) {
+      const profile::ComponentPlacement *placement = nullptr;
+      const auto *ci = sad.find_instantiation(p.instance, &placement);
+      ComponentInstance c;
+      c.id = p.instance;
+      c.usage_name = ci->usage_name.empty() ? ci->id : ci->usage_name;
+      c.node = p.node;
+      c.device = p.device;
+      c.implementation = p.implementation->id;
+      c.address = fmt::format("{}/component/{}.{}/{}", s_.domain_name, app_->name, launch_, p.instance);
+      c.spd = request_.profile->softpkg_of(*placement)->spd_path.string();
+      c.start_order = ci->start_order.value_or(UINT32_MAX);
+      c.assembly_controller = sad.assembly_controller == ci->id;
+      c.state = "allocated";
+      app_->components.push_back(std::move(c));
+    }
+  }
+
+  std::size_t count_instances() const {
+    std::size_t n = 0;
+    for (const auto &p : request_.profile->sad->placements)
+      n += p.instantiations.size();
+    return n;
+  }
+
+  std::vector<std::string> nodes_used() const {
+    std::vector<std::string> nodes;
+    for (const auto &c : app_->components)
+      if (std::find(nodes.begin(), nodes.end(), c.node) == nodes.end())
+        nodes.push_back(c.node);
+    return nodes;
+  }
+
+  CallResult<std::shared_ptr<Application>> fail(const char *step, const control::CallError &error) {
+    const std::string undone = roll_back();
+    const std::string message =
+        fmt::format("launch of {} failed at step '{}': {}{}", app_->name, step, error.message,
+                    undone.empty() ? "" : fmt::format("\nrolled back: {}", undone));
+    spdlog::warn("{}", message);
+    progress_({step, "failed", 0});
+    return control::call_error(error.status, message);
+  }
+
+  // Undoes what the launch did: processes first, then the allocation.
+  std::string roll_back() {
+    std::vector<std::string> undone;
+    ApplicationFactory factory(s_);
+    const std::size_t started =
+        std::count_if(app_->components.begin(), app_->components.end(), [](const auto &c) { return c.pid != 0; });
+    if (started > 0) {
+      factory.release(*app_);
+      undone.push_back(fmt::format("{} process{} terminated", started, started == 1 ? "" : "es"));
+    } else if (allocated_) {
+      s_.allocator->release(app_->placements);
+    }
+    if (allocated_) {
+      std::vector<std::string> devices;
+      for (const auto &p : app_->placements)
+        if (std::find(devices.begin(), devices.end(), p.device) == devices.end())
+          devices.push_back(p.device);
+      undone.push_back(fmt::format("allocations on {} released", fmt::join(devices, ", ")));
+    }
+    return fmt::format("{}", fmt::join(undone, "; "));
+  }
+
+  const DomainServices &s_;
+  const LaunchRequest &request_;
+  const ProgressSink &progress_;
+  std::shared_ptr<Application> app_;
+  bool allocated_ = false;
+  std::uint64_t launch_ = 0;
+  std::string detail_;
+};
+
+CallResult<std::shared_ptr<Application>> ApplicationFactory::create(const LaunchRequest &request,
+                                                                    const ProgressSink &progress) {
+  return Launch(services_, request, progress).run();
+}
+
+CallResult<void> ApplicationFactory::start(Application &app) {
+  // In start order (the assembly controller first among equals); each group of one order at once.
+  std::vector<ComponentInstance *> order;
+  for (auto &c : app.components)
+    order.push_back(&c);
+  std::stable_sort(order.begin(), order.end(), [](const auto *a, const auto *b) {
+    if (a->start_order != b->start_order)
+      return a->start_order < b->start_order;
+    return a->assembly_controller && !b->assembly_controller;
+  });
+  for (auto *c : order) {
+    auto ok = services_.endpoint->call_sync(c->address, "component.start", Json::object(),
+                                            services_.call_timeout);
+    if (!ok)
+      return control::call_error(ok.error().status, fmt::format("{}: {}", c->id, ok.error().message));
+    c->state = "running";
+  }
+  app.state = ApplicationState::Running;
+  return {};
+}
+
+CallResult<void> ApplicationFactory::stop(Application &app) {
+  std::vector<Call> calls;
+  for (auto &c : app.components)
+    calls.push_back({c.address, "component.stop", Json::object(), c.id});
+  auto ok = call_all(*services_.endpoint, calls, services_.call_timeout);
+  for (auto &c : app.components)
+    c.state = "stopped";
+  app.state = ApplicationState::Stopped;
+  return ok.map([](auto &&) {});
+}
+
+CallResult<void> ApplicationFactory::release(Application &app) {
+  std::vector<Call> releases;
+  for (auto &c : app.components)
+    if (c.pid != 0 && services_.components->registered(c.address))
+      releases.push_back({c.address, "component.release", Json::object(), c.id});
+  call_all(*services_.endpoint, releases, services_.call_timeout);
+  // Whatever is still running is terminated by its node; the node reaps every process.
+  std::vector<Call> terminations;
+  for (auto &c : app.components) {
+    if (c.pid == 0)
+      continue;
+    auto node = services_.node_address(c.node);
+    if (node)
+      terminations.push_back({*node, "node.terminate", Json{{"pid", c.pid}}, c.id});
+  }
+  auto terminated = call_all(*services_.endpoint, terminations, services_.call_timeout);
+  for (auto &c : app.components) {
+    services_.components->forget(c.address);
+    c.state = "released";
+    c.pid = 0;
+  }
+  services_.allocator->release(app.placements);
+  app.placements.clear();
+  return terminated.map([](auto &&) {});
+}
+
+} // namespace rsca::domain

@@ -1,0 +1,71 @@
+// ApplicationFactory: turns an installed application into running components, in SCA's order —
+// check the wiring, allocate devices, execute, wait for registration, initialize, configure,
+// connect, start — each step for all components at once. A failure at any step rolls back all
+// that was done (processes, allocations, connections) and says which step failed and why.
+#pragma once
+
+#include <chrono>
+#include <functional>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "allocator/resource_allocator.hpp"
+#include "control/endpoint.hpp"
+#include "domain/application.hpp"
+#include "domain/component_registry.hpp"
+
+namespace rsca::domain {
+
+struct LaunchStep {
+  std::string step;   // "check", "allocate", "execute", "register", ...
+  std::string detail; // what was done
+  double milliseconds = 0;
+};
+using ProgressSink = std::function<void(const LaunchStep &)>;
+
+struct LaunchRequest {
+  std::string name;      // the instance name
+  std::string installed; // the installed application
+  std::shared_ptr<const profile::ResolvedApplication> profile;
+  std::map<std::string, std::string> assignments; // instance id → device id
+  bool start = true;
+};
+
+// What the factory uses of the domain.
+struct DomainServices {
+  std::string domain_name;
+  control::Endpoint *endpoint = nullptr;
+  allocator::ResourceAllocator *allocator = nullptr;
+  ComponentRegistry *components = nullptr;
+  std::function<std::optional<std::string>(const std::string &node)> node_address;
+  // A number unique to each launch in this domain: component addresses and topics carry it, so
+  // an application re-launched under the same name never meets its predecessor's leftovers.
+  std::function<std::uint64_t()> next_launch;
+  std::chrono::milliseconds call_timeout{5000};
+  std::chrono::milliseconds registration_timeout{10000};
+};
+
+class ApplicationFactory {
+public:
+  explicit ApplicationFactory(DomainServices services) : services_(std::move(services)) {}
+
+  control::CallResult<std::shared_ptr<Application>> create(const LaunchRequest &request,
+                                                           const ProgressSink &progress);
+  control::CallResult<void> start(Application &app);
+  control::CallResult<void> stop(Application &app);
+  // Stops, releases and terminates every component, and frees the allocation. Best effort: a
+  // component that does not answer is terminated by its node.
+  control::CallResult<void> release(Application &app);
+
+  // The DDS topic of one connection: unique per domain, application instance and connection.
+  static std::string topic_name(const std::string &domain, const std::string &app,
+                                const std::string &connection);
+
+private:
+  class Launch;
+  DomainServices services_;
+};
+
+} // namespace rsca::domain

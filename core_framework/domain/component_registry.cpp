@@ -1,0 +1,97 @@
+#include "domain/component_registry.hpp"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+namespace rsca::domain {
+
+void ComponentRegistry::expect(const std::string &address) {
+  std::lock_guard lock(mutex_);
+  entries_[address] = Entry{};
+}
+
+void ComponentRegistry::announced(const std::string &address, const nlohmann::json &body) {
+  {
+    std::lock_guard lock(mutex_);
+    auto &e = entries_[address];
+    e.registered = true;
+    e.body = body;
+  }
+  changed_.notify_all();
+}
+
+void ComponentRegistry::gone(const std::string &address) {
+  exited(address, "its endpoint disappeared");
+}
+
+void ComponentRegistry::exited(const std::string &address, const std::string &why) {
+  {
+    std::lock_guard lock(mutex_);
+    auto it = entries_.find(address);
+    if (it == entries_.end() || it->second.exited)
+      return;
+    it->second.exited = true;
+    it->second.why = why;
+  }
+  changed_.notify_all();
+}
+
+void ComponentRegistry::forget(const std::string &address) {
+  std::lock_guard lock(mutex_);
+  entries_.erase(address);
+}
+
+bool ComponentRegistry::registered(const std::string &address) const {
+  std::lock_guard lock(mutex_);
+  auto it = entries_.find(address);
+  return it != entries_.end() && it->second.registered && !it->second.exited;
+}
+
+std::optional<nlohmann::json> ComponentRegistry::announcement(const std::string &address) const {
+  std::lock_guard lock(mutex_);
+  auto it = entries_.find(address);
+  if (it == entries_.end() || !it->second.registered)
+    return std::nullopt;
+  return it->second.body;
+}
+
+control::CallResult<void>
+ComponentRegistry::wait_registered(const std::vector<std::string> &addresses,
+                                   std::chrono::steady_clock::time_point deadline) {
+  std::unique_lock lock(mutex_);
+  std::string failure;
+  auto settled = [&] {
+    bool all = true;
+    for (const auto &a : addresses) {
+      auto it = entries_.find(a);
+      if (it != entries_.end() && it->second.exited) {
+        failure = fmt::format("{} exited before registering: {}", a, it->second.why);
+        return true;
+      }
+      all = all && it != entries_.end() && it->second.registered;
+    }
+    return all;
+  };
+  if (!changed_.wait_until(lock, deadline, settled)) {
+    std::vector<std::string> missing;
+    for (const auto &a : addresses)
+      if (auto it = entries_.find(a); it == entries_.end() || !it->second.registered)
+        missing.push_back(a);
+    return control::call_error(control::Status::Timeout,
+                               fmt::format("not registered in time: {}", fmt::join(missing, ", ")));
+  }
+  if (!failure.empty())
+    return control::call_error(control::Status::Failed, failure);
+  return {};
+}
+
+bool ComponentRegistry::wait_gone(const std::string &address,
+                                  std::chrono::steady_clock::time_point deadline) {
+  std::unique_lock lock(mutex_);
+  return changed_.wait_until(lock, deadline, [&] {
+    auto it = entries_.find(address);
+    return it == entries_.end() || it->second.exited;
+  });
+}
+
+} // namespace rsca::domain

@@ -1,0 +1,51 @@
+// Which component processes have registered (announced themselves) and which have exited, so
+// that a launch can wait for its components — bounded, and failing at once when one dies.
+#pragma once
+
+#include <chrono>
+#include <condition_variable>
+#include <map>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "control/endpoint.hpp"
+
+namespace rsca::domain {
+
+class ComponentRegistry {
+public:
+  // A launch is about to start a component at this address: from now on its registration and
+  // exit count. Exits of addresses nobody expects (released components) are ignored.
+  void expect(const std::string &address);
+  void announced(const std::string &address, const nlohmann::json &body);
+  void gone(const std::string &address);
+  void exited(const std::string &address, const std::string &why);
+  // Forgets an address (its component was released), so a later one can reuse it.
+  void forget(const std::string &address);
+
+  bool registered(const std::string &address) const;
+  std::optional<nlohmann::json> announcement(const std::string &address) const;
+
+  // Waits until every address has registered; fails at once when one of them exits, or at the
+  // deadline, naming which did not register.
+  control::CallResult<void> wait_registered(const std::vector<std::string> &addresses,
+                                            std::chrono::steady_clock::time_point deadline);
+  // Waits until the address is gone or exited.
+  bool wait_gone(const std::string &address, std::chrono::steady_clock::time_point deadline);
+
+private:
+  struct Entry {
+    bool registered = false;
+    bool exited = false;
+    std::string why;
+    nlohmann::json body;
+  };
+  mutable std::mutex mutex_;
+  std::condition_variable changed_;
+  std::map<std::string, Entry> entries_;
+};
+
+} // namespace rsca::domain

@@ -1,0 +1,558 @@
+#include "domain/domain_manager.hpp"
+
+#include <atomic>
+#include <fstream>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+#include <spdlog/spdlog.h>
+
+#include "profile/profile_loader.hpp"
+#include "profile/property_binding.hpp"
+#include "profile/property_json.hpp"
+
+namespace rsca::domain {
+namespace {
+
+namespace fs = std::filesystem;
+using control::CallResult;
+using control::Json;
+using control::Status;
+
+struct InstalledApplication {
+  std::string name;
+  fs::path sad;
+  std::shared_ptr<const profile::ResolvedApplication> profile;
+};
+
+struct NodeRecord {
+  std::string name;
+  std::string address;
+  Json body;
+};
+
+struct LaunchProgress {
+  std::vector<LaunchStep> steps;
+  bool done = false;
+};
+
+template <typename T>
+CallResult<T> required(const Json &body, const char *key) {
+  if (!body.contains(key))
+    return control::call_error(Status::BadRequest, fmt::format("the request has no \"{}\"", key));
+  try {
+    return body.at(key).get<T>();
+  } catch (const Json::exception &) {
+    return control::call_error(Status::BadRequest, fmt::format("\"{}\" has the wrong type", key));
+  }
+}
+
+// A path from a client must stay inside the repository: no absolute paths, no "..".
+std::optional<fs::path> safe_relative(const std::string &path) {
+  fs::path p = fs::path(path).lexically_normal();
+  if (p.empty() || p.is_absolute() || *p.begin() == "..")
+    return std::nullopt;
+  return p;
+}
+
+std::vector<allocator::Device> devices_of(const std::string &node, const Json &body) {
+  std::vector<allocator::Device> devices;
+  for (const auto &d : body.value("devices", Json::array())) {
+    allocator::Device device;
+    device.id = d.value("id", "");
+    device.node = node;
+    device.kind = d.value("kind", "device");
+    const Json properties = d.value("properties", Json::object());
+    const Json capacity = d.value("capacity", Json::object());
+    for (const auto &[k, v] : properties.items())
+      device.properties[k] = v.is_string() ? v.get<std::string>() : v.dump();
+    for (const auto &[k, v] : capacity.items())
+      if (v.is_number())
+        device.capacity[k] = v.get<double>();
+    devices.push_back(std::move(device));
+  }
+  return devices;
+}
+
+} // namespace
+
+struct DomainManager::Impl {
+  DomainOptions options;
+  std::shared_ptr<dds::Participant> participant;
+  std::unique_ptr<control::Endpoint> endpoint;
+  allocator::ResourceAllocator allocator;
+  ComponentRegistry components;
+  std::optional<DomainStore> store;
+
+  std::mutex mutex; // guards everything below
+  std::map<std::string, NodeRecord> nodes;
+  std::map<std::string, InstalledApplication> installed;
+  std::map<std::string, std::shared_ptr<Application>> applications;
+  std::map<std::string, std::shared_ptr<LaunchProgress>> launches;
+  std::atomic<std::uint64_t> launch_counter{0};
+
+  ApplicationFactory factory() {
+    DomainServices s;
+    s.domain_name = options.name;
+    s.endpoint = endpoint.get();
+    s.allocator = &allocator;
+    s.components = &components;
+    s.node_address = [this](const std::string &node) -> std::optional<std::string> {
+      std::lock_guard lock(mutex);
+      auto it = nodes.find(node);
+      if (it == nodes.end())
+        return std::nullopt;
+      return it->second.address;
+    };
+    s.next_launch = [this] { return ++launch_counter; };
+    s.call_timeout = options.call_timeout;
+    s.registration_timeout = options.registration_timeout;
+    return ApplicationFactory(std::move(s));
+  }
+
+  void serve();
+  void on_announcement(const control::AnnouncementEvent &event);
+  Expected<void> load_installed();
+  CallResult<Json> install(const Json &body);
+  CallResult<Json> uninstall(const Json &body);
+  CallResult<Json> list_installed();
+  CallResult<Json> create_application(const Json &body);
+  CallResult<Json> progress(const Json &body);
+  CallResult<std::shared_ptr<Application>> find_application(const Json &body);
+  CallResult<Json> release(const Json &body);
+  CallResult<Json> configure(const Json &body);
+  CallResult<Json> query(const Json &body);
+  CallResult<Json> list_nodes();
+  CallResult<Json> list_devices();
+  CallResult<Json> component_exited(const Json &body);
+  std::string unique_name(const std::string &wanted) const;
+  CallResult<std::string> target_of(const Application &app, const Json &body) const;
+};
+
+Expected<void> DomainManager::Impl::load_installed() {
+  auto records = store->installed();
+  if (!records)
+    return tl::unexpected(records.error());
+  for (const auto &r : *records) {
+    const fs::path sad = options.repository / r.sad;
+    profile::ProfileLoader loader(options.repository / r.name);
+    auto app = loader.load_application(sad);
+    if (!app) {
+      spdlog::warn("installed application {} no longer loads, skipped:\n{}", r.name,
+                   app.error().to_string());
+      continue;
+    }
+    installed[r.name] = {r.name, sad, std::make_shared<const profile::ResolvedApplication>(std::move(*app))};
+  }
+  spdlog::info("{} installed application(s) loaded", installed.size());
+  return {};
+}
+
+CallResult<Json> DomainManager::Impl::install(const Json &body) {
+  auto sad_rel = required<std::string>(body, "sad");
+  auto files = required<std::vector<Json>>(body, "files");
+  if (!sad_rel || !files)
+    return tl::unexpected(sad_rel ? files.error() : sad_rel.error());
+  // Write into a staging folder, load from there, and only then replace what was installed.
+  const std::string staging_name = fmt::format(".staging-{}", std::chrono::steady_clock::now().time_since_epoch().count());
+  const fs::path staging = options.repository / staging_name;
+  std::error_code ec;
+  fs::remove_all(staging, ec);
+  for (const auto &f : *files) {
+    auto rel = safe_relative(f.value("path", ""));
+    if (!rel) {
+      fs::remove_all(staging, ec);
+      return control::call_error(Status::BadRequest,
+                                 fmt::format("file path \"{}\" is not inside an SDR root", f.value("path", "")));
+    }
+    fs::create_directories((staging / *rel).parent_path(), ec);
+    std::ofstream(staging / *rel, std::ios::binary) << f.value("content", "");
+  }
+  auto rel_sad = safe_relative(*sad_rel);
+  profile::ProfileLoader loader(staging);
+  auto app = rel_sad ? loader.load_application(staging / *rel_sad)
+                     : Expected<profile::ResolvedApplication>(
+                           make_error({*sad_rel, 0, 0}, "install", "not a relative path"));
+  if (!app) {
+    fs::remove_all(staging, ec);
+    return control::call_error(Status::BadRequest, app.error().to_string());
+  }
+  const std::string name = body.value("name", app->sad->name.empty() ? app->sad->id : app->sad->name);
+  std::lock_guard lock(mutex);
+  const fs::path final_dir = options.repository / name;
+  fs::remove_all(final_dir, ec);
+  fs::rename(staging, final_dir, ec);
+  if (ec)
+    return control::call_error(Status::Failed, fmt::format("storing {}: {}", name, ec.message()));
+  profile::ProfileLoader final_loader(final_dir);
+  auto final_app = final_loader.load_application(final_dir / *rel_sad);
+  if (!final_app)
+    return control::call_error(Status::Failed, final_app.error().to_string());
+  if (auto ok = store->put_installed({name, (fs::path(name) / *rel_sad).string()}); !ok)
+    return control::call_error(Status::Failed, ok.error().to_string());
+  installed[name] = {name, final_dir / *rel_sad,
+                     std::make_shared<const profile::ResolvedApplication>(std::move(*final_app))};
+  spdlog::info("installed application {} ({} files)", name, files->size());
+  Json warnings = Json::array();
+  for (const auto &w : installed[name].profile->warnings)
+    warnings.push_back(to_string(w));
+  return Json{{"name", name}, {"warnings", warnings}};
+}
+
+CallResult<Json> DomainManager::Impl::uninstall(const Json &body) {
+  auto name = required<std::string>(body, "name");
+  if (!name)
+    return tl::unexpected(name.error());
+  std::lock_guard lock(mutex);
+  if (installed.erase(*name) == 0)
+    return control::call_error(Status::NotFound, fmt::format("no application {} is installed", *name));
+  for (const auto &[app_name, app] : applications)
+    if (app->installed == *name)
+      spdlog::info("{} stays running after uninstalling {}", app_name, *name);
+  store->remove_installed(*name);
+  std::error_code ec;
+  fs::remove_all(options.repository / *name, ec);
+  return Json{{"name", *name}};
+}
+
+CallResult<Json> DomainManager::Impl::list_installed() {
+  std::lock_guard lock(mutex);
+  Json list = Json::array();
+  for (const auto &[name, app] : installed) {
+    std::size_t count = 0;
+    for (const auto &p : app.profile->sad->placements)
+      count += p.instantiations.size();
+    list.push_back({{"name", name}, {"sad", app.sad.string()}, {"components", count}});
+  }
+  return Json{{"applications", list}};
+}
+
+std::string DomainManager::Impl::unique_name(const std::string &wanted) const {
+  if (applications.count(wanted) == 0)
+    return wanted;
+  for (int i = 2;; ++i)
+    if (auto name = fmt::format("{}_{}", wanted, i); applications.count(name) == 0)
+      return name;
+}
+
+CallResult<Json> DomainManager::Impl::create_application(const Json &body) {
+  auto installed_name = required<std::string>(body, "application");
+  if (!installed_name)
+    return tl::unexpected(installed_name.error());
+  LaunchRequest request;
+  std::shared_ptr<LaunchProgress> progress = std::make_shared<LaunchProgress>();
+  {
+    std::lock_guard lock(mutex);
+    auto it = installed.find(*installed_name);
+    if (it == installed.end())
+      return control::call_error(Status::NotFound,
+                                 fmt::format("no application {} is installed", *installed_name));
+    request.installed = *installed_name;
+    request.profile = it->second.profile;
+    const std::string wanted = body.value("name", *installed_name);
+    if (body.contains("name") && applications.count(wanted) != 0)
+      return control::call_error(Status::Rejected, fmt::format("an application named {} already runs", wanted));
+    request.name = unique_name(wanted);
+    // Reserve the name while launching.
+    applications[request.name] = nullptr;
+    launches[body.value("launch_id", request.name)] = progress;
+  }
+  request.start = body.value("start", true);
+  const Json assign = body.value("assign", Json::object());
+  for (const auto &[k, v] : assign.items())
+    request.assignments[k] = v.get<std::string>();
+  auto record = [this, progress](const LaunchStep &step) {
+    std::lock_guard lock(mutex);
+    progress->steps.push_back(step);
+  };
+  auto app = factory().create(request, record);
+  std::lock_guard lock(mutex);
+  progress->done = true;
+  if (!app) {
+    applications.erase(request.name);
+    return tl::unexpected(app.error());
+  }
+  applications[request.name] = *app;
+  return to_json(**app);
+}
+
+CallResult<Json> DomainManager::Impl::progress(const Json &body) {
+  auto id = required<std::string>(body, "launch_id");
+  if (!id)
+    return tl::unexpected(id.error());
+  std::lock_guard lock(mutex);
+  auto it = launches.find(*id);
+  if (it == launches.end())
+    return control::call_error(Status::NotFound, fmt::format("no launch {}", *id));
+  Json steps = Json::array();
+  for (const auto &s : it->second->steps)
+    steps.push_back({{"step", s.step}, {"detail", s.detail}, {"ms", s.milliseconds}});
+  return Json{{"steps", steps}, {"done", it->second->done}};
+}
+
+CallResult<std::shared_ptr<Application>> DomainManager::Impl::find_application(const Json &body) {
+  auto name = required<std::string>(body, "app");
+  if (!name)
+    return tl::unexpected(name.error());
+  std::lock_guard lock(mutex);
+  auto it = applications.find(*name);
+  if (it == applications.end() || !it->second)
+    return control::call_error(Status::NotFound, fmt::format("no application {} is running", *name));
+  return it->second;
+}
+
+CallResult<Json> DomainManager::Impl::release(const Json &body) {
+  auto app = find_application(body);
+  if (!app)
+    return tl::unexpected(app.error());
+  {
+    std::lock_guard lock(mutex);
+    applications.erase((*app)->name);
+  }
+  auto ok = factory().release(**app);
+  spdlog::info("application {} released", (*app)->name);
+  if (!ok)
+    return control::call_error(ok.error().status,
+                               fmt::format("released {} with problems: {}", (*app)->name, ok.error().message));
+  return Json{{"name", (*app)->name}};
+}
+
+// Where configure/query go: the named component, or else the assembly controller (SCA).
+CallResult<std::string> DomainManager::Impl::target_of(const Application &app, const Json &body) const {
+  const std::string component = body.value("component", "");
+  for (const auto &c : app.components)
+    if (component.empty() ? c.assembly_controller : c.id == component)
+      return c.address;
+  return control::call_error(Status::NotFound,
+                             fmt::format("application {} has no component {}", app.name,
+                                         component.empty() ? "(assembly controller)" : component));
+}
+
+namespace {
+
+// Property values given as text (from the CLI), typed against the component's PRF.
+CallResult<Json> typed_values(const Application &app, const ComponentInstance &component,
+                              const Json &values) {
+  const profile::ComponentPlacement *placement = nullptr;
+  app.profile->sad->find_instantiation(component.id, &placement);
+  const auto *pkg = placement != nullptr ? app.profile->softpkg_of(*placement) : nullptr;
+  Json typed = Json::object();
+  for (const auto &[id, text] : values.items()) {
+    const auto *definition = pkg != nullptr ? pkg->find_property(id) : nullptr;
+    if (definition == nullptr)
+      return control::call_error(Status::NotFound,
+                                 fmt::format("component {} has no property {}", component.id, id));
+    const std::string value = text.is_string() ? text.get<std::string>() : text.dump();
+    profile::PropertyRef ref = profile::SimpleRef{id, value, {}};
+    if (std::holds_alternative<profile::SimpleSequenceProperty>(*definition)) {
+      profile::SimpleSequenceRef seq{id, {}, {}};
+      std::stringstream items(value);
+      for (std::string item; std::getline(items, item, ',');)
+        seq.values.push_back(item);
+      ref = seq;
+    }
+    auto bound = profile::bind_property(*definition, ref);
+    if (!bound)
+      return control::call_error(Status::BadRequest, bound.error().diagnostics().front().message);
+    typed[id] = profile::to_json(*bound);
+  }
+  return typed;
+}
+
+} // namespace
+
+CallResult<Json> DomainManager::Impl::configure(const Json &body) {
+  auto app = find_application(body);
+  if (!app)
+    return tl::unexpected(app.error());
+  auto target = target_of(**app, body);
+  if (!target)
+    return tl::unexpected(target.error());
+  Json properties = body.value("properties", Json::object());
+  if (body.contains("values")) {
+    const ComponentInstance *component = nullptr;
+    for (const auto &c : (*app)->components)
+      if (c.address == *target)
+        component = &c;
+    auto typed = typed_values(**app, *component, body.at("values"));
+    if (!typed)
+      return tl::unexpected(typed.error());
+    properties.update(*typed);
+  }
+  return endpoint->call_sync(*target, "component.configure", Json{{"properties", properties}},
+                             options.call_timeout);
+}
+
+CallResult<Json> DomainManager::Impl::query(const Json &body) {
+  auto app = find_application(body);
+  if (!app)
+    return tl::unexpected(app.error());
+  auto target = target_of(**app, body);
+  if (!target)
+    return tl::unexpected(target.error());
+  return endpoint->call_sync(*target, "component.query",
+                             Json{{"ids", body.value("ids", Json::array())}}, options.call_timeout);
+}
+
+CallResult<Json> DomainManager::Impl::list_nodes() {
+  std::lock_guard lock(mutex);
+  Json list = Json::array();
+  for (const auto &[name, node] : nodes)
+    list.push_back({{"name", name},
+                    {"address", node.address},
+                    {"pid", node.body.value("pid", 0)},
+                    {"devices", node.body.value("devices", Json::array()).size()}});
+  return Json{{"nodes", list}};
+}
+
+CallResult<Json> DomainManager::Impl::list_devices() {
+  Json list = Json::array();
+  for (const auto &state : allocator.snapshot()) {
+    Json capacity = Json::object();
+    for (const auto &[name, total] : state.device.capacity) {
+      auto used = state.allocated.find(name);
+      const double allocated = used == state.allocated.end() ? 0.0 : used->second;
+      capacity[name] = {{"total", total}, {"allocated", allocated}, {"free", total - allocated}};
+    }
+    list.push_back({{"id", state.device.id},
+                    {"node", state.device.node},
+                    {"kind", state.device.kind},
+                    {"properties", state.device.properties},
+                    {"capacity", capacity}});
+  }
+  return Json{{"devices", list}};
+}
+
+CallResult<Json> DomainManager::Impl::component_exited(const Json &body) {
+  const std::string address = body.value("address", "");
+  const std::string why = body.value("status", "exited");
+  components.exited(address, why);
+  std::lock_guard lock(mutex);
+  for (auto &[name, app] : applications) {
+    if (!app)
+      continue;
+    for (auto &c : app->components) {
+      if (c.address != address || c.pid == 0)
+        continue;
+      c.state = "exited";
+      spdlog::warn("component {} of application {} exited unexpectedly: {}", c.id, name, why);
+    }
+  }
+  return Json::object();
+}
+
+void DomainManager::Impl::on_announcement(const control::AnnouncementEvent &event) {
+  if (event.kind == control::AnnouncementEvent::Kind::Alive && event.endpoint_kind == "node") {
+    const std::string node = event.body.value("node", event.address);
+    allocator.set_node_devices(node, devices_of(node, event.body));
+    std::lock_guard lock(mutex);
+    const bool known = nodes.count(node) != 0;
+    nodes[node] = {node, event.address, event.body};
+    if (!known)
+      spdlog::info("node {} registered with {} device(s)", node, event.body.value("devices", Json::array()).size());
+    return;
+  }
+  if (event.kind == control::AnnouncementEvent::Kind::Alive && event.endpoint_kind == "component") {
+    components.announced(event.address, event.body);
+    return;
+  }
+  if (event.kind != control::AnnouncementEvent::Kind::Gone)
+    return;
+  components.gone(event.address);
+  std::lock_guard lock(mutex);
+  for (auto it = nodes.begin(); it != nodes.end(); ++it) {
+    if (it->second.address != event.address)
+      continue;
+    spdlog::warn("node {} is gone; its devices leave the domain", it->first);
+    allocator.remove_node(it->first);
+    nodes.erase(it);
+    return;
+  }
+}
+
+void DomainManager::Impl::serve() {
+  auto bind = [this](const char *op, auto method) {
+    endpoint->on(op, [this, method](const Json &body, const control::RequestContext &) {
+      return (this->*method)(body);
+    });
+  };
+  auto bind0 = [this](const char *op, auto method) {
+    endpoint->on(op, [this, method](const Json &, const control::RequestContext &) { return (this->*method)(); });
+  };
+  bind("domain.install", &Impl::install);
+  bind("domain.uninstall", &Impl::uninstall);
+  bind0("domain.installed", &Impl::list_installed);
+  bind0("domain.nodes", &Impl::list_nodes);
+  bind0("domain.devices", &Impl::list_devices);
+  bind("domain.component_exited", &Impl::component_exited);
+  bind("app.create", &Impl::create_application);
+  bind("app.progress", &Impl::progress);
+  bind("app.release", &Impl::release);
+  bind("app.configure", &Impl::configure);
+  bind("app.query", &Impl::query);
+  endpoint->on("app.list", [this](const Json &, const control::RequestContext &) -> CallResult<Json> {
+    std::lock_guard lock(mutex);
+    Json list = Json::array();
+    for (const auto &[name, app] : applications)
+      if (app)
+        list.push_back({{"name", name}, {"installed", app->installed},
+                        {"state", to_string(app->state)}, {"components", app->components.size()}});
+    return Json{{"applications", list}};
+  });
+  endpoint->on("app.show", [this](const Json &body, const control::RequestContext &) -> CallResult<Json> {
+    auto app = find_application(body);
+    if (!app)
+      return tl::unexpected(app.error());
+    std::lock_guard lock(mutex);
+    return to_json(**app);
+  });
+  for (const char *op : {"app.start", "app.stop"}) {
+    const bool starting = std::string_view(op) == "app.start";
+    endpoint->on(op, [this, starting](const Json &body, const control::RequestContext &) -> CallResult<Json> {
+      auto app = find_application(body);
+      if (!app)
+        return tl::unexpected(app.error());
+      auto ok = starting ? factory().start(**app) : factory().stop(**app);
+      if (!ok)
+        return tl::unexpected(ok.error());
+      return to_json(**app);
+    });
+  }
+}
+
+DomainManager::DomainManager(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+
+DomainManager::~DomainManager() {
+  // Releasing applications is the operator's decision; the domain only stops serving.
+  impl_->endpoint.reset();
+}
+
+Expected<std::unique_ptr<DomainManager>>
+DomainManager::create(std::shared_ptr<dds::Participant> participant, DomainOptions options) {
+  auto impl = std::make_unique<Impl>();
+  impl->options = std::move(options);
+  impl->participant = participant;
+  std::error_code ec;
+  fs::create_directories(impl->options.repository, ec);
+  if (ec)
+    return make_error({impl->options.repository.string(), 0, 0}, "io", ec.message());
+  auto store = DomainStore::open(impl->options.repository / "domain.sqlite");
+  if (!store)
+    return tl::unexpected(store.error());
+  impl->store.emplace(std::move(*store));
+  if (auto ok = impl->load_installed(); !ok)
+    return tl::unexpected(ok.error());
+  Impl *raw = impl.get();
+  auto endpoint = control::Endpoint::open(
+      participant, address_of(impl->options.name),
+      {.workers = 16, .on_announcement = [raw](const control::AnnouncementEvent &e) { raw->on_announcement(e); }});
+  if (!endpoint)
+    return tl::unexpected(endpoint.error());
+  impl->endpoint = std::move(*endpoint);
+  impl->serve();
+  spdlog::info("domain {} serving at {}", impl->options.name, impl->endpoint->address());
+  return std::unique_ptr<DomainManager>(new DomainManager(std::move(impl)));
+}
+
+} // namespace rsca::domain

@@ -1,0 +1,47 @@
+// DomainManager: the domain daemon's state and the operations it serves — nodes and devices
+// (from their announcements), installed applications (one ApplicationFactory each, persisted),
+// running applications — and what it does when a node or component goes away.
+#pragma once
+
+#include <chrono>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+
+#include "allocator/resource_allocator.hpp"
+#include "control/endpoint.hpp"
+#include "domain/application_factory.hpp"
+#include "domain/component_registry.hpp"
+#include "domain/domain_store.hpp"
+
+namespace rsca::domain {
+
+struct DomainOptions {
+  std::string name = "rsca";                // the DMD's name
+  std::filesystem::path repository;         // installed profiles are kept here
+  std::chrono::milliseconds registration_timeout{10000};
+  std::chrono::milliseconds call_timeout{5000};
+};
+
+class DomainManager {
+public:
+  static Expected<std::unique_ptr<DomainManager>> create(std::shared_ptr<dds::Participant> participant,
+                                                         DomainOptions options);
+  ~DomainManager();
+
+  static std::string address_of(const std::string &domain) { return domain + "/domain"; }
+  static std::string node_address(const std::string &domain, const std::string &node) {
+    return domain + "/node/" + node;
+  }
+
+  struct Impl;
+
+private:
+  explicit DomainManager(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+} // namespace rsca::domain

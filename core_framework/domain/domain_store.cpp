@@ -1,0 +1,68 @@
+#include "domain/domain_store.hpp"
+
+#include <fmt/format.h>
+
+namespace rsca::domain {
+namespace {
+
+struct StatementDeleter {
+  void operator()(sqlite3_stmt *s) const { sqlite3_finalize(s); }
+};
+using Statement = std::unique_ptr<sqlite3_stmt, StatementDeleter>;
+
+tl::unexpected<Error> sqlite_error(sqlite3 *db, std::string_view what) {
+  return make_error({"domain store", 0, 0}, "store", fmt::format("{}: {}", what, sqlite3_errmsg(db)));
+}
+
+} // namespace
+
+Expected<DomainStore> DomainStore::open(const std::filesystem::path &file) {
+  sqlite3 *raw = nullptr;
+  const int rc = sqlite3_open(file.c_str(), &raw);
+  std::unique_ptr<sqlite3, Closer> db(raw);
+  if (rc != SQLITE_OK)
+    return sqlite_error(db.get(), fmt::format("opening {}", file.string()));
+  DomainStore store(std::move(db));
+  auto ok = store.exec("CREATE TABLE IF NOT EXISTS installed ("
+                       " name TEXT PRIMARY KEY, sad TEXT NOT NULL,"
+                       " installed_at TEXT NOT NULL DEFAULT CURRENT_TIMESTAMP)",
+                       {});
+  if (!ok)
+    return tl::unexpected(ok.error());
+  return store;
+}
+
+Expected<void> DomainStore::exec(const std::string &sql, const std::vector<std::string> &params) const {
+  sqlite3_stmt *raw = nullptr;
+  if (sqlite3_prepare_v2(db_.get(), sql.c_str(), -1, &raw, nullptr) != SQLITE_OK)
+    return sqlite_error(db_.get(), "preparing a statement");
+  Statement statement(raw);
+  for (std::size_t i = 0; i < params.size(); ++i)
+    sqlite3_bind_text(raw, static_cast<int>(i + 1), params[i].c_str(), -1, SQLITE_TRANSIENT);
+  if (sqlite3_step(raw) != SQLITE_DONE)
+    return sqlite_error(db_.get(), "writing");
+  return {};
+}
+
+Expected<void> DomainStore::put_installed(const InstalledRecord &record) {
+  return exec("INSERT OR REPLACE INTO installed (name, sad) VALUES (?, ?)", {record.name, record.sad});
+}
+
+Expected<void> DomainStore::remove_installed(const std::string &name) {
+  return exec("DELETE FROM installed WHERE name = ?", {name});
+}
+
+Expected<std::vector<InstalledRecord>> DomainStore::installed() const {
+  sqlite3_stmt *raw = nullptr;
+  if (sqlite3_prepare_v2(db_.get(), "SELECT name, sad FROM installed ORDER BY name", -1, &raw,
+                         nullptr) != SQLITE_OK)
+    return sqlite_error(db_.get(), "reading installed applications");
+  Statement statement(raw);
+  std::vector<InstalledRecord> records;
+  while (sqlite3_step(raw) == SQLITE_ROW)
+    records.push_back({reinterpret_cast<const char *>(sqlite3_column_text(raw, 0)),
+                       reinterpret_cast<const char *>(sqlite3_column_text(raw, 1))});
+  return records;
+}
+
+} // namespace rsca::domain

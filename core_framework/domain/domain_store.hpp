@@ -1,0 +1,38 @@
+// The domain's persistent state in SQLite: which applications are installed, so that a domain
+// daemon that restarts still has them.
+#pragma once
+
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <sqlite3.h>
+
+#include "common/diagnostic.hpp"
+
+namespace rsca::domain {
+
+struct InstalledRecord {
+  std::string name;
+  std::string sad; // path of the SAD inside the domain's repository
+};
+
+class DomainStore {
+public:
+  static Expected<DomainStore> open(const std::filesystem::path &file);
+
+  Expected<void> put_installed(const InstalledRecord &record);
+  Expected<void> remove_installed(const std::string &name);
+  Expected<std::vector<InstalledRecord>> installed() const;
+
+private:
+  struct Closer {
+    void operator()(sqlite3 *db) const { sqlite3_close(db); }
+  };
+  explicit DomainStore(std::unique_ptr<sqlite3, Closer> db) : db_(std::move(db)) {}
+  Expected<void> exec(const std::string &sql, const std::vector<std::string> &params) const;
+  std::unique_ptr<sqlite3, Closer> db_;
+};
+
+} // namespace rsca::domain

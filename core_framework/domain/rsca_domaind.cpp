@@ -1,0 +1,54 @@
+// rsca-domaind: the domain daemon. Runs in the foreground (for systemd and similar supervisors);
+// `rsca domain up` starts it in the background.
+#include <CLI/CLI.hpp>
+#include <spdlog/spdlog.h>
+
+#include "common/termination_signals.hpp"
+#include "dds/participant.hpp"
+#include "domain/domain_manager.hpp"
+#include "profile/profile_loader.hpp"
+
+int main(int argc, char **argv) {
+  rsca::TerminationSignals signals; // before any thread exists
+  CLI::App app{"rsca-domaind — the rsca domain daemon (DomainManager, ApplicationFactory, ResourceAllocator)"};
+  std::string dmd;
+  std::string repository = "/tmp/rsca/domain";
+  std::string level = "info";
+  int registration_ms = 10000;
+  app.add_option("--dmd", dmd, "The domain's DMD; its name names the domain")->check(CLI::ExistingFile);
+  app.add_option("--repository", repository, "Where installed applications are kept")
+      ->capture_default_str();
+  app.add_option("--registration-timeout-ms", registration_ms,
+                 "How long a launch waits for its components to register")
+      ->capture_default_str();
+  app.add_option("--log-level", level, "trace, debug, info, warn, error")->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
+  spdlog::set_level(spdlog::level::from_str(level));
+  spdlog::set_pattern("%Y-%m-%dT%H:%M:%S.%e %^%l%$ domaind: %v");
+
+  rsca::domain::DomainOptions options;
+  options.repository = repository;
+  options.registration_timeout = std::chrono::milliseconds(registration_ms);
+  if (!dmd.empty()) {
+    rsca::profile::ProfileLoader loader;
+    auto domain = loader.load_domain(dmd);
+    if (!domain) {
+      spdlog::error("the DMD is invalid:\n{}", domain.error().to_string());
+      return 1;
+    }
+    options.name = domain->name;
+  }
+  auto participant = rsca::dds::Participant::create(rsca::dds::DdsSettings::from_environment());
+  if (!participant) {
+    spdlog::error("{}", participant.error().to_string());
+    return 1;
+  }
+  auto manager = rsca::domain::DomainManager::create(*participant, options);
+  if (!manager) {
+    spdlog::error("{}", manager.error().to_string());
+    return 1;
+  }
+  const int signal = signals.wait();
+  spdlog::info("signal {} received; stopping", signal);
+  return 0;
+}

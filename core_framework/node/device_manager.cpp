@@ -1,0 +1,190 @@
+#include "node/device_manager.hpp"
+
+#include <atomic>
+#include <unistd.h>
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include "profile/property_binding.hpp"
+#include "profile/property_json.hpp"
+
+namespace rsca::node {
+namespace {
+
+using control::Status;
+
+struct RunningDevice {
+  std::string id;
+  std::string label;
+  std::string softpkg;
+  std::unique_ptr<LogicalDevice> device;
+  ExecutableDevice *executable() const { return dynamic_cast<ExecutableDevice *>(device.get()); }
+};
+
+// The DCD's property values for one device, keyed by property id and by name.
+Json overrides_of(const profile::ComponentInstantiation &ci, const profile::ResolvedSoftPkg &pkg) {
+  Json out = Json::object();
+  for (const auto &ref : ci.properties) {
+    const auto *definition = pkg.find_property(profile::refid_of(ref));
+    if (definition == nullptr)
+      continue;
+    auto value = profile::bind_property(*definition, ref);
+    if (!value)
+      continue; // the loader already refused invalid values
+    out[profile::common_of(*definition).id] = profile::to_json(*value);
+    out[profile::common_of(*definition).label()] = profile::to_json(*value);
+  }
+  return out;
+}
+
+} // namespace
+
+struct DeviceManager::Impl {
+  NodeOptions options;
+  std::shared_ptr<dds::Participant> participant;
+  std::unique_ptr<control::Endpoint> endpoint;
+  std::shared_ptr<const profile::DeviceConfiguration> dcd;
+  profile::ResolvedNode node;
+  std::vector<RunningDevice> devices;
+  std::atomic<bool> stopping{false};
+
+  Expected<void> start_devices(const DeviceRegistry &registry);
+  Json announcement() const;
+  void serve();
+  ExecutableDevice *executable_device(const std::string &id) const;
+  void report_exit(const Json &report);
+};
+
+Expected<void> DeviceManager::Impl::start_devices(const DeviceRegistry &registry) {
+  for (const auto &placed : node.devices) {
+    if (!placed.softpkg)
+      continue;
+    const DeviceFactory *factory = registry.find(placed.softpkg->spd->name);
+    for (const auto &ci : placed.placement->instantiations) {
+      const std::string label = ci.usage_name.empty() ? ci.id : ci.usage_name;
+      const std::string id = fmt::format("{}:{}", dcd->name, label);
+      if (factory == nullptr) {
+        spdlog::warn("device {}: no implementation of {} in this node daemon; skipped", id,
+                     placed.softpkg->spd->name);
+        continue;
+      }
+      DeviceContext context{id,
+                            label,
+                            dcd->name,
+                            placed.softpkg.get(),
+                            overrides_of(ci, *placed.softpkg),
+                            options.exec_path,
+                            options.log_dir,
+                            participant->settings(),
+                            [this](const Json &report) { report_exit(report); }};
+      auto device = (*factory)(context);
+      if (!device)
+        return tl::unexpected(device.error());
+      spdlog::info("device {} ({}) started", id, placed.softpkg->spd->name);
+      devices.push_back({id, label, placed.softpkg->spd->name, std::move(*device)});
+    }
+  }
+  return {};
+}
+
+Json DeviceManager::Impl::announcement() const {
+  Json list = Json::array();
+  for (const auto &d : devices)
+    list.push_back({{"id", d.id},
+                    {"label", d.label},
+                    {"softpkg", d.softpkg},
+                    {"kind", d.device->kind()},
+                    {"properties", d.device->properties()},
+                    {"capacity", d.device->capacity()}});
+  char host[256] = {};
+  gethostname(host, sizeof(host) - 1);
+  return {{"node", dcd->name}, {"pid", static_cast<long>(getpid())}, {"host", host}, {"devices", list}};
+}
+
+ExecutableDevice *DeviceManager::Impl::executable_device(const std::string &id) const {
+  for (const auto &d : devices)
+    if ((id.empty() || d.id == id) && d.executable() != nullptr)
+      return d.executable();
+  return nullptr;
+}
+
+void DeviceManager::Impl::report_exit(const Json &report) {
+  if (stopping.load() || !endpoint)
+    return;
+  spdlog::warn("process {} exited on its own: {}", report.value("pid", 0L), report.value("status", ""));
+  // Fire and forget: the reply is not needed, and the reaper that calls this must not block.
+  endpoint->call(options.domain_name + "/domain", "domain.component_exited", report,
+                 std::chrono::seconds(2));
+}
+
+void DeviceManager::Impl::serve() {
+  endpoint->on("node.execute", [this](const Json &body, const control::RequestContext &) -> CallResult<Json> {
+    ExecutableDevice *device = executable_device(body.value("device", ""));
+    if (device == nullptr)
+      return control::call_error(Status::NotFound,
+                                 fmt::format("node {} has no executable device {}", dcd->name,
+                                             body.value("device", "")));
+    return device->execute(body);
+  });
+  endpoint->on("node.terminate", [this](const Json &body, const control::RequestContext &) -> CallResult<Json> {
+    for (const auto &d : devices) {
+      if (d.executable() == nullptr)
+        continue;
+      auto result = d.executable()->terminate(body);
+      if (result || result.error().status != Status::NotFound)
+        return result;
+    }
+    return control::call_error(Status::NotFound,
+                               fmt::format("node {} did not start process {}", dcd->name, body.value("pid", 0L)));
+  });
+  endpoint->on("node.status", [this](const Json &, const control::RequestContext &) -> CallResult<Json> {
+    Json processes = Json::array();
+    for (const auto &d : devices)
+      if (d.executable() != nullptr)
+        for (const auto &p : d.executable()->processes())
+          processes.push_back(p);
+    Json status = announcement();
+    status["processes"] = processes;
+    return status;
+  });
+}
+
+DeviceManager::DeviceManager(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+
+DeviceManager::~DeviceManager() {
+  impl_->stopping = true;
+  impl_->endpoint->withdraw();
+  impl_->devices.clear(); // terminates whatever the GPP still runs
+  impl_->endpoint.reset();
+}
+
+const std::string &DeviceManager::node_name() const { return impl_->dcd->name; }
+
+Expected<std::unique_ptr<DeviceManager>>
+DeviceManager::create(std::shared_ptr<dds::Participant> participant, NodeOptions options,
+                      const DeviceRegistry &registry) {
+  auto impl = std::make_unique<Impl>();
+  impl->options = std::move(options);
+  impl->participant = participant;
+  profile::ProfileLoader loader(impl->options.sdrroot);
+  auto node = loader.load_node(impl->options.dcd);
+  if (!node)
+    return tl::unexpected(node.error());
+  impl->node = std::move(*node);
+  impl->dcd = impl->node.dcd;
+  auto endpoint = control::Endpoint::open(
+      participant, fmt::format("{}/node/{}", impl->options.domain_name, impl->dcd->name));
+  if (!endpoint)
+    return tl::unexpected(endpoint.error());
+  impl->endpoint = std::move(*endpoint);
+  if (auto ok = impl->start_devices(registry); !ok)
+    return tl::unexpected(ok.error());
+  impl->serve();
+  if (auto ok = impl->endpoint->announce("node", impl->announcement()); !ok)
+    return tl::unexpected(ok.error());
+  spdlog::info("node {} announced with {} device(s)", impl->dcd->name, impl->devices.size());
+  return std::unique_ptr<DeviceManager>(new DeviceManager(std::move(impl)));
+}
+
+} // namespace rsca::node

@@ -1,0 +1,40 @@
+// DeviceManager: the node daemon. Reads its DCD, starts the logical devices it names, announces
+// the node and its devices to the domain, and serves node.execute / node.terminate for its
+// executable devices. It needs no registration protocol: its announcement is durable, so a
+// domain daemon that (re)starts sees it at once.
+#pragma once
+
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "node/logical_device.hpp"
+
+namespace rsca::node {
+
+struct NodeOptions {
+  std::filesystem::path dcd;
+  std::optional<std::filesystem::path> sdrroot;
+  std::string domain_name = "rsca";
+  std::vector<std::filesystem::path> exec_path;
+  std::filesystem::path log_dir = "/tmp/rsca/logs";
+};
+
+class DeviceManager {
+public:
+  static Expected<std::unique_ptr<DeviceManager>> create(std::shared_ptr<dds::Participant> participant,
+                                                         NodeOptions options,
+                                                         const DeviceRegistry &registry);
+  ~DeviceManager();
+
+  const std::string &node_name() const;
+
+  struct Impl;
+
+private:
+  explicit DeviceManager(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+} // namespace rsca::node

@@ -1,0 +1,70 @@
+// The device plugin interface of the DeviceManager: a logical device says what it is (matching
+// properties, capacities) and, if it is an ExecutableDevice such as the GPP, runs processes.
+#pragma once
+
+#include <filesystem>
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "control/endpoint.hpp"
+#include "dds/dds_settings.hpp"
+#include "profile/profile_loader.hpp"
+
+namespace rsca::node {
+
+using control::CallResult;
+using control::Json;
+
+// What a device is given when its node starts it.
+struct DeviceContext {
+  std::string id;    // "<node>:<usage name>"
+  std::string label; // the DCD's usage name
+  std::string node;
+  const profile::ResolvedSoftPkg *softpkg = nullptr;
+  Json overrides;    // the DCD's property values for this device, by property name and id
+  std::vector<std::filesystem::path> exec_path; // where bare entrypoint names are looked for
+  std::filesystem::path log_dir;                // component logs go here
+  dds::DdsSettings dds;                         // what launched processes must join
+  // Reports a process that exited on its own (a crash, for a component). Must not block.
+  std::function<void(const Json &report)> report_exit;
+};
+
+class LogicalDevice {
+public:
+  virtual ~LogicalDevice() = default;
+  virtual std::string kind() const = 0; // "gpp" runs components; "device" is used by them
+  virtual Json properties() const = 0;  // matching properties, by name
+  virtual Json capacity() const = 0;    // total capacities, by name
+};
+
+class ExecutableDevice : public LogicalDevice {
+public:
+  // body: {"application", "component", "entrypoint", "spd_dir", "args": [...]} → {"pid"}
+  virtual CallResult<Json> execute(const Json &body) = 0;
+  // body: {"pid"}; fails with NotFound for a process this device did not start.
+  virtual CallResult<Json> terminate(const Json &body) = 0;
+  virtual Json processes() const = 0;
+};
+
+using DeviceFactory =
+    std::function<Expected<std::unique_ptr<LogicalDevice>>(const DeviceContext &context)>;
+
+// Device implementations by the name of their SPD (softpkg name attribute).
+class DeviceRegistry {
+public:
+  void add(std::string softpkg_name, DeviceFactory factory) {
+    factories_[std::move(softpkg_name)] = std::move(factory);
+  }
+  const DeviceFactory *find(const std::string &softpkg_name) const {
+    auto it = factories_.find(softpkg_name);
+    return it == factories_.end() ? nullptr : &it->second;
+  }
+
+private:
+  std::map<std::string, DeviceFactory> factories_;
+};
+
+} // namespace rsca::node

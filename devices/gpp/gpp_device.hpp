@@ -1,0 +1,42 @@
+// The GPP: the ExecutableDevice of a host. Its matching properties (os_name, processor_name, as
+// REDHAWK's GPP names them) and capacities (CPU and memory) come from the host itself, unless the
+// DCD sets them; it executes component processes, each in its own process group with its own
+// log file, and terminates them with bounded escalation.
+#pragma once
+
+#include <memory>
+
+#include "node/logical_device.hpp"
+#include "process_launcher.hpp"
+
+namespace rsca::gpp {
+
+class GppDevice final : public node::ExecutableDevice {
+public:
+  static Expected<std::unique_ptr<node::LogicalDevice>> create(const node::DeviceContext &context);
+
+  std::string kind() const override { return "gpp"; }
+  node::Json properties() const override { return properties_; }
+  node::Json capacity() const override { return capacity_; }
+  node::CallResult<node::Json> execute(const node::Json &body) override;
+  node::CallResult<node::Json> terminate(const node::Json &body) override;
+  node::Json processes() const override;
+
+  explicit GppDevice(node::DeviceContext context);
+
+private:
+  std::filesystem::path find_executable(const std::string &entrypoint, const std::string &spd_dir) const;
+  void on_exit(ProcessId pid, const ExitStatus &status);
+
+  node::DeviceContext context_;
+  node::Json properties_;
+  node::Json capacity_;
+  std::mutex mutex_;
+  std::map<ProcessId, node::Json> owners_; // pid → {application, component, address}
+  ProcessLauncher launcher_;               // last: destroyed (terminating children) first
+};
+
+// Registers the GPP under its SPD names.
+void register_gpp(node::DeviceRegistry &registry);
+
+} // namespace rsca::gpp

@@ -1,0 +1,67 @@
+// rsca-noded: a node daemon (DeviceManager) with every device this build provides. Runs in the
+// foreground (for systemd and similar supervisors); `rsca domain up` starts it in the background.
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <spdlog/spdlog.h>
+
+#include "common/termination_signals.hpp"
+#include "dds/participant.hpp"
+#include "gpp/gpp_device.hpp"
+#include "node/device_manager.hpp"
+
+namespace {
+
+// The folder this executable is in: a development build keeps the components beside it.
+std::filesystem::path own_folder() {
+  std::error_code ec;
+  auto self = std::filesystem::read_symlink("/proc/self/exe", ec);
+  return ec ? std::filesystem::path() : self.parent_path();
+}
+
+} // namespace
+
+int main(int argc, char **argv) {
+  rsca::TerminationSignals signals; // before any thread exists
+  CLI::App app{"rsca-noded — an rsca node daemon (DeviceManager)"};
+  rsca::node::NodeOptions options;
+  std::string dcd, sdrroot, level = "info";
+  std::vector<std::string> exec_path;
+  std::string log_dir = options.log_dir.string();
+  app.add_option("--dcd", dcd, "The node's DCD")->required()->check(CLI::ExistingFile);
+  app.add_option("--sdrroot", sdrroot, "SDR root of the DCD (default: found from its location)");
+  app.add_option("--domain", options.domain_name, "The domain's name")->capture_default_str();
+  app.add_option("--exec-path", exec_path,
+                 "Folders where component executables named without a path are looked for "
+                 "(default: this program's folder)");
+  app.add_option("--log-dir", log_dir, "Component logs go here")->capture_default_str();
+  app.add_option("--log-level", level, "trace, debug, info, warn, error")->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
+  spdlog::set_level(spdlog::level::from_str(level));
+  spdlog::set_pattern("%Y-%m-%dT%H:%M:%S.%e %^%l%$ noded: %v");
+
+  options.dcd = dcd;
+  if (!sdrroot.empty())
+    options.sdrroot = sdrroot;
+  for (const auto &p : exec_path)
+    options.exec_path.emplace_back(p);
+  if (options.exec_path.empty())
+    options.exec_path.push_back(own_folder());
+  options.log_dir = log_dir;
+
+  rsca::node::DeviceRegistry registry;
+  rsca::gpp::register_gpp(registry);
+  auto participant = rsca::dds::Participant::create(rsca::dds::DdsSettings::from_environment());
+  if (!participant) {
+    spdlog::error("{}", participant.error().to_string());
+    return 1;
+  }
+  auto manager = rsca::node::DeviceManager::create(*participant, options, registry);
+  if (!manager) {
+    spdlog::error("the node cannot start:\n{}", manager.error().to_string());
+    return 1;
+  }
+  const int signal = signals.wait();
+  spdlog::info("signal {} received; stopping node {}", signal, (*manager)->node_name());
+  return 0;
+}

@@ -1,0 +1,302 @@
+// rsca install | uninstall | launch | start | stop | release | configure | query, and show APP.
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <thread>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "commands.hpp"
+#include "domain_client.hpp"
+#include "exit_codes.hpp"
+#include "profile/profile_loader.hpp"
+
+namespace rsca::cli {
+namespace {
+
+namespace fs = std::filesystem;
+using control::Json;
+using namespace std::chrono_literals;
+
+std::string read_text(const fs::path &file) {
+  std::ifstream in(file, std::ios::binary);
+  std::ostringstream out;
+  out << in.rdbuf();
+  return out.str();
+}
+
+// Every file an application needs, as paths relative to its SDR root.
+void collect(const profile::ResolvedSoftPkg &pkg, std::set<fs::path> &files) {
+  if (!files.insert(pkg.spd_path).second)
+    return;
+  if (pkg.properties)
+    files.insert(pkg.properties->file);
+  if (pkg.scd)
+    files.insert(pkg.scd->file);
+  for (const auto &impl : pkg.implementations) {
+    if (impl.properties)
+      files.insert(impl.properties->file);
+    for (const auto &dep : impl.dependencies)
+      collect(*dep.softpkg, files);
+  }
+}
+
+std::optional<fs::path> sdrroot_of(const fs::path &file, const GlobalOptions &global) {
+  if (!global.sdrroot.empty())
+    return fs::absolute(global.sdrroot);
+  if (auto root = profile::SdrRoot::find_for(file))
+    return root->path();
+  return std::nullopt;
+}
+
+// The install request for a SAD: the application's files, read here and carried to the domain,
+// so that the CLI may run on another host than the domain daemon.
+Expected<Json> install_request(const fs::path &sad, const GlobalOptions &global, const std::string &name) {
+  auto root = sdrroot_of(sad, global);
+  if (!root)
+    return make_error({sad.string(), 0, 0}, "sdrroot",
+                      "no SDR root found: no folder above this file holds dom/ or dev/ (give --sdrroot)");
+  profile::ProfileLoader loader(*root);
+  auto app = loader.load_application(sad);
+  if (!app)
+    return tl::unexpected(app.error());
+  std::set<fs::path> files{app->sad_path};
+  for (const auto &[id, pkg] : app->component_files)
+    collect(*pkg, files);
+  Json list = Json::array();
+  for (const auto &f : files)
+    list.push_back({{"path", fs::path(f).lexically_relative(*root).string()}, {"content", read_text(f)}});
+  Json request{{"sad", app->sad_path.lexically_relative(*root).string()}, {"files", list}};
+  if (!name.empty())
+    request["name"] = name;
+  return request;
+}
+
+int install(const std::string &sad, const std::string &name, const GlobalOptions &global,
+            std::string *installed_name = nullptr) {
+  auto request = install_request(sad, global, name);
+  if (!request) {
+    fmt::print(stderr, "rsca install: {}\n", request.error().to_string());
+    return kInvalidProfile;
+  }
+  auto client = DomainClient::connect(global);
+  if (!client) {
+    fmt::print(stderr, "rsca install: {}\n", client.error().to_string());
+    return kFailed;
+  }
+  auto reply = client->call("domain.install", *request, std::chrono::milliseconds(global.timeout_ms) * 2);
+  if (!reply)
+    return report_failure(global, "install", reply.error());
+  if (installed_name != nullptr)
+    *installed_name = reply->at("name").get<std::string>();
+  if (global.json && installed_name == nullptr)
+    print_json(*reply);
+  else if (!global.json)
+    fmt::print("installed {} ({} files)\n", reply->at("name").get<std::string>(), (*request)["files"].size());
+  return kOk;
+}
+
+// Prints each launch step as the domain completes it, while the launch runs.
+void follow_progress(const DomainClient &client, const std::string &launch_id,
+                     std::future<control::CallResult<Json>> &launch) {
+  std::size_t shown = 0;
+  for (;;) {
+    const bool finished = launch.wait_for(50ms) == std::future_status::ready;
+    auto progress = client.call("app.progress", Json{{"launch_id", launch_id}}, 2s);
+    if (progress) {
+      const auto &steps = progress->at("steps");
+      for (; shown < steps.size(); ++shown) {
+        const auto &s = steps[shown];
+        const bool failed = s.value("detail", "") == "failed";
+        fmt::print("  {} {:<10} {:>8.1f} ms  {}\n", failed ? "x" : "+", s.value("step", ""),
+                   s.value("ms", 0.0), failed ? "" : s.value("detail", ""));
+      }
+    }
+    if (finished)
+      return;
+  }
+}
+
+int launch(const std::string &what, const std::string &name, bool no_start,
+           const std::vector<std::string> &assignments, const GlobalOptions &global) {
+  std::string application = what;
+  if (fs::is_regular_file(what)) {
+    if (int rc = install(what, "", global, &application); rc != kOk)
+      return rc;
+  }
+  Json assign = Json::object();
+  for (const auto &a : assignments) {
+    auto eq = a.find('=');
+    if (eq == std::string::npos) {
+      fmt::print(stderr, "rsca launch: --assign takes COMPONENT=DEVICE, not \"{}\"\n", a);
+      return kUsage;
+    }
+    assign[a.substr(0, eq)] = a.substr(eq + 1);
+  }
+  auto client = DomainClient::connect(global);
+  if (!client) {
+    fmt::print(stderr, "rsca launch: {}\n", client.error().to_string());
+    return kFailed;
+  }
+  const std::string launch_id = fmt::format("{}-{}", getpid(), std::chrono::steady_clock::now().time_since_epoch().count());
+  Json request{{"application", application}, {"start", !no_start}, {"assign", assign}, {"launch_id", launch_id}};
+  if (!name.empty())
+    request["name"] = name;
+  const bool show_progress = !global.json && isatty(STDOUT_FILENO);
+  if (show_progress)
+    fmt::print("launching {}\n", application);
+  auto future = client->call_async("app.create", request, std::chrono::milliseconds(global.timeout_ms) * 6);
+  if (show_progress)
+    follow_progress(*client, launch_id, future);
+  auto reply = future.get();
+  if (!reply)
+    return report_failure(global, "launch", reply.error());
+  if (global.json) {
+    print_json(*reply);
+    return kOk;
+  }
+  fmt::print("{} {} ({} components)\n", no_start ? "created" : "launched", reply->at("name").get<std::string>(),
+             reply->at("components").size());
+  return kOk;
+}
+
+int simple_call(const char *what, const std::string &operation, Json body, const GlobalOptions &global,
+                const std::function<void(const Json &)> &print_text) {
+  auto client = DomainClient::connect(global);
+  if (!client) {
+    fmt::print(stderr, "rsca {}: {}\n", what, client.error().to_string());
+    return kFailed;
+  }
+  auto reply = client->call(operation, std::move(body), std::chrono::milliseconds(global.timeout_ms) * 2);
+  if (!reply)
+    return report_failure(global, what, reply.error());
+  if (global.json)
+    print_json(*reply);
+  else
+    print_text(*reply);
+  return kOk;
+}
+
+// APP or APP/COMPONENT
+std::pair<std::string, std::string> split_target(const std::string &target) {
+  auto slash = target.find('/');
+  if (slash == std::string::npos)
+    return {target, ""};
+  return {target.substr(0, slash), target.substr(slash + 1)};
+}
+
+// prop=value arguments; values are sent as text and typed by the domain against the PRF.
+std::optional<Json> parse_assignments(const std::vector<std::string> &args) {
+  Json values = Json::object();
+  for (const auto &a : args) {
+    auto eq = a.find('=');
+    if (eq == std::string::npos || eq == 0)
+      return std::nullopt;
+    values[a.substr(0, eq)] = a.substr(eq + 1);
+  }
+  return values;
+}
+
+std::string scalar_text(const Json &v) { return v.is_string() ? v.get<std::string>() : v.dump(); }
+
+} // namespace
+
+int show_application(const std::string &name, const GlobalOptions &global) {
+  return simple_call("show", "app.show", Json{{"app", name}}, global, [](const Json &app) {
+    fmt::print("application {} ({}) {}\n", app.value("name", ""), app.value("installed", ""),
+               app.value("state", ""));
+    fmt::print("  components:\n");
+    for (const auto &c : app.at("components"))
+      fmt::print("    {:<20} {:<16} pid {:<8} {}{}\n", c.value("id", ""), c.value("device", ""),
+                 c.value("pid", 0L), c.value("state", ""),
+                 c.value("assembly_controller", false) ? "  (assembly controller)" : "");
+    if (!app.at("connections").empty())
+      fmt::print("  connections:\n");
+    for (const auto &c : app.at("connections"))
+      fmt::print("    {:<16} {} -> {}  [{}]\n", c.value("id", ""), c.value("uses", ""),
+                 c.value("provides", ""), c.value("topic", ""));
+  });
+}
+
+void add_application_commands(CLI::App &app, const GlobalOptions &global, int &exit_code) {
+  auto *install_cmd = app.add_subcommand("install", "Install an application (its SAD and every profile it names) in the domain");
+  auto sad = std::make_shared<std::string>();
+  auto name = std::make_shared<std::string>();
+  install_cmd->add_option("sad", *sad, "The application's SAD")->required()->check(CLI::ExistingFile);
+  install_cmd->add_option("--name", *name, "Install under this name (default: the SAD's name)");
+  install_cmd->callback([=, &global, &exit_code] { exit_code = install(*sad, *name, global); });
+
+  auto *uninstall_cmd = app.add_subcommand("uninstall", "Remove an installed application");
+  auto installed = std::make_shared<std::string>();
+  uninstall_cmd->add_option("name", *installed, "Installed application")->required();
+  uninstall_cmd->callback([=, &global, &exit_code] {
+    exit_code = simple_call("uninstall", "domain.uninstall", Json{{"name", *installed}}, global,
+                            [](const Json &r) { fmt::print("uninstalled {}\n", r.value("name", "")); });
+  });
+
+  auto *launch_cmd = app.add_subcommand("launch", "Create (and start) an application from a SAD or an installed name");
+  auto what = std::make_shared<std::string>();
+  auto instance = std::make_shared<std::string>();
+  auto no_start = std::make_shared<bool>(false);
+  auto assign = std::make_shared<std::vector<std::string>>();
+  launch_cmd->add_option("application", *what, "SAD file or installed application name")->required();
+  launch_cmd->add_option("--name", *instance, "Name of the running application");
+  launch_cmd->add_flag("--no-start", *no_start, "Create and connect, but do not start");
+  launch_cmd->add_option("--assign", *assign, "Place a component on a device: COMPONENT=DEVICE (repeatable)");
+  launch_cmd->callback([=, &global, &exit_code] {
+    exit_code = launch(*what, *instance, *no_start, *assign, global);
+  });
+
+  for (const auto &[verb, op, help] :
+       {std::tuple{"start", "app.start", "Start a created or stopped application"},
+        std::tuple{"stop", "app.stop", "Stop a running application"},
+        std::tuple{"release", "app.release", "Tear an application down: its processes, connections and allocations"}}) {
+    auto *cmd = app.add_subcommand(verb, help);
+    auto target = std::make_shared<std::string>();
+    cmd->add_option("app", *target, "Running application")->required();
+    cmd->callback([=, verb = std::string(verb), op = std::string(op), &global, &exit_code] {
+      exit_code = simple_call(verb.c_str(), op, Json{{"app", *target}}, global,
+                              [verb](const Json &r) { fmt::print("{}: {}\n", verb, r.value("name", "")); });
+    });
+  }
+
+  auto *configure_cmd = app.add_subcommand("configure", "Set properties of an application's assembly controller or one component");
+  auto configure_target = std::make_shared<std::string>();
+  auto assignments = std::make_shared<std::vector<std::string>>();
+  configure_cmd->add_option("target", *configure_target, "APP or APP/COMPONENT")->required();
+  configure_cmd->add_option("values", *assignments, "property=value ...")->required();
+  configure_cmd->callback([=, &global, &exit_code] {
+    auto values = parse_assignments(*assignments);
+    if (!values) {
+      fmt::print(stderr, "rsca configure: give properties as property=value\n");
+      exit_code = kUsage;
+      return;
+    }
+    auto [app_name, component] = split_target(*configure_target);
+    exit_code = simple_call("configure", "app.configure",
+                            Json{{"app", app_name}, {"component", component}, {"values", *values}}, global,
+                            [](const Json &) { fmt::print("configured\n"); });
+  });
+
+  auto *query_cmd = app.add_subcommand("query", "Read properties of an application's assembly controller or one component");
+  auto query_target = std::make_shared<std::string>();
+  auto ids = std::make_shared<std::vector<std::string>>();
+  query_cmd->add_option("target", *query_target, "APP or APP/COMPONENT")->required();
+  query_cmd->add_option("properties", *ids, "Property ids (default: all)");
+  query_cmd->callback([=, &global, &exit_code] {
+    auto [app_name, component] = split_target(*query_target);
+    exit_code = simple_call("query", "app.query",
+                            Json{{"app", app_name}, {"component", component}, {"ids", *ids}}, global,
+                            [](const Json &r) {
+                              const Json properties = r.value("properties", Json::object());
+                              for (const auto &[id, value] : properties.items())
+                                fmt::print("{} = {}\n", id, scalar_text(value));
+                            });
+  });
+}
+
+} // namespace rsca::cli

@@ -1,0 +1,80 @@
+#include "domain_client.hpp"
+
+#include <unistd.h>
+
+#include <atomic>
+#include <iostream>
+
+#include <fmt/format.h>
+
+#include "commands.hpp"
+#include "exit_codes.hpp"
+
+namespace rsca::cli {
+
+Expected<DomainClient> DomainClient::connect(const GlobalOptions &global) {
+  auto settings = dds::DdsSettings::from_environment();
+  settings.trace = "none";
+  auto participant = dds::Participant::create(settings);
+  if (!participant)
+    return tl::unexpected(participant.error());
+  char host[128] = {};
+  gethostname(host, sizeof(host) - 1);
+  static std::atomic<int> counter{0};
+  const std::string address = fmt::format("{}/cli/{}-{}-{}", global.domain, host, getpid(), ++counter);
+  auto endpoint = control::Endpoint::open(*participant, address, {.workers = 1, .on_announcement = {}});
+  if (!endpoint)
+    return tl::unexpected(endpoint.error());
+  DomainClient client;
+  client.participant_ = *participant;
+  client.endpoint_ = std::move(*endpoint);
+  client.domain_ = global.domain;
+  return client;
+}
+
+std::future<control::CallResult<control::Json>>
+DomainClient::call_async(const std::string &operation, control::Json body,
+                         std::chrono::milliseconds timeout) const {
+  return endpoint_->call(domain_ + "/domain", operation, std::move(body), timeout);
+}
+
+control::CallResult<control::Json> DomainClient::call(const std::string &operation, control::Json body,
+                                                      std::chrono::milliseconds timeout) const {
+  return call_async(operation, std::move(body), timeout).get();
+}
+
+int exit_code_of(control::Status status) {
+  switch (status) {
+  case control::Status::Ok:
+    return kOk;
+  case control::Status::BadRequest:
+    return kInvalidProfile;
+  case control::Status::NotFound:
+    return kNotFound;
+  case control::Status::Timeout:
+  case control::Status::Unavailable:
+    return kUnreachable;
+  case control::Status::Rejected:
+    return kRejected;
+  case control::Status::Failed:
+    break;
+  }
+  return kFailed;
+}
+
+int report_failure(const GlobalOptions &global, const std::string &what, const control::CallError &error) {
+  std::string message = error.message;
+  if (error.status == control::Status::Unavailable || error.status == control::Status::Timeout)
+    message += fmt::format(" (is the domain \"{}\" up on DDS domain {}? see `rsca domain up`)", global.domain,
+                           dds::DdsSettings::from_environment().domain_id);
+  if (global.json) {
+    print_json({{"error", {{"status", control::to_string(error.status)}, {"message", message}}}});
+  } else {
+    fmt::print(stderr, "rsca {}: {}\n", what, message);
+  }
+  return exit_code_of(error.status);
+}
+
+void print_json(const control::Json &value) { std::cout << value.dump(2) << '\n'; }
+
+} // namespace rsca::cli

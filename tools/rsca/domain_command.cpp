@@ -1,0 +1,251 @@
+// rsca domain up|down: a local domain daemon and N node daemons in the background, with their
+// logs and pid files in a run folder.
+#include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#include <fmt/format.h>
+
+#include "commands.hpp"
+#include "domain_client.hpp"
+#include "exit_codes.hpp"
+
+extern char **environ;
+
+namespace rsca::cli {
+namespace {
+
+namespace fs = std::filesystem;
+using control::Json;
+using namespace std::chrono_literals;
+
+fs::path own_folder() {
+  std::error_code ec;
+  auto self = fs::read_symlink("/proc/self/exe", ec);
+  return ec ? fs::path() : self.parent_path();
+}
+
+fs::path default_run_dir() {
+  if (const char *dir = std::getenv("RSCA_RUN_DIR"); dir != nullptr && *dir != '\0')
+    return dir;
+  return fs::temp_directory_path() /
+         fmt::format("rsca-{}-{}", getuid(), dds::DdsSettings::from_environment().domain_id);
+}
+
+fs::path default_sdrroot(const GlobalOptions &global) {
+  if (!global.sdrroot.empty())
+    return fs::absolute(global.sdrroot);
+  if (const char *dir = std::getenv("RSCA_SDRROOT"); dir != nullptr && *dir != '\0')
+    return dir;
+  return (own_folder() / "../../profiles").lexically_normal();
+}
+
+bool alive(pid_t pid) { return pid > 0 && ::kill(pid, 0) == 0; }
+
+std::optional<pid_t> read_pid(const fs::path &file) {
+  std::ifstream in(file);
+  pid_t pid = 0;
+  if (in >> pid)
+    return pid;
+  return std::nullopt;
+}
+
+// Starts a daemon in its own session (so the terminal's Ctrl-C does not reach it), with stdout
+// and stderr in `log`, and records its pid in `pid_file`.
+Expected<pid_t> spawn_daemon(const fs::path &program, const std::vector<std::string> &args,
+                             const fs::path &log, const fs::path &pid_file) {
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
+  posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
+  posix_spawnattr_t attributes;
+  posix_spawnattr_init(&attributes);
+  posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETSID);
+  std::vector<std::string> argv_strings{program.string()};
+  argv_strings.insert(argv_strings.end(), args.begin(), args.end());
+  std::vector<char *> argv;
+  for (auto &a : argv_strings)
+    argv.push_back(a.data());
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  const int rc = posix_spawn(&pid, program.c_str(), &actions, &attributes, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  posix_spawnattr_destroy(&attributes);
+  if (rc != 0)
+    return make_error({program.string(), 0, 0}, "spawn", std::strerror(rc));
+  std::ofstream(pid_file) << pid << '\n';
+  return pid;
+}
+
+// Waits for a process to exit, without polling by sleeping: a pidfd becomes readable at exit.
+bool wait_exit(pid_t pid, std::chrono::milliseconds timeout) {
+  const int fd = static_cast<int>(::syscall(SYS_pidfd_open, pid, 0));
+  if (fd < 0)
+    return !alive(pid);
+  pollfd p{fd, POLLIN, 0};
+  const int ready = ::poll(&p, 1, static_cast<int>(timeout.count()));
+  ::close(fd);
+  return ready > 0 || !alive(pid);
+}
+
+std::string tail(const fs::path &log, std::size_t lines = 8) {
+  std::ifstream in(log);
+  std::vector<std::string> all;
+  for (std::string line; std::getline(in, line);)
+    all.push_back(line);
+  std::string out;
+  for (std::size_t i = all.size() > lines ? all.size() - lines : 0; i < all.size(); ++i)
+    out += "    " + all[i] + "\n";
+  return out;
+}
+
+// The DCD of node i: the SDR root's own nodeI if it has one, else one made in the run folder
+// from node1's, in an SDR root that links the real devices.
+Expected<fs::path> node_dcd(int i, const fs::path &sdrroot, const fs::path &run) {
+  const fs::path own = sdrroot / fmt::format("dev/nodes/node{}/DeviceManager.dcd.xml", i);
+  if (fs::is_regular_file(own))
+    return own;
+  const fs::path templ = sdrroot / "dev/nodes/node1/DeviceManager.dcd.xml";
+  if (!fs::is_regular_file(templ))
+    return make_error({templ.string(), 0, 0}, "missing-file", "no node DCD to make more nodes from");
+  const fs::path sdr = run / "sdr";
+  std::error_code ec;
+  fs::create_directories(sdr / "dev/nodes", ec);
+  for (const char *shared : {"dev/devices", "dev/mgr"})
+    if (!fs::exists(sdr / shared))
+      fs::create_directory_symlink(sdrroot / shared, sdr / shared, ec);
+  std::ifstream in(templ);
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string dcd = text.str();
+  const std::string from = "node1", to = fmt::format("node{}", i);
+  for (auto at = dcd.find(from); at != std::string::npos; at = dcd.find(from, at + to.size()))
+    dcd.replace(at, from.size(), to);
+  const fs::path out = sdr / fmt::format("dev/nodes/node{}/DeviceManager.dcd.xml", i);
+  fs::create_directories(out.parent_path(), ec);
+  std::ofstream(out) << dcd;
+  return out;
+}
+
+int up(int nodes, const fs::path &run, const GlobalOptions &global) {
+  std::error_code ec;
+  fs::create_directories(run / "logs", ec);
+  if (auto pid = read_pid(run / "domaind.pid"); pid && alive(*pid)) {
+    fmt::print(stderr, "rsca domain up: a domain is already up in {} (domaind pid {}); `rsca domain down` first\n",
+               run.string(), *pid);
+    return kRejected;
+  }
+  const fs::path bin = own_folder();
+  const fs::path sdrroot = default_sdrroot(global);
+  auto domaind = spawn_daemon(bin / "rsca-domaind",
+                              {"--dmd", (sdrroot / "dom/domain/DomainManager.dmd.xml").string(),
+                               "--repository", (run / "repository").string()},
+                              run / "domaind.log", run / "domaind.pid");
+  if (!domaind) {
+    fmt::print(stderr, "rsca domain up: {}\n", domaind.error().to_string());
+    return kFailed;
+  }
+  std::vector<std::pair<pid_t, fs::path>> started{{*domaind, run / "domaind.log"}};
+  for (int i = 1; i <= nodes; ++i) {
+    auto dcd = node_dcd(i, sdrroot, run);
+    if (!dcd) {
+      fmt::print(stderr, "rsca domain up: {}\n", dcd.error().to_string());
+      return kFailed;
+    }
+    const fs::path log = run / fmt::format("node{}.log", i);
+    auto pid = spawn_daemon(bin / "rsca-noded",
+                            {"--dcd", dcd->string(), "--domain", global.domain, "--log-dir",
+                             (run / "logs").string(), "--exec-path", bin.string()},
+                            log, run / fmt::format("node{}.pid", i));
+    if (!pid) {
+      fmt::print(stderr, "rsca domain up: {}\n", pid.error().to_string());
+      return kFailed;
+    }
+    started.emplace_back(*pid, log);
+  }
+  auto client = DomainClient::connect(global);
+  if (!client) {
+    fmt::print(stderr, "rsca domain up: {}\n", client.error().to_string());
+    return kFailed;
+  }
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(global.timeout_ms) * 4;
+  Json reply;
+  for (;;) {
+    for (const auto &[pid, log] : started)
+      if (!alive(pid)) {
+        fmt::print(stderr, "rsca domain up: a daemon (pid {}) stopped; its log ends:\n{}", pid, tail(log));
+        return kFailed;
+      }
+    auto listed = client->call("domain.nodes", Json::object(), 1s);
+    if (listed && listed->at("nodes").size() >= static_cast<std::size_t>(nodes)) {
+      reply = *listed;
+      break;
+    }
+    if (std::chrono::steady_clock::now() > deadline) {
+      fmt::print(stderr, "rsca domain up: the nodes did not all register in time (see {})\n", run.string());
+      return kUnreachable;
+    }
+    std::this_thread::sleep_for(50ms); // pacing a poll of the domain, not a wait for a condition
+  }
+  if (global.json) {
+    reply["run_dir"] = run.string();
+    print_json(reply);
+  } else {
+    fmt::print("domain {} up: domaind pid {}, {} node(s); logs in {}\n", global.domain, *domaind, nodes, run.string());
+  }
+  return kOk;
+}
+
+int down(const fs::path &run, const GlobalOptions &global) {
+  std::vector<fs::path> pid_files;
+  for (const auto &e : fs::directory_iterator(run, std::filesystem::directory_options::skip_permission_denied))
+    if (e.path().extension() == ".pid" && e.path().filename() != "domaind.pid")
+      pid_files.push_back(e.path());
+  pid_files.push_back(run / "domaind.pid"); // nodes first: they stop their components
+  int stopped = 0;
+  for (const auto &file : pid_files) {
+    auto pid = read_pid(file);
+    if (pid && alive(*pid)) {
+      ::kill(*pid, SIGTERM);
+      if (!wait_exit(*pid, 5s)) {
+        ::kill(*pid, SIGKILL);
+        wait_exit(*pid, 2s);
+      }
+      ++stopped;
+    }
+    std::error_code ec;
+    fs::remove(file, ec);
+  }
+  if (global.json)
+    print_json({{"stopped", stopped}, {"run_dir", run.string()}});
+  else
+    fmt::print("domain down: {} daemon(s) stopped\n", stopped);
+  return kOk;
+}
+
+} // namespace
+
+void add_domain_command(CLI::App &app, const GlobalOptions &global, int &exit_code) {
+  auto *domain = app.add_subcommand("domain", "Start or stop a local domain (daemons in the background)");
+  domain->require_subcommand(1);
+  auto run = std::make_shared<std::string>(default_run_dir().string());
+  auto nodes = std::make_shared<int>(2);
+  auto *up_cmd = domain->add_subcommand("up", "Start a domain daemon and N node daemons; return when all are registered");
+  up_cmd->add_option("--nodes", *nodes, "How many node daemons")->capture_default_str()->check(CLI::Range(1, 100));
+  up_cmd->add_option("--run-dir", *run, "Logs and pid files go here")->capture_default_str();
+  up_cmd->callback([=, &global, &exit_code] { exit_code = up(*nodes, *run, global); });
+  auto *down_cmd = domain->add_subcommand("down", "Stop the daemons started by `rsca domain up`");
+  down_cmd->add_option("--run-dir", *run, "Where `domain up` put its pid files")->capture_default_str();
+  down_cmd->callback([=, &global, &exit_code] { exit_code = down(*run, global); });
+}
+
+} // namespace rsca::cli
