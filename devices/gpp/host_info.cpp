@@ -68,7 +68,9 @@ tl::unexpected<Error> host_error(std::string file, std::string message) {
   return make_error({std::move(file), 0, 0}, "host-info", std::move(message));
 }
 
-std::string to_string(const char *text) { return text == nullptr ? std::string{} : text; }
+std::string to_string(const char *text) {
+  return text == nullptr ? std::string{} : text;
+}
 
 // Closes the descriptor it holds, if any, when it goes.
 struct FileDescriptor {

@@ -68,7 +68,9 @@ private:
 };
 
 // A pidfd (close-on-exec): readable once the process has exited.
-Fd open_pidfd(pid_t pid) { return Fd{static_cast<int>(::syscall(SYS_pidfd_open, pid, 0))}; }
+Fd open_pidfd(pid_t pid) {
+  return Fd{static_cast<int>(::syscall(SYS_pidfd_open, pid, 0))};
+}
 
 std::string errno_text(int error) {
   switch (error) {
@@ -162,8 +164,8 @@ Expected<Fd> open_log(const ExecRequest &request) {
   }
   Fd log{::open(path.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC | O_NOCTTY, 0644)};
   if (!log) {
-    return launch_error(request,
-                        fmt::format("cannot open log file {}: {}", path.string(), errno_text(errno)));
+    return launch_error(
+        request, fmt::format("cannot open log file {}: {}", path.string(), errno_text(errno)));
   }
   if (log.get() <= STDERR_FILENO) { // this process runs with a standard stream closed
     log = Fd{::fcntl(log.get(), F_DUPFD_CLOEXEC, STDERR_FILENO + 1)};
@@ -200,7 +202,8 @@ private:
 // stdin from /dev/null, stdout and stderr to the log, the working directory, and no other
 // descriptor of this process, whether close-on-exec or not. Returns 0 or an errno value.
 int prepare_files(SpawnActions &actions, const ExecRequest &request, int log_fd) {
-  int rc = ::posix_spawn_file_actions_addopen(actions.get(), STDIN_FILENO, "/dev/null", O_RDONLY, 0);
+  int rc =
+      ::posix_spawn_file_actions_addopen(actions.get(), STDIN_FILENO, "/dev/null", O_RDONLY, 0);
   if (rc == 0 && log_fd >= 0) {
     rc = ::posix_spawn_file_actions_adddup2(actions.get(), log_fd, STDOUT_FILENO);
   }
@@ -237,7 +240,9 @@ int prepare_attributes(SpawnAttributes &attributes) {
   return rc;
 }
 
-std::string_view variable_name(std::string_view entry) { return entry.substr(0, entry.find('=')); }
+std::string_view variable_name(std::string_view entry) {
+  return entry.substr(0, entry.find('='));
+}
 
 // This process's environment with the request's variables added; the last value of a name wins.
 std::vector<std::string> child_environment(const ExecRequest &request) {
@@ -252,8 +257,9 @@ std::vector<std::string> child_environment(const ExecRequest &request) {
     }
   }
   for (auto it = request.env.begin(); it != request.env.end(); ++it) {
-    const auto later = std::find_if(std::next(it), request.env.end(),
-                                    [&](const auto &variable) { return variable.first == it->first; });
+    const auto later = std::find_if(std::next(it), request.env.end(), [&](const auto &variable) {
+      return variable.first == it->first;
+    });
     if (later == request.env.end()) {
       entries.push_back(it->first + "=" + it->second);
     }
@@ -299,8 +305,8 @@ Expected<pid_t> spawn(const ExecRequest &request, int log_fd) {
   rc = ::posix_spawn(&pid, request.executable.c_str(), actions.get(), attributes.get(), argv.data(),
                      envp.data());
   if (rc != 0) {
-    return launch_error(request, fmt::format("cannot execute {}: {}", request.executable.string(),
-                                             errno_text(rc)));
+    return launch_error(
+        request, fmt::format("cannot execute {}: {}", request.executable.string(), errno_text(rc)));
   }
   return pid;
 }
@@ -361,7 +367,9 @@ std::vector<GroupMember> scan_group(pid_t group) {
   return members;
 }
 
-bool group_exists(pid_t group) { return ::kill(-group, 0) == 0 || errno == EPERM; }
+bool group_exists(pid_t group) {
+  return ::kill(-group, 0) == 0 || errno == EPERM;
+}
 
 ExitStatus exit_status(const siginfo_t &info) {
   ExitStatus status;
@@ -395,8 +403,8 @@ struct Member {
 struct Record {
   std::uint64_t serial = 0; // tells a record from a later one for a reused pid
   ProcessInfo info;
-  Fd pidfd;                     // the leader's, until it is reaped
-  std::vector<Member> members;  // the rest of the group once the leader has exited
+  Fd pidfd;                    // the leader's, until it is reaped
+  std::vector<Member> members; // the rest of the group once the leader has exited
   bool terminate_requested = false;
   int last_signal = 0;
   bool leftovers_killed = false;
@@ -473,8 +481,9 @@ void reap(Record &record, std::vector<PendingExit> &exits) {
 void watch_members(Record &record, const std::vector<GroupMember> &found) {
   std::vector<Member> watched;
   for (const auto &process : found) {
-    const auto known = std::find_if(record.members.begin(), record.members.end(),
-                                    [&](const Member &member) { return member.pid == process.pid; });
+    const auto known =
+        std::find_if(record.members.begin(), record.members.end(),
+                     [&](const Member &member) { return member.pid == process.pid; });
     if (known != record.members.end() && (!known->exited || process.dead)) {
       watched.push_back(std::move(*known));
       continue;
@@ -493,8 +502,8 @@ void kill_leftovers(Record &record) {
   if (!alive || record.terminate_requested || record.leftovers_killed) {
     return;
   }
-  spdlog::warn("{} (pid {}) exited leaving processes in its group: killing them",
-               record.info.label, record.info.pid);
+  spdlog::warn("{} (pid {}) exited leaving processes in its group: killing them", record.info.label,
+               record.info.pid);
   ::kill(-record.info.pid, SIGKILL);
   record.leftovers_killed = true;
 }

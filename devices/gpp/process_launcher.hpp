@@ -71,8 +71,8 @@ struct ProcessInfo {
   std::filesystem::path executable;
   std::chrono::system_clock::time_point started_at;
   std::filesystem::path log_file;
-  bool running = false;            // the process itself has not exited yet
-  std::optional<ExitStatus> exit;  // set once it has exited and been reaped
+  bool running = false;           // the process itself has not exited yet
+  std::optional<ExitStatus> exit; // set once it has exited and been reaped
 };
 
 struct TerminateOptions {

@@ -256,8 +256,8 @@ TEST_CASE("SPD: Producer and Consumer packages", "[descriptors][spd]") {
   CHECK(cpp.description == "C++ implementation.");
   CHECK(cpp.code.type == CodeType::Executable);
   CHECK(to_string(cpp.code.type) == "Executable");
-  CHECK(cpp.code.file.name == "bin/rsca-producer");
-  CHECK(cpp.code.entrypoint == "bin/rsca-producer");
+  CHECK(cpp.code.file.name == "rsca-producer");
+  CHECK(cpp.code.entrypoint == "rsca-producer");
   CHECK(cpp.programming_language == "C++");
   CHECK(cpp.human_language == "EN");
   REQUIRE(cpp.os.size() == 1);
@@ -279,7 +279,7 @@ TEST_CASE("SPD: Producer and Consumer packages", "[descriptors][spd]") {
   const auto consumer = read<SoftPkg>(kConsumer / "Consumer.spd.xml");
   CHECK(consumer.name == "Consumer");
   REQUIRE(consumer.implementations.size() == 1);
-  CHECK(consumer.implementations[0].code.file.name == "bin/rsca-consumer");
+  CHECK(consumer.implementations[0].code.file.name == "rsca-consumer");
   CHECK(consumer.implementations[0].resource_demand->memory_bytes == 33'554'432u);
 
   // The GPP device package declares no demand of its own.
@@ -388,7 +388,7 @@ TEST_CASE("PRF: Producer's simples and struct", "[descriptors][prf]") {
   const auto &payload = definition<SimpleProperty>(prf, "payload_size");
   CHECK(payload.type.type == SimpleType::ULong);
   CHECK(as<std::uint32_t>(payload.value) == 64u);
-  CHECK(payload.units == "bytes");
+  CHECK(payload.units == "samples");
   CHECK_FALSE(payload.range.has_value());
 
   const auto &message = definition<SimpleProperty>(prf, "message");

@@ -89,7 +89,8 @@ TEST_CASE("CPU utilisation is the busy share of the time between two samples", "
 }
 
 TEST_CASE("the CPU load sampler measures between consecutive samples", "[host]") {
-  const auto file = fs::temp_directory_path() / ("rsca_host_info_stat_" + std::to_string(::getpid()));
+  const auto file =
+      fs::temp_directory_path() / ("rsca_host_info_stat_" + std::to_string(::getpid()));
   const auto write = [&](std::uint64_t user, std::uint64_t idle) {
     std::ofstream(file, std::ios::trunc) << proc_stat(user, idle);
   };
@@ -98,8 +99,8 @@ TEST_CASE("the CPU load sampler measures between consecutive samples", "[host]")
   write(130, 970); // 30 busy of 100
   CHECK(sampler.sample() == Approx(0.3));
   CHECK_FALSE(sampler.sample().has_value()); // no tick since
-  write(230, 970); // 100 busy of 100
-  CHECK(sampler.sample() == Approx(1.0));
+  write(230, 970);
+  CHECK(sampler.sample() == Approx(1.0)); // 100 busy of 100
   fs::remove(file);
   CHECK_FALSE(sampler.sample().has_value());
 }

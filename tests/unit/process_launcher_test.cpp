@@ -114,7 +114,8 @@ public:
         buffer_.erase(0, newline + 1);
         return line;
       }
-      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
+      const auto left =
+          std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
       pollfd pfd{fd_, POLLIN, 0};
       if (left <= 0ms || ::poll(&pfd, 1, static_cast<int>(left.count())) <= 0) {
         return std::nullopt;
@@ -144,9 +145,13 @@ std::string slurp(const fs::path &path) {
 }
 
 // Exists in /proc: running, or a zombie nobody has reaped.
-bool process_exists(pid_t pid) { return fs::exists(fs::path("/proc") / std::to_string(pid)); }
+bool process_exists(pid_t pid) {
+  return fs::exists(fs::path("/proc") / std::to_string(pid));
+}
 
-bool group_exists(pid_t group) { return ::kill(-group, 0) == 0 || errno != ESRCH; }
+bool group_exists(pid_t group) {
+  return ::kill(-group, 0) == 0 || errno != ESRCH;
+}
 
 std::optional<char> process_state(pid_t pid) {
   const auto text = rsca::gpp::read_proc_file(fs::path("/proc") / std::to_string(pid) / "stat");
@@ -316,8 +321,8 @@ TEST_CASE("what cannot be executed is an error and starts nothing", "[process]")
 
   auto bad_directory = shell("exit 0");
   bad_directory.working_dir = dir.path() / "missing";
-  CHECK(error_of(bad_directory) ==
-        "cannot use working directory " + bad_directory.working_dir.string() + ": no such directory");
+  CHECK(error_of(bad_directory) == "cannot use working directory " +
+                                       bad_directory.working_dir.string() + ": no such directory");
 
   auto bad_variable = shell("exit 0");
   bad_variable.env = {{"A=B", "c"}};
@@ -366,7 +371,8 @@ TEST_CASE("terminate kills a process that ignores SIGINT and SIGTERM", "[process
   REQUIRE(fifo.read_line(10s) == "ready");
 
   const auto start = Clock::now();
-  const TerminateOptions options{.grace_sigint = 200ms, .grace_sigterm = 200ms, .grace_sigkill = 2s};
+  const TerminateOptions options{
+      .grace_sigint = 200ms, .grace_sigterm = 200ms, .grace_sigkill = 2s};
   REQUIRE(launcher.terminate(pid, options).has_value());
   const auto elapsed = Clock::now() - start;
   CHECK(elapsed >= 400ms);
@@ -419,8 +425,9 @@ TEST_CASE("what a process leaves in its group when it exits on its own is killed
   REQUIRE(line.has_value());
   const pid_t grandchild = std::stoi(*line);
   const int pidfd = static_cast<int>(::syscall(SYS_pidfd_open, grandchild, 0));
-  if (pidfd >= 0) { // else already killed and reaped
-    CHECK(wait_pidfd(pidfd, 10s)); // killed by the launcher: nothing else here would kill it
+  // Killed by the launcher (nothing else here would kill it), or already killed and reaped.
+  if (pidfd >= 0) {
+    CHECK(wait_pidfd(pidfd, 10s));
     ::close(pidfd);
   } else {
     CHECK(errno == ESRCH);
