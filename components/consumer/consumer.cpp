@@ -46,4 +46,6 @@ private:
 
 } // namespace
 
-int main(int argc, char **argv) { return rsca::component::run<Consumer>(argc, argv); }
+int main(int argc, char **argv) {
+  return rsca::component::run<Consumer>(argc, argv);
+}

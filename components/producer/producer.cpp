@@ -32,8 +32,8 @@ private:
   static constexpr double kToneHz = 10.0;
 
   Result start() override {
-    log().info("{}: publishing {} samples at {} Hz on stream {}", message_, payload_size_,
-               rate_hz_, stream_.stream_id);
+    log().info("{}: publishing {} samples at {} Hz on stream {}", message_, payload_size_, rate_hz_,
+               stream_.stream_id);
     return {};
   }
 
@@ -42,7 +42,8 @@ private:
     if (auto written = out_.write(samples_); !written && failures_++ % 100 == 0)
       log().warn("{} (failures so far: {})", written.error(), failures_);
     ++samples_.sequence;
-    return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / rate_hz_));
+    return std::chrono::duration_cast<Clock::duration>(
+        std::chrono::duration<double>(1.0 / rate_hz_));
   }
 
   // The next sequence, in the buffers of the last (no allocation unless payload_size grew).
@@ -69,4 +70,6 @@ private:
 
 } // namespace
 
-int main(int argc, char **argv) { return rsca::component::run<Producer>(argc, argv); }
+int main(int argc, char **argv) {
+  return rsca::component::run<Producer>(argc, argv);
+}

@@ -53,12 +53,12 @@ std::string_view to_string(State state);
 
 // Who the component is: from its exec parameters.
 struct Context {
-  std::string identifier;      // COMPONENT_IDENTIFIER
-  std::string name;            // NAME_BINDING (the identifier when not given)
-  std::string application;     // APPLICATION
-  std::string domain;          // DOMAIN_NAME
-  std::filesystem::path profile; // PROFILE_NAME: the SPD
-  std::string control_address; // CONTROL_ADDRESS
+  std::string identifier;                 // COMPONENT_IDENTIFIER
+  std::string name;                       // NAME_BINDING (the identifier when not given)
+  std::string application;                // APPLICATION
+  std::string domain;                     // DOMAIN_NAME
+  std::filesystem::path profile;          // PROFILE_NAME: the SPD
+  std::string control_address;            // CONTROL_ADDRESS
   std::shared_ptr<spdlog::logger> logger; // named after the instance
 };
 
@@ -86,7 +86,8 @@ protected:
   // ---- Declarations: call from the constructor only.
 
   template <typename T>
-  void property(std::string id, T &variable, std::type_identity_t<ChangeCallback<T>> on_change = {}) {
+  void property(std::string id, T &variable,
+                std::type_identity_t<ChangeCallback<T>> on_change = {}) {
     properties_.bind(std::move(id),
                      std::make_unique<detail::ScalarBinding<T>>(variable, std::move(on_change)));
   }
@@ -111,9 +112,9 @@ protected:
                                         variable, std::move(fields), std::move(on_change)));
   }
   template <typename S>
-  void struct_sequence_property(std::string id, std::vector<S> &variable,
-                                std::vector<Field<S>> fields,
-                                std::type_identity_t<ChangeCallback<std::vector<S>>> on_change = {}) {
+  void
+  struct_sequence_property(std::string id, std::vector<S> &variable, std::vector<Field<S>> fields,
+                           std::type_identity_t<ChangeCallback<std::vector<S>>> on_change = {}) {
     properties_.bind(std::move(id), std::make_unique<detail::StructSequenceBinding<S>>(
                                         variable, std::move(fields), std::move(on_change)));
   }
@@ -125,8 +126,7 @@ protected:
   }
   // A provides port of the SCD; `on_sample` runs on the receive thread while started.
   template <typename T>
-  ProvidesPort<T> &provides_port(std::string name,
-                                 typename ProvidesPort<T>::Callback on_sample) {
+  ProvidesPort<T> &provides_port(std::string name, typename ProvidesPort<T>::Callback on_sample) {
     return add_port(std::make_unique<ProvidesPort<T>>(std::move(name), std::move(on_sample)));
   }
 

@@ -15,8 +15,8 @@ struct Samples {
   std::uint64_t timestamp_ns = 0; // when the first sample was taken (CLOCK_REALTIME)
   std::uint64_t sequence = 0;     // per writer, from 0
   std::string stream_id;
-  double sample_rate = 0;         // samples per second; 0 when not periodic
-  bool complex = false;           // samples hold re, im pairs
+  double sample_rate = 0; // samples per second; 0 when not periodic
+  bool complex = false;   // samples hold re, im pairs
   bool end_of_stream = false;
   std::vector<double> samples;
 };
@@ -26,7 +26,7 @@ struct PropertyEvent {
   std::uint64_t timestamp_ns = 0;
   std::string source; // the component instance that sent it
   std::string id;
-  std::string value;  // JSON
+  std::string value; // JSON
 };
 
 // rsca::port::Command: a name with numeric arguments and optional text.

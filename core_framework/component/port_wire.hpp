@@ -40,7 +40,9 @@ inline const dds_topic_descriptor_t *descriptor(PortType type) {
 }
 
 // The C API takes non-const pointers but only reads what it writes.
-inline char *borrow(const std::string &text) { return const_cast<char *>(text.c_str()); }
+inline char *borrow(const std::string &text) {
+  return const_cast<char *>(text.c_str());
+}
 
 inline dds_sequence_double borrow(const std::vector<double> &values) {
   dds_sequence_double s{};

@@ -37,9 +37,8 @@ using detail::DataConnection;
 
 constexpr std::uint32_t kTakeBatch = 32;
 
-Expected<std::unique_ptr<DataConnection>> open_writer(dds_entity_t participant,
-                                                      std::unique_ptr<DataConnection> c,
-                                                      const dds_qos_t *qos) {
+Expected<std::unique_ptr<DataConnection>>
+open_writer(dds_entity_t participant, std::unique_ptr<DataConnection> c, const dds_qos_t *qos) {
   auto writer = dds::checked(dds_create_writer(participant, c->topic.get(), qos, nullptr),
                              fmt::format("creating a writer on topic \"{}\"", c->topic_name));
   if (!writer)
@@ -88,7 +87,9 @@ std::int32_t matched_count(dds_entity_t entity, profile::PortDirection direction
 PortBase::PortBase(std::string name, profile::PortDirection direction, port::PortType type)
     : name_(std::move(name)), direction_(direction), type_(type) {}
 
-PortBase::~PortBase() { disconnect_all(); }
+PortBase::~PortBase() {
+  disconnect_all();
+}
 
 std::size_t PortBase::connection_count() const {
   std::shared_lock lock(mutex_);
@@ -131,13 +132,16 @@ std::vector<ConnectionStatus> PortBase::status() const {
   std::vector<ConnectionStatus> out;
   out.reserve(connections_.size());
   for (const auto &[id, c] : connections_)
-    out.push_back({id, c->topic_name, matched_count(c->entity.get(), direction_), c->samples.load()});
+    out.push_back(
+        {id, c->topic_name, matched_count(c->entity.get(), direction_), c->samples.load()});
   return out;
 }
 
 void PortBase::take_all(bool) {}
 
-void PortBase::quiesce() { std::unique_lock lock(mutex_); }
+void PortBase::quiesce() {
+  std::unique_lock lock(mutex_);
+}
 
 WriteResult PortBase::write_wire(const void *sample) {
   std::shared_lock lock(mutex_);

@@ -59,8 +59,8 @@ std::size_t scalar_index(TypeSpec spec) {
 // The C++ type that binds the Scalar alternative at `index`.
 std::string_view cxx_type_name(std::size_t index) {
   constexpr std::array<std::string_view, 14> kNames{
-      "bool",         "char",          "std::uint8_t",  "std::int16_t", "std::uint16_t",
-      "std::int32_t", "std::uint32_t", "std::int64_t",  "std::uint64_t", "float",
+      "bool",         "char",          "std::uint8_t",     "std::int16_t",        "std::uint16_t",
+      "std::int32_t", "std::uint32_t", "std::int64_t",     "std::uint64_t",       "float",
       "double",       "std::string",   "profile::UtcTime", "std::complex<double>"};
   return index < kNames.size() ? kNames[index] : "?";
 }
@@ -183,7 +183,8 @@ Expected<void> PropertySet::load(std::vector<profile::PropertyDefinition> defini
   for (const auto &[id, binding] : bindings_) {
     const auto *definition = find(id);
     if (definition == nullptr) {
-      error.add({{"component", 0, 0}, "binding",
+      error.add({{"component", 0, 0},
+                 "binding",
                  fmt::format("property \"{}\" is bound, but the PRF does not define it", id)});
       continue;
     }

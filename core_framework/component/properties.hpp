@@ -91,7 +91,8 @@ class PropertyBinding {
 public:
   virtual ~PropertyBinding() = default;
   // Why the variable cannot hold values of `definition`; empty when it can.
-  virtual std::optional<std::string> mismatch(const profile::PropertyDefinition &definition) const = 0;
+  virtual std::optional<std::string>
+  mismatch(const profile::PropertyDefinition &definition) const = 0;
   virtual profile::PropertyValue get() const = 0;
   // `value` fits the definition (from_json checked it). Returns the change notification to run
   // once every value of the configure is applied (empty when there is no callback).
@@ -142,10 +143,10 @@ private:
 
 namespace detail {
 
-std::optional<std::string> struct_mismatch(const profile::StructProperty &definition,
-                                           const std::vector<std::string> &field_ids,
-                                           const std::function<std::optional<std::string>(
-                                               std::size_t, const profile::StructMember &)> &check);
+std::optional<std::string> struct_mismatch(
+    const profile::StructProperty &definition, const std::vector<std::string> &field_ids,
+    const std::function<std::optional<std::string>(std::size_t, const profile::StructMember &)>
+        &check);
 
 template <typename T>
 class ScalarBinding final : public PropertyBinding {

@@ -28,7 +28,9 @@ Expected<std::unique_ptr<ReceiveLoop>> ReceiveLoop::start(dds_entity_t participa
 ReceiveLoop::ReceiveLoop(dds::Entity waitset, dds::Entity guard, std::function<void()> poll)
     : waitset_(std::move(waitset)), guard_(std::move(guard)), poll_(std::move(poll)) {}
 
-ReceiveLoop::~ReceiveLoop() { stop(); }
+ReceiveLoop::~ReceiveLoop() {
+  stop();
+}
 
 void ReceiveLoop::stop() {
   stopping_ = true;
@@ -43,7 +45,9 @@ Expected<void> ReceiveLoop::attach(dds_entity_t condition) {
   return {};
 }
 
-void ReceiveLoop::detach(dds_entity_t condition) { dds_waitset_detach(waitset_.get(), condition); }
+void ReceiveLoop::detach(dds_entity_t condition) {
+  dds_waitset_detach(waitset_.get(), condition);
+}
 
 void ReceiveLoop::run() {
   while (!stopping_.load()) {

@@ -1,12 +1,8 @@
 #include "component/runtime.hpp"
 
-#include <atomic>
 #include <cerrno>
-#include <condition_variable>
 #include <csignal>
 #include <cstring>
-#include <mutex>
-#include <thread>
 
 #include <fmt/format.h>
 #include <poll.h>
@@ -14,18 +10,13 @@
 #include <spdlog/sinks/stdout_sinks.h>
 #include <spdlog/spdlog.h>
 #include <sys/eventfd.h>
+#include <sys/prctl.h>
 #include <sys/signalfd.h>
 #include <unistd.h>
 
-#include "component/receive_loop.hpp"
-#include "dds/port_qos.hpp"
-#include "profile/profile_loader.hpp"
+#include "component/host.hpp"
 
 namespace rsca::component {
-
-using control::CallResult;
-using control::Json;
-using control::Status;
 
 namespace {
 
@@ -100,9 +91,6 @@ private:
   UniqueFd released_;
 };
 
-// ---------------------------------------------------------------------------------------------
-// Helpers
-
 std::shared_ptr<spdlog::logger> make_logger(const std::string &name) {
   auto logger =
       std::make_shared<spdlog::logger>(name, std::make_shared<spdlog::sinks::stderr_sink_mt>());
@@ -111,527 +99,7 @@ std::shared_ptr<spdlog::logger> make_logger(const std::string &name) {
   return logger;
 }
 
-// REDHAWK's DEBUG_LEVEL: 0 fatal, 1 error, 2 warn, 3 info, 4 debug, 5 trace.
-std::optional<spdlog::level::level_enum> debug_level(const std::string &text) {
-  constexpr spdlog::level::level_enum kLevels[] = {
-      spdlog::level::critical, spdlog::level::err,   spdlog::level::warn,
-      spdlog::level::info,     spdlog::level::debug, spdlog::level::trace};
-  if (text.size() != 1 || text[0] < '0' || text[0] > '5')
-    return std::nullopt;
-  return kLevels[text[0] - '0'];
-}
-
-// Exec parameters a REDHAWK GPP passes that are not properties.
-bool is_redhawk_extra(const std::string &key) {
-  return key == "LOGGING_CONFIG_URI" || key == "NIC" || key == "RH::GPP::MODIFIED_CPU_RESERVATION_VALUE";
-}
-
-// Every PRF definition of the package: the SPD's PRF, then the implementations' (first wins).
-std::vector<profile::PropertyDefinition> definitions_of(const profile::ResolvedSoftPkg &softpkg) {
-  std::vector<profile::PropertyDefinition> out;
-  auto add = [&out](const std::shared_ptr<const profile::Properties> &prf) {
-    if (!prf)
-      return;
-    for (const auto &d : prf->properties) {
-      const auto &id = profile::common_of(d).id;
-      const bool known = std::any_of(out.begin(), out.end(),
-                                     [&](const auto &o) { return profile::common_of(o).id == id; });
-      if (!known)
-        out.push_back(d);
-    }
-  };
-  add(softpkg.properties);
-  for (const auto &implementation : softpkg.implementations)
-    add(implementation.properties);
-  return out;
-}
-
-std::string_view direction_name(profile::PortDirection direction) {
-  return direction == profile::PortDirection::Uses ? "uses" : "provides";
-}
-
-CallResult<std::string> string_field(const Json &body, const char *key) {
-  auto it = body.find(key);
-  if (it == body.end() || !it->is_string() || it->get_ref<const std::string &>().empty())
-    return control::call_error(Status::BadRequest,
-                               fmt::format("the request needs \"{}\", a non-empty string", key));
-  return it->get<std::string>();
-}
-
-CallResult<std::vector<std::string>> ids_field(const Json &body) {
-  auto it = body.find("ids");
-  if (it == body.end() || it->is_null())
-    return std::vector<std::string>{};
-  if (!it->is_array())
-    return control::call_error(Status::BadRequest, "\"ids\" must be an array of property ids");
-  std::vector<std::string> ids;
-  for (const auto &id : *it) {
-    if (!id.is_string())
-      return control::call_error(Status::BadRequest, "\"ids\" must be an array of property ids");
-    ids.push_back(id.get<std::string>());
-  }
-  return ids;
-}
-
-std::string first_message(const Error &error) {
-  return error.diagnostics().empty() ? std::string("unknown error")
-                                     : error.diagnostics().front().message;
-}
-
 } // namespace
-
-// ---------------------------------------------------------------------------------------------
-// The host: one component behind its control endpoint.
-
-namespace detail {
-
-class Host {
-public:
-  Host(std::unique_ptr<Component> component,
-       std::shared_ptr<const profile::ResolvedSoftPkg> softpkg)
-      : component_(std::move(component)), softpkg_(std::move(softpkg)) {}
-  ~Host() { close(); }
-  Host(const Host &) = delete;
-  Host &operator=(const Host &) = delete;
-
-  Expected<void> prepare(const std::vector<std::pair<std::string, std::string>> &execparams);
-  Expected<void> open(std::shared_ptr<dds::Participant> participant,
-                      std::function<void()> on_released);
-  void shutdown(std::string_view why);
-  void close();
-  bool idle() const { return in_flight_.load() == 0; }
-
-private:
-  using Operation = CallResult<Json> (Host::*)(const Json &);
-
-  Expected<void> check_ports() const;
-  void serve(const std::string &operation, Operation op);
-  Json announcement() const;
-  void set_state(State state);
-  PortBase *find_port(const std::string &name) const;
-  void poll_ports();
-  void start_service();
-  void stop_service();
-  void service_loop();
-  void stop_component();
-
-  CallResult<Json> op_initialize(const Json &body);
-  CallResult<Json> op_configure(const Json &body);
-  CallResult<Json> op_query(const Json &body);
-  CallResult<Json> op_connect(const Json &body);
-  CallResult<Json> op_disconnect(const Json &body);
-  CallResult<Json> op_start(const Json &body);
-  CallResult<Json> op_stop(const Json &body);
-  CallResult<Json> op_status(const Json &body);
-  CallResult<Json> op_release(const Json &body);
-
-  Component &c() const { return *component_; }
-  spdlog::logger &log() const { return component_->log(); }
-
-  std::unique_ptr<Component> component_;
-  std::shared_ptr<const profile::ResolvedSoftPkg> softpkg_;
-  std::shared_ptr<dds::Participant> participant_;
-  std::unique_ptr<ReceiveLoop> loop_;
-  std::unique_ptr<control::Endpoint> endpoint_;
-  std::function<void()> on_released_;
-
-  std::mutex lifecycle_; // one lifecycle operation at a time
-  std::atomic<bool> delivering_{false};
-  std::atomic<int> in_flight_{0};
-
-  std::mutex service_mutex_;
-  std::condition_variable service_wake_;
-  bool service_stopping_ = false;
-  std::thread service_thread_;
-};
-
-Expected<void> Host::check_ports() const {
-  const auto &scd = softpkg_->scd;
-  Error error;
-  auto fail = [&](std::string message) {
-    error.add({{softpkg_->spd_path.string(), 0, 0}, "binding", std::move(message)});
-  };
-  for (const auto &port : c().ports_) {
-    const auto *definition = scd ? scd->find_port(port->name(), port->direction()) : nullptr;
-    if (definition == nullptr) {
-      fail(fmt::format("the component has {} port \"{}\", which its SCD does not declare",
-                       direction_name(port->direction()), port->name()));
-      continue;
-    }
-    const auto type = port::port_type_for_repid(definition->repid);
-    if (type != port->type())
-      fail(fmt::format("port \"{}\" carries {}, but its SCD repid is {}", port->name(),
-                       port::to_string(port->type()), definition->repid));
-  }
-  if (!error.empty())
-    return tl::unexpected(std::move(error));
-  for (const auto &definition : scd ? scd->ports : std::vector<profile::PortDefinition>{})
-    if (find_port(definition.name) == nullptr)
-      log().warn("SCD port \"{}\" has no implementation in the component: it cannot be connected",
-                 definition.name);
-  return {};
-}
-
-Expected<void>
-Host::prepare(const std::vector<std::pair<std::string, std::string>> &execparams) {
-  auto lock = c().lock_properties();
-  if (auto loaded = c().properties_.load(definitions_of(*softpkg_)); !loaded)
-    return loaded;
-  for (const auto &[key, value] : execparams) {
-    if (key == "DEBUG_LEVEL") {
-      if (auto level = debug_level(value))
-        log().set_level(*level);
-      continue;
-    }
-    if (c().properties_.find(key) == nullptr) {
-      if (!is_redhawk_extra(key))
-        log().warn("ignoring exec parameter \"{}\": no such property", key);
-      continue;
-    }
-    if (auto applied = c().properties_.apply_text(key, value); !applied)
-      return make_error({softpkg_->spd_path.string(), 0, 0}, "execparam", applied.error());
-  }
-  return check_ports();
-}
-
-Expected<void> Host::open(std::shared_ptr<dds::Participant> participant,
-                          std::function<void()> on_released) {
-  participant_ = std::move(participant);
-  on_released_ = std::move(on_released);
-  auto loop = ReceiveLoop::start(participant_->get(), [this] { poll_ports(); });
-  if (!loop)
-    return tl::unexpected(loop.error());
-  loop_ = std::move(*loop);
-  auto endpoint = control::Endpoint::open(participant_, c().context().control_address);
-  if (!endpoint)
-    return tl::unexpected(endpoint.error());
-  endpoint_ = std::move(*endpoint);
-  serve("component.initialize", &Host::op_initialize);
-  serve("component.configure", &Host::op_configure);
-  serve("component.query", &Host::op_query);
-  serve("component.connect", &Host::op_connect);
-  serve("component.disconnect", &Host::op_disconnect);
-  serve("component.start", &Host::op_start);
-  serve("component.stop", &Host::op_stop);
-  serve("component.status", &Host::op_status);
-  serve("component.release", &Host::op_release);
-  std::lock_guard lock(lifecycle_);
-  return endpoint_->announce("component", announcement());
-}
-
-void Host::close() {
-  if (endpoint_) {
-    endpoint_->withdraw();
-    endpoint_.reset(); // waits for running handlers
-  }
-  stop_service();
-  if (loop_)
-    loop_->stop();
-  component_.reset(); // its ports detach from the stopped loop
-  loop_.reset();
-  participant_.reset();
-}
-
-// Runs `op` for `operation`: exceptions become errors, and running handlers are counted.
-void Host::serve(const std::string &operation, Operation op) {
-  endpoint_->on(operation, [this, op](const Json &body, const control::RequestContext &context)
-                               -> CallResult<Json> {
-    ++in_flight_;
-    struct Done {
-      std::atomic<int> &count;
-      ~Done() { --count; }
-    } done{in_flight_};
-    log().debug("{} from {}", context.operation, context.sender);
-    try {
-      return (this->*op)(body);
-    } catch (const nlohmann::json::exception &e) {
-      return control::call_error(Status::BadRequest, e.what());
-    } catch (const std::exception &e) {
-      return control::call_error(Status::Failed, e.what());
-    }
-  });
-}
-
-Json Host::announcement() const {
-  Json ports = Json::array();
-  for (const auto &port : c().ports_) {
-    const auto *definition =
-        softpkg_->scd ? softpkg_->scd->find_port(port->name(), port->direction()) : nullptr;
-    ports.push_back({{"name", port->name()},
-                     {"direction", direction_name(port->direction())},
-                     {"repid", definition ? definition->repid
-                                          : std::string(port::repid_of(port->type()))}});
-  }
-  return {{"id", c().identifier()},         {"name", c().name()},
-          {"application", c().context().application}, {"pid", ::getpid()},
-          {"state", to_string(c().state())}, {"ports", ports}};
-}
-
-// Called with lifecycle_ held.
-void Host::set_state(State state) {
-  c().state_ = state;
-  log().info("{}", to_string(state));
-  if (state == State::Released || !endpoint_)
-    return;
-  if (auto ok = endpoint_->announce("component", announcement()); !ok)
-    log().warn("updating the announcement failed: {}", ok.error().to_string());
-}
-
-PortBase *Host::find_port(const std::string &name) const {
-  for (const auto &port : c().ports_)
-    if (port->name() == name)
-      return port.get();
-  return nullptr;
-}
-
-void Host::poll_ports() {
-  const bool deliver = delivering_.load();
-  for (const auto &port : c().ports_)
-    if (port->direction() == profile::PortDirection::Provides)
-      port->take_all(deliver);
-}
-
-// ---- The service thread
-
-void Host::start_service() {
-  {
-    std::lock_guard lock(service_mutex_);
-    service_stopping_ = false;
-  }
-  service_thread_ = std::thread([this] { service_loop(); });
-}
-
-void Host::stop_service() {
-  {
-    std::lock_guard lock(service_mutex_);
-    service_stopping_ = true;
-  }
-  service_wake_.notify_all();
-  if (service_thread_.joinable())
-    service_thread_.join();
-}
-
-void Host::service_loop() {
-  auto next = Clock::now();
-  for (;;) {
-    std::optional<Clock::duration> delay;
-    {
-      auto lock = c().lock_properties();
-      try {
-        delay = c().service();
-      } catch (const std::exception &e) {
-        log().error("service() failed: {}; it is not called again until the next start", e.what());
-        return;
-      }
-    }
-    if (!delay)
-      return;
-    const auto period = std::max(*delay, Clock::duration::zero());
-    next += period;
-    if (const auto now = Clock::now(); next + period < now)
-      next = now; // more than a period late: skip ahead rather than burst
-    std::unique_lock lock(service_mutex_);
-    if (service_wake_.wait_until(lock, next, [this] { return service_stopping_; }))
-      return;
-  }
-}
-
-// ---- Operations
-
-CallResult<Json> Host::op_initialize(const Json &) {
-  std::lock_guard lock(lifecycle_);
-  if (c().state() == State::Released)
-    return control::call_error(Status::Unavailable, "the component is released");
-  if (c().state() != State::Loaded)
-    return Json::object(); // already initialized
-  {
-    auto properties = c().lock_properties();
-    if (auto ok = c().initialize(); !ok)
-      return tl::unexpected(ok.error());
-  }
-  set_state(State::Initialized);
-  return Json::object();
-}
-
-CallResult<Json> Host::op_configure(const Json &body) {
-  auto it = body.find("properties");
-  if (it == body.end())
-    return control::call_error(Status::BadRequest, "the request needs \"properties\"");
-  std::lock_guard lock(lifecycle_);
-  if (c().state() == State::Released)
-    return control::call_error(Status::Unavailable, "the component is released");
-  auto properties = c().lock_properties();
-  auto notifications = c().properties_.configure(*it);
-  if (!notifications)
-    return tl::unexpected(notifications.error());
-  for (const auto &notify : *notifications) {
-    try {
-      notify();
-    } catch (const std::exception &e) {
-      log().error("a property change callback failed: {}", e.what());
-    }
-  }
-  log().info("configured {}", it->dump());
-  return Json::object();
-}
-
-CallResult<Json> Host::op_query(const Json &body) {
-  auto ids = ids_field(body);
-  if (!ids)
-    return tl::unexpected(ids.error());
-  auto properties = c().lock_properties();
-  auto values = c().properties_.query(*ids);
-  if (!values)
-    return tl::unexpected(values.error());
-  return Json{{"properties", std::move(*values)}};
-}
-
-CallResult<Json> Host::op_connect(const Json &body) {
-  auto connection = string_field(body, "connection");
-  auto port_name = string_field(body, "port");
-  auto direction = string_field(body, "direction");
-  auto topic = string_field(body, "topic");
-  auto repid = string_field(body, "repid");
-  for (const auto *field : {&connection, &port_name, &direction, &topic, &repid})
-    if (!*field)
-      return tl::unexpected(field->error());
-  PortBase *port = find_port(*port_name);
-  if (port == nullptr)
-    return control::call_error(Status::NotFound, fmt::format("no port \"{}\"", *port_name));
-  if (*direction != direction_name(port->direction()))
-    return control::call_error(Status::BadRequest,
-                               fmt::format("port \"{}\" is a {} port, not {}", *port_name,
-                                           direction_name(port->direction()), *direction));
-  if (port::port_type_for_repid(*repid) != port->type())
-    return control::call_error(Status::BadRequest,
-                               fmt::format("port \"{}\" carries {}, which {} does not",
-                                           *port_name, port::to_string(port->type()), *repid));
-  auto qos = dds::qos_from_json(body.contains("qos") ? body.at("qos") : Json::object());
-  if (!qos)
-    return control::call_error(Status::BadRequest, first_message(qos.error()));
-  std::lock_guard lock(lifecycle_);
-  if (c().state() == State::Released)
-    return control::call_error(Status::Unavailable, "the component is released");
-  if (auto ok = port->connect(participant_->get(), loop_.get(), *connection, *topic, qos->get());
-      !ok)
-    return control::call_error(Status::Failed, first_message(ok.error()));
-  log().info("port {}: connection {} on topic \"{}\"", *port_name, *connection, *topic);
-  return Json::object();
-}
-
-CallResult<Json> Host::op_disconnect(const Json &body) {
-  auto connection = string_field(body, "connection");
-  if (!connection)
-    return tl::unexpected(connection.error());
-  auto port_name = string_field(body, "port");
-  if (!port_name)
-    return tl::unexpected(port_name.error());
-  PortBase *port = find_port(*port_name);
-  if (port == nullptr)
-    return control::call_error(Status::NotFound, fmt::format("no port \"{}\"", *port_name));
-  std::lock_guard lock(lifecycle_);
-  if (!port->disconnect(*connection))
-    return control::call_error(Status::NotFound, fmt::format("port \"{}\" has no connection \"{}\"",
-                                                             *port_name, *connection));
-  log().info("port {}: connection {} removed", *port_name, *connection);
-  return Json::object();
-}
-
-CallResult<Json> Host::op_start(const Json &) {
-  std::lock_guard lock(lifecycle_);
-  switch (c().state()) {
-  case State::Released:
-    return control::call_error(Status::Unavailable, "the component is released");
-  case State::Loaded:
-    return control::call_error(Status::Rejected, "the component is not initialized");
-  case State::Started:
-    return Json::object();
-  default:
-    break;
-  }
-  {
-    auto properties = c().lock_properties();
-    if (auto ok = c().start(); !ok)
-      return tl::unexpected(ok.error());
-  }
-  delivering_ = true;
-  start_service();
-  set_state(State::Started);
-  return Json::object();
-}
-
-// Called with lifecycle_ held, when started: the service thread and port callbacks stop before
-// the stop hook runs.
-void Host::stop_component() {
-  stop_service();
-  delivering_ = false;
-  for (const auto &port : c().ports_)
-    port->quiesce();
-}
-
-CallResult<Json> Host::op_stop(const Json &) {
-  std::lock_guard lock(lifecycle_);
-  if (c().state() != State::Started)
-    return Json::object();
-  stop_component();
-  Result result;
-  {
-    auto properties = c().lock_properties();
-    result = c().stop();
-  }
-  set_state(State::Stopped);
-  if (!result)
-    return tl::unexpected(result.error());
-  return Json::object();
-}
-
-CallResult<Json> Host::op_status(const Json &) {
-  Json ports = Json::array();
-  for (const auto &port : c().ports_) {
-    Json connections = Json::array();
-    for (const auto &s : port->status())
-      connections.push_back({{"connection", s.connection},
-                             {"topic", s.topic},
-                             {"matched", s.matched},
-                             {"samples", s.samples}});
-    ports.push_back({{"name", port->name()},
-                     {"direction", direction_name(port->direction())},
-                     {"connections", std::move(connections)}});
-  }
-  return Json{{"state", to_string(c().state())}, {"ports", std::move(ports)}};
-}
-
-CallResult<Json> Host::op_release(const Json &) {
-  shutdown("component.release");
-  return Json::object();
-}
-
-void Host::shutdown(std::string_view why) {
-  {
-    std::lock_guard lock(lifecycle_);
-    if (c().state() == State::Released)
-      return;
-    log().info("releasing ({})", why);
-    if (c().state() == State::Started) {
-      stop_component();
-      auto properties = c().lock_properties();
-      if (auto ok = c().stop(); !ok)
-        log().error("stop failed: {}", ok.error().message);
-    }
-    {
-      auto properties = c().lock_properties();
-      if (auto ok = c().release(); !ok)
-        log().error("release failed: {}", ok.error().message);
-    }
-    for (const auto &port : c().ports_)
-      port->disconnect_all();
-    set_state(State::Released);
-  }
-  if (on_released_)
-    on_released_();
-}
-
-} // namespace detail
 
 // ---------------------------------------------------------------------------------------------
 
@@ -703,8 +171,12 @@ int run_host(const ExecParams &params, const ExitEvents &events, const Factory &
     logger->error("cannot load the profile {}:\n{}", params.profile, softpkg.error().to_string());
     return kExitProfile;
   }
-  Context context{params.identifier,  params.name_binding, params.application,
-                  params.domain,      params.profile,      params.control_address,
+  Context context{params.identifier,
+                  params.name_binding,
+                  params.application,
+                  params.domain,
+                  params.profile,
+                  params.control_address,
                   logger};
   std::unique_ptr<Component> component;
   try {
@@ -737,6 +209,13 @@ int run_host(const ExecParams &params, const ExitEvents &events, const Factory &
 } // namespace
 
 int run_component(int argc, char **argv, const Factory &factory) {
+  // A component does not outlive the node daemon that started it. With the node gone nobody could
+  // escalate a stuck shutdown, so its death kills the component outright; the domain learns of
+  // it from the lost announcements.
+  const pid_t parent = getppid();
+  prctl(PR_SET_PDEATHSIG, SIGKILL);
+  if (getppid() != parent)
+    return kExitFailure; // the parent died before the request took effect
   auto events = ExitEvents::install(); // first: before any thread starts
   if (!events) {
     spdlog::error("{}", events.error());

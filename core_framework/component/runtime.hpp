@@ -25,10 +25,10 @@ namespace rsca::component {
 
 // What run returns, the process's exit status.
 enum ExitStatus : int {
-  kExitOk = 0,        // released, or stopped by SIGTERM/SIGINT
-  kExitFailure = 1,   // DDS, the endpoint or the component's constructor failed
-  kExitUsage = 2,     // the exec parameters are wrong
-  kExitProfile = 3,   // the profile cannot be loaded or does not fit the component
+  kExitOk = 0,      // released, or stopped by SIGTERM/SIGINT
+  kExitFailure = 1, // DDS, the endpoint or the component's constructor failed
+  kExitUsage = 2,   // the exec parameters are wrong
+  kExitProfile = 3, // the profile cannot be loaded or does not fit the component
 };
 
 struct ExecParams {

@@ -137,6 +137,7 @@ struct Endpoint::Impl {
     Clock::time_point deadline;
     std::string target;
     std::string operation;
+    bool sent = false; // written: the addressee exists, so silence is a timeout
   };
 
   std::shared_ptr<dds::Participant> participant;
@@ -379,7 +380,7 @@ void Endpoint::Impl::complete(const std::string &id, CallResult<Json> result) {
 }
 
 void Endpoint::Impl::expire_calls() {
-  std::vector<std::pair<std::promise<CallResult<Json>>, std::string>> expired;
+  std::vector<std::pair<std::promise<CallResult<Json>>, control::CallError>> expired;
   {
     std::lock_guard lock(state_mutex);
     const auto now = Clock::now();
@@ -388,14 +389,17 @@ void Endpoint::Impl::expire_calls() {
         ++it;
         continue;
       }
-      expired.emplace_back(std::move(it->second.promise),
-                           fmt::format("no reply from {} to \"{}\" before the deadline",
-                                       it->second.target, it->second.operation));
+      const auto &p = it->second;
+      expired.emplace_back(
+          std::move(it->second.promise),
+          p.sent ? CallError{Status::Timeout, fmt::format("no reply from {} to \"{}\" before the deadline",
+                                                          p.target, p.operation)}
+                 : CallError{Status::Unavailable, fmt::format("nobody serves address {}", p.target)});
       it = pending.erase(it);
     }
   }
-  for (auto &[promise, message] : expired)
-    promise.set_value(call_error(Status::Timeout, message));
+  for (auto &[promise, error] : expired)
+    promise.set_value(tl::unexpected(std::move(error)));
 }
 
 CallResult<dds_entity_t> Endpoint::Impl::writer_to(std::map<std::string, PartitionWriter> &cache,
@@ -458,9 +462,14 @@ void Endpoint::Impl::send_request(std::string id, std::string target, std::strin
   request.sender = address.data();
   request.operation = operation.data();
   request.body = body.data();
-  if (dds_return_t rc = dds_write(*writer, &request); rc < 0)
+  if (dds_return_t rc = dds_write(*writer, &request); rc < 0) {
     complete(id, call_error(Status::Failed, fmt::format("sending to {} failed: {}", target,
                                                         dds_strretcode(rc))));
+    return;
+  }
+  std::lock_guard lock(state_mutex);
+  if (auto it = pending.find(id); it != pending.end())
+    it->second.sent = true;
 }
 
 Endpoint::Endpoint(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}

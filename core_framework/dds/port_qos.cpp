@@ -19,9 +19,9 @@ using profile::Reliability;
 constexpr const char *kInfinite = "infinite";
 constexpr dds_duration_t kMaxBlockingTime = DDS_MSECS(100);
 
-constexpr std::array kKeys{"reliability", "durability",        "history",  "depth",
-                           "deadline_ns", "latencybudget_ns",  "transportpriority",
-                           "liveliness",  "lease_ns",          "ownership", "strength"};
+constexpr std::array kKeys{"reliability", "durability",       "history",           "depth",
+                           "deadline_ns", "latencybudget_ns", "transportpriority", "liveliness",
+                           "lease_ns",    "ownership",        "strength"};
 
 tl::unexpected<Error> qos_error(std::string message) {
   return make_error({"qos", 0, 0}, "qos", std::move(message));
@@ -74,18 +74,24 @@ Expected<Duration> duration_from_json(const Json &json, const char *key) {
       fmt::format("\"{}\" is {}, not whole nanoseconds or \"infinite\"", key, json.dump()));
 }
 
+// Whether an integer JSON number (received numbers >= 0 are unsigned) lies in [min, max].
+bool within(const Json &json, std::int64_t min, std::int64_t max) {
+  if (json.is_number_unsigned()) {
+    const auto value = json.get<std::uint64_t>();
+    return value <= static_cast<std::uint64_t>(max) &&
+           (min <= 0 || value >= static_cast<std::uint64_t>(min));
+  }
+  const auto value = json.get<std::int64_t>();
+  return value >= min && value <= max;
+}
+
 template <typename T>
 Expected<T> integer_from_json(const Json &json, const char *key, T min) {
-  if (json.is_number_integer()) {
-    const bool too_big = json.is_number_unsigned()
-                             ? json.get<std::uint64_t>() > std::uint64_t(std::numeric_limits<T>::max())
-                             : json.get<std::int64_t>() > std::int64_t(std::numeric_limits<T>::max());
-    const bool too_small = !json.is_number_unsigned() && json.get<std::int64_t>() < std::int64_t(min);
-    if (!too_big && !too_small)
-      return json.get<T>();
-  }
-  return qos_error(fmt::format("\"{}\" is {}, not an integer from {} to {}", key, json.dump(), min,
-                               std::numeric_limits<T>::max()));
+  constexpr T kMax = std::numeric_limits<T>::max();
+  if (json.is_number_integer() && within(json, min, kMax))
+    return json.get<T>();
+  return qos_error(
+      fmt::format("\"{}\" is {}, not an integer from {} to {}", key, json.dump(), min, kMax));
 }
 
 Expected<void> check_keys(const Json &json) {
@@ -142,22 +148,21 @@ Expected<ConnectionQos> parse(const Json &json) {
   auto int32 = [](const Json &j, const char *k) {
     return integer_from_json<std::int32_t>(j, k, std::numeric_limits<std::int32_t>::min());
   };
-  auto ok = check_keys(json)
-                .and_then([&] { return read(json, "reliability", qos.reliability, reliability); })
-                .and_then([&] { return read(json, "durability", qos.durability, durability); })
-                .and_then([&] { return read(json, "history", qos.history, history); })
-                .and_then([&] { return read(json, "depth", qos.depth, depth); })
-                .and_then([&] { return read(json, "deadline_ns", qos.deadline, duration_from_json); })
-                .and_then([&] {
-                  return read(json, "latencybudget_ns", qos.latency_budget, duration_from_json);
-                })
-                .and_then([&] {
-                  return read(json, "transportpriority", qos.transport_priority, int32);
-                })
-                .and_then([&] { return read(json, "liveliness", qos.liveliness, liveliness); })
-                .and_then([&] { return read(json, "lease_ns", qos.lease, duration_from_json); })
-                .and_then([&] { return read(json, "ownership", qos.ownership, ownership); })
-                .and_then([&] { return read(json, "strength", qos.strength, int32); });
+  auto ok =
+      check_keys(json)
+          .and_then([&] { return read(json, "reliability", qos.reliability, reliability); })
+          .and_then([&] { return read(json, "durability", qos.durability, durability); })
+          .and_then([&] { return read(json, "history", qos.history, history); })
+          .and_then([&] { return read(json, "depth", qos.depth, depth); })
+          .and_then([&] { return read(json, "deadline_ns", qos.deadline, duration_from_json); })
+          .and_then([&] {
+            return read(json, "latencybudget_ns", qos.latency_budget, duration_from_json);
+          })
+          .and_then([&] { return read(json, "transportpriority", qos.transport_priority, int32); })
+          .and_then([&] { return read(json, "liveliness", qos.liveliness, liveliness); })
+          .and_then([&] { return read(json, "lease_ns", qos.lease, duration_from_json); })
+          .and_then([&] { return read(json, "ownership", qos.ownership, ownership); })
+          .and_then([&] { return read(json, "strength", qos.strength, int32); });
   if (!ok)
     return tl::unexpected(ok.error());
   return with_defaults(std::move(qos));
@@ -171,7 +176,8 @@ dds_reliability_kind_t dds_kind(Reliability v) {
   return v == Reliability::Reliable ? DDS_RELIABILITY_RELIABLE : DDS_RELIABILITY_BEST_EFFORT;
 }
 dds_durability_kind_t dds_kind(Durability v) {
-  constexpr dds_durability_kind_t kinds[] = {DDS_DURABILITY_VOLATILE, DDS_DURABILITY_TRANSIENT_LOCAL,
+  constexpr dds_durability_kind_t kinds[] = {DDS_DURABILITY_VOLATILE,
+                                             DDS_DURABILITY_TRANSIENT_LOCAL,
                                              DDS_DURABILITY_TRANSIENT, DDS_DURABILITY_PERSISTENT};
   return kinds[static_cast<std::size_t>(v)];
 }

@@ -31,29 +31,32 @@ struct Call {
   std::string what; // for messages: "Producer_1"
 };
 
-// Makes every call at once and waits for all; the first failure, prefixed with its `what`.
-CallResult<std::vector<Json>> call_all(control::Endpoint &endpoint, const std::vector<Call> &calls,
-                                       std::chrono::milliseconds timeout) {
+// Makes every call at once and waits for all of them; each result in the order of the calls.
+std::vector<CallResult<Json>> call_each_of(control::Endpoint &endpoint, const std::vector<Call> &calls,
+                                           std::chrono::milliseconds timeout) {
   std::vector<std::future<CallResult<Json>>> futures;
   futures.reserve(calls.size());
   for (const auto &c : calls)
     futures.push_back(endpoint.call(c.target, c.operation, c.body, timeout));
-  std::vector<Json> replies;
-  std::optional<control::CallError> first_error;
-  for (std::size_t i = 0; i < futures.size(); ++i) {
-    auto reply = futures[i].get();
-    if (reply) {
-      replies.push_back(std::move(*reply));
-      continue;
-    }
-    if (!first_error)
-      first_error = control::CallError{reply.error().status,
-                                       fmt::format("{}: {}", calls[i].what, reply.error().message)};
-    replies.emplace_back();
-  }
-  if (first_error)
-    return tl::unexpected(*first_error);
-  return replies;
+  std::vector<CallResult<Json>> results;
+  results.reserve(futures.size());
+  for (auto &f : futures)
+    results.push_back(f.get());
+  return results;
+}
+
+// The first failure among `results`, prefixed with its call's `what`.
+CallResult<void> first_failure(const std::vector<Call> &calls, const std::vector<CallResult<Json>> &results) {
+  for (std::size_t i = 0; i < results.size(); ++i)
+    if (!results[i])
+      return control::call_error(results[i].error().status,
+                                 fmt::format("{}: {}", calls[i].what, results[i].error().message));
+  return {};
+}
+
+CallResult<void> call_all(control::Endpoint &endpoint, const std::vector<Call> &calls,
+                          std::chrono::milliseconds timeout) {
+  return first_failure(calls, call_each_of(endpoint, calls, timeout));
 }
 
 std::string sanitize(std::string_view text) {
@@ -163,16 +166,16 @@ private:
         return control::call_error(Status::Unavailable, fmt::format("node {} is gone", c.node));
       calls.push_back({*node, "node.execute", execute_body(c), c.id});
     }
-    auto replies = call_all(*s_.endpoint, calls, s_.call_timeout);
+    auto replies = call_each_of(*s_.endpoint, calls, s_.call_timeout);
     // Record every process that did start, even when another failed, so rollback finds it.
     for (std::size_t i = 0; i < app_->components.size(); ++i) {
-      if (replies && (*replies)[i].contains("pid")) {
-        app_->components[i].pid = (*replies)[i]["pid"].get<long>();
+      if (replies[i] && replies[i]->contains("pid")) {
+        app_->components[i].pid = (*replies[i])["pid"].get<long>();
         app_->components[i].state = "executed";
       }
     }
-    if (!replies)
-      return tl::unexpected(replies.error());
+    if (auto ok = first_failure(calls, replies); !ok)
+      return ok;
     detail_ = fmt::format("{} processes", app_->components.size());
     return {};
   }
@@ -214,7 +217,7 @@ private:
       }
     }
     detail_ = fmt::format("{} components configured", calls.size());
-    return call_all(*s_.endpoint, calls, s_.call_timeout).map([](auto &&) {});
+    return call_all(*s_.endpoint, calls, s_.call_timeout);
   }
 
   CallResult<void> connect() {
@@ -242,12 +245,10 @@ private:
       app_->connections.push_back(std::move(ci));
     }
     // Readers first, so the first samples written find them.
-    auto ok = call_all(*s_.endpoint, provides_side, s_.call_timeout);
-    if (!ok)
-      return tl::unexpected(ok.error());
-    ok = call_all(*s_.endpoint, uses_side, s_.call_timeout);
-    if (!ok)
-      return tl::unexpected(ok.error());
+    if (auto ok = call_all(*s_.endpoint, provides_side, s_.call_timeout); !ok)
+      return ok;
+    if (auto ok = call_all(*s_.endpoint, uses_side, s_.call_timeout); !ok)
+      return ok;
     detail_ = fmt::format("{} connections", app_->connections.size());
     return {};
   }
@@ -267,7 +268,7 @@ private:
     std::vector<Call> calls;
     for (auto &c : app_->components)
       calls.push_back({c.address, operation, body(c), c.id});
-    return call_all(*s_.endpoint, calls, s_.call_timeout).map([](auto &&) {});
+    return call_all(*s_.endpoint, calls, s_.call_timeout);
   }
 
   Call connect_call(const ConnectionInstance &ci, const ConnectionEnd &end, const char *direction) {
@@ -394,6 +395,10 @@ private:
   // Undoes what the launch did: processes first, then the allocation.
   std::string roll_back() {
     std::vector<std::string> undone;
+    std::vector<std::string> devices;
+    for (const auto &p : app_->placements)
+      if (std::find(devices.begin(), devices.end(), p.device) == devices.end())
+        devices.push_back(p.device);
     ApplicationFactory factory(s_);
     const std::size_t started =
         std::count_if(app_->components.begin(), app_->components.end(), [](const auto &c) { return c.pid != 0; });
@@ -404,10 +409,6 @@ private:
       s_.allocator->release(app_->placements);
     }
     if (allocated_) {
-      std::vector<std::string> devices;
-      for (const auto &p : app_->placements)
-        if (std::find(devices.begin(), devices.end(), p.device) == devices.end())
-          devices.push_back(p.device);
       undone.push_back(fmt::format("allocations on {} released", fmt::join(devices, ", ")));
     }
     return fmt::format("{}", fmt::join(undone, "; "));
@@ -456,7 +457,7 @@ CallResult<void> ApplicationFactory::stop(Application &app) {
   for (auto &c : app.components)
     c.state = "stopped";
   app.state = ApplicationState::Stopped;
-  return ok.map([](auto &&) {});
+  return ok;
 }
 
 CallResult<void> ApplicationFactory::release(Application &app) {
@@ -474,7 +475,7 @@ CallResult<void> ApplicationFactory::release(Application &app) {
     if (node)
       terminations.push_back({*node, "node.terminate", Json{{"pid", c.pid}}, c.id});
   }
-  auto terminated = call_all(*services_.endpoint, terminations, services_.call_timeout);
+  auto terminated = call_each_of(*services_.endpoint, terminations, services_.call_timeout);
   for (auto &c : app.components) {
     services_.components->forget(c.address);
     c.state = "released";
@@ -482,7 +483,12 @@ CallResult<void> ApplicationFactory::release(Application &app) {
   }
   services_.allocator->release(app.placements);
   app.placements.clear();
-  return terminated.map([](auto &&) {});
+  // A component whose node is gone cannot be terminated by it, and is gone with it.
+  for (std::size_t i = 0; i < terminated.size(); ++i)
+    if (!terminated[i] && terminated[i].error().status != Status::Unavailable &&
+        terminated[i].error().status != Status::NotFound)
+      return first_failure(terminations, terminated);
+  return {};
 }
 
 } // namespace rsca::domain

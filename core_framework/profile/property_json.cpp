@@ -85,11 +85,12 @@ Result<Scalar> integer_as(TypeSpec spec, const Json &original, const Json &json)
     fits = json.get<std::uint64_t>() <= std::uint64_t{kMax};
   } else {
     const auto v = json.get<std::int64_t>();
-    fits = v >= std::int64_t{kMin} && (v < 0 || static_cast<std::uint64_t>(v) <= std::uint64_t{kMax});
+    fits =
+        v >= std::int64_t{kMin} && (v < 0 || static_cast<std::uint64_t>(v) <= std::uint64_t{kMax});
   }
   if (!fits)
-    return failure(fmt::format("{} is out of range for {} ({}..{})", shown(original), type_label(spec),
-                               +kMin, +kMax));
+    return failure(fmt::format("{} is out of range for {} ({}..{})", shown(original),
+                               type_label(spec), +kMin, +kMax));
   return Scalar(std::in_place_type<T>, json.get<T>());
 }
 
@@ -214,8 +215,7 @@ Result<Scalar> check_enumeration(const std::vector<Enumeration> &enumerations, c
                              enumeration_list(enumerations)));
 }
 
-Result<Scalar> check_range(const std::optional<ValueRange> &range, const Json &json,
-                           Scalar value) {
+Result<Scalar> check_range(const std::optional<ValueRange> &range, const Json &json, Scalar value) {
   if (!range)
     return value;
   const bool inside = satisfies(Action::Ge, value, range->min).value_or(true) &&
@@ -313,7 +313,9 @@ Result<PropertyValue> value_from_json(const PropertyDefinition &definition, cons
 
 } // namespace
 
-Json to_json(const Scalar &value) { return std::visit(ScalarToJson{}, value); }
+Json to_json(const Scalar &value) {
+  return std::visit(ScalarToJson{}, value);
+}
 
 Json to_json(const PropertyValue &value) {
   if (const auto *scalar = std::get_if<Scalar>(&value))
@@ -336,8 +338,7 @@ tl::expected<PropertyValue, std::string> from_json(const PropertyDefinition &def
                                                    const nlohmann::json &json) {
   auto value = value_from_json(definition, json);
   if (!value)
-    return failure(
-        fmt::format("property \"{}\": {}", common_of(definition).id, value.error()));
+    return failure(fmt::format("property \"{}\": {}", common_of(definition).id, value.error()));
   return value;
 }
 

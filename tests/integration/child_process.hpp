@@ -15,7 +15,7 @@
 
 #include <poll.h>
 #include <spawn.h>
-#include <sys/pidfd.h>
+#include <sys/syscall.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -54,7 +54,8 @@ public:
       pid_ = -1;
       FAIL("cannot start " << path << ": " << std::strerror(rc));
     }
-    pidfd_ = pidfd_open(pid_, 0);
+    // glibc's <sys/pidfd.h> lacks extern "C" in this version: the system call directly.
+    pidfd_ = static_cast<int>(::syscall(SYS_pidfd_open, pid_, 0));
     if (pidfd_ < 0) {
       const int error = errno;
       ::kill(pid_, SIGKILL); // the destructor does not run for a constructor that throws

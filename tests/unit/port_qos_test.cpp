@@ -13,7 +13,9 @@ using profile::ConnectionQos;
 
 namespace {
 
-Duration duration(std::chrono::nanoseconds value) { return Duration{value}; }
+Duration duration(std::chrono::nanoseconds value) {
+  return Duration{value};
+}
 
 dds::Qos qos_of(const Json &json) {
   INFO("QoS " << json.dump());
@@ -166,6 +168,11 @@ TEST_CASE("bad QoS JSON is refused, naming the key", "[port_qos]") {
   CHECK(error_of({{"reliability", "sometimes"}}) ==
         "\"reliability\" is \"sometimes\", not one of besteffort, reliable");
   CHECK(error_of({{"depth", 0}}) == "\"depth\" is 0, not an integer from 1 to 2147483647");
+  // As received: numbers >= 0 parse as unsigned.
+  CHECK(error_of(Json::parse(R"({"depth": 0})")) ==
+        "\"depth\" is 0, not an integer from 1 to 2147483647");
+  CHECK(error_of(Json::parse(R"({"strength": 2147483648})")) ==
+        "\"strength\" is 2147483648, not an integer from -2147483648 to 2147483647");
   CHECK(error_of({{"strength", "high"}}) ==
         "\"strength\" is \"high\", not an integer from -2147483648 to 2147483647");
   CHECK(error_of({{"deadline_ns", -1}}) ==

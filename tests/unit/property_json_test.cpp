@@ -152,7 +152,8 @@ TEST_CASE("numbers outside their type or the PRF range are refused", "[property_
   auto rate = simple("rate_hz", SimpleType::Double);
   rate.range = ValueRange{Scalar(0.1), Scalar(10000.0)};
   CHECK(scalar_of<double>(rate, 10000) == 10000.0);
-  CHECK(error_of(rate, 1e9) == "property \"rate_hz\": 1000000000.0 is outside its range 0.1..10000");
+  CHECK(error_of(rate, 1e9) ==
+        "property \"rate_hz\": 1000000000.0 is outside its range 0.1..10000");
   auto seq = sequence("gains", SimpleType::Long);
   seq.range = ValueRange{Scalar(std::int32_t{0}), Scalar(std::int32_t{10})};
   CHECK(error_of(seq, Json::array({1, 11})) ==
@@ -168,8 +169,7 @@ TEST_CASE("a simple with enumerations takes their values or labels only", "[prop
   CHECK(error_of(mode, "auto") == "property \"mode\": \"auto\" is not a short");
 }
 
-TEST_CASE("structs are objects of their members; unknown members are refused",
-          "[property_json]") {
+TEST_CASE("structs are objects of their members; unknown members are refused", "[property_json]") {
   const PropertyDefinition stream = stream_struct();
   round_trips(stream, {{"stream_id", "s1"}, {"sample_rate", 48000.0}, {"taps", {0.5, 0.25}}});
   // A configure may name some members only.
@@ -189,7 +189,8 @@ TEST_CASE("struct sequences are arrays of objects", "[property_json]") {
   streams.id = "streams";
   streams.element = stream_struct();
   const PropertyDefinition definition = streams;
-  round_trips(definition, Json::array({{{"stream_id", "a"}}, {{"stream_id", "b"}, {"taps", {1.0}}}}));
+  round_trips(definition,
+              Json::array({{{"stream_id", "a"}}, {{"stream_id", "b"}, {"taps", {1.0}}}}));
   CHECK(error_of(definition, Json::array({{{"stream_id", "a"}}, {{"stream_id", 3}}})) ==
         "property \"streams\": element 1: member \"stream_id\": 3 is not a string");
 }

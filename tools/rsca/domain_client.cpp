@@ -64,7 +64,10 @@ int exit_code_of(control::Status status) {
 
 int report_failure(const GlobalOptions &global, const std::string &what, const control::CallError &error) {
   std::string message = error.message;
-  if (error.status == control::Status::Unavailable || error.status == control::Status::Timeout)
+  // The hint only when the domain itself did not answer, not a component during a launch.
+  const bool domain_silent = message.find(global.domain + "/domain") != std::string::npos &&
+                             message.find("launch of") == std::string::npos;
+  if (domain_silent)
     message += fmt::format(" (is the domain \"{}\" up on DDS domain {}? see `rsca domain up`)", global.domain,
                            dds::DdsSettings::from_environment().domain_id);
   if (global.json) {

@@ -1,0 +1,97 @@
+// Private to the component runtime: one component behind its control endpoint. The host checks
+// the component against its profile, serves the component.* operations (docs/architecture.md),
+// keeps the announcement up to date with the component's state, and runs the service thread and
+// the receive thread.
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <string_view>
+#include <thread>
+#include <utility>
+#include <vector>
+
+#include "component/component.hpp"
+#include "component/receive_loop.hpp"
+#include "control/endpoint.hpp"
+#include "dds/participant.hpp"
+#include "profile/profile_loader.hpp"
+
+namespace rsca::component::detail {
+
+using control::CallResult;
+using control::Json;
+
+class Host {
+public:
+  Host(std::unique_ptr<Component> component,
+       std::shared_ptr<const profile::ResolvedSoftPkg> softpkg)
+      : component_(std::move(component)), softpkg_(std::move(softpkg)) {}
+  ~Host() { close(); }
+  Host(const Host &) = delete;
+  Host &operator=(const Host &) = delete;
+
+  // Checks the bindings against the PRF and the ports against the SCD, then applies the PRF
+  // defaults and the execparams (DEBUG_LEVEL sets the log level).
+  Expected<void> prepare(const std::vector<std::pair<std::string, std::string>> &execparams);
+  // Starts the receive thread, opens the endpoint, serves the operations and announces.
+  // `on_released` runs once the component is released, by component.release or shutdown.
+  Expected<void> open(std::shared_ptr<dds::Participant> participant,
+                      std::function<void()> on_released);
+  // Stops (when started) and releases the component and drops its connections. Idempotent.
+  void shutdown(std::string_view why);
+  // Withdraws the announcement, closes the endpoint (waiting for running operations), stops the
+  // threads and destroys the component. Idempotent.
+  void close();
+  // No operation handler is running.
+  bool idle() const { return in_flight_.load() == 0; }
+
+private:
+  using Operation = CallResult<Json> (Host::*)(const Json &);
+
+  Expected<void> check_ports() const;
+  void serve(const std::string &operation, Operation op);
+  Json announcement() const;
+  void set_state(State state);
+  PortBase *find_port(const std::string &name) const;
+  void poll_ports();
+  void start_service();
+  void stop_service();
+  void service_loop();
+  void stop_component();
+
+  CallResult<Json> op_initialize(const Json &body);
+  CallResult<Json> op_configure(const Json &body);
+  CallResult<Json> op_query(const Json &body);
+  CallResult<Json> op_connect(const Json &body);
+  CallResult<Json> op_disconnect(const Json &body);
+  CallResult<Json> op_start(const Json &body);
+  CallResult<Json> op_stop(const Json &body);
+  CallResult<Json> op_status(const Json &body);
+  CallResult<Json> op_release(const Json &body);
+
+  Component &c() const { return *component_; }
+  spdlog::logger &log() const { return component_->log(); }
+
+  std::unique_ptr<Component> component_;
+  std::shared_ptr<const profile::ResolvedSoftPkg> softpkg_;
+  std::shared_ptr<dds::Participant> participant_;
+  std::unique_ptr<ReceiveLoop> loop_;
+  std::unique_ptr<control::Endpoint> endpoint_;
+  std::function<void()> on_released_;
+
+  std::mutex lifecycle_; // one lifecycle operation at a time
+  std::atomic<bool> delivering_{false};
+  std::atomic<int> in_flight_{0};
+
+  std::mutex service_mutex_;
+  std::condition_variable service_wake_;
+  bool service_stopping_ = false;
+  std::thread service_thread_;
+};
+
+} // namespace rsca::component::detail

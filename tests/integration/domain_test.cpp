@@ -1,0 +1,312 @@
+// The whole product with real processes: rsca-domaind and two rsca-noded on loopback, on a DDS
+// domain of their own, driven through the CLI and the control plane. Each test checks that what
+// it launched leaves nothing behind: no component process, no allocation, no application.
+#include <signal.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <thread>
+
+#include <catch2/catch.hpp>
+#include <fmt/format.h>
+#include <future>
+
+#include "child_process.hpp"
+#include "control/endpoint.hpp"
+#include "../unit/test_domain.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+using rsca::control::Json;
+using rsca::control::Status;
+using rsca::test::ChildProcess;
+
+const fs::path kBin = RSCA_BIN_DIR;
+const fs::path kSource = RSCA_SOURCE_DIR;
+const fs::path kTestSdr = kSource / "tests/data/integration";
+
+bool process_exists(long pid) {
+  if (pid <= 0)
+    return false;
+  std::ifstream stat(fmt::format("/proc/{}/stat", pid));
+  std::string state;
+  if (!stat)
+    return false;
+  std::string skip;
+  stat >> skip >> skip >> state;
+  return state != "Z"; // a zombie has exited; its parent has not reaped it yet
+}
+
+// A domain daemon and `nodes` node daemons, stopped (nodes first, gracefully) when it goes.
+class TestDomain {
+public:
+  explicit TestDomain(int nodes = 2, int registration_timeout_ms = 3000)
+      : run_(fs::temp_directory_path() / fmt::format("rsca-it-{}-{}", getpid(), std::random_device{}())) {
+    fs::create_directories(run_ / "logs");
+    env_ = {{"RSCA_DDS_DOMAIN", std::to_string(rsca::test::isolated_domain_id())}};
+    domaind_ = std::make_unique<ChildProcess>(
+        (kBin / "rsca-domaind").string(),
+        std::vector<std::string>{"--dmd", (kSource / "profiles/dom/domain/DomainManager.dmd.xml").string(),
+                                 "--repository", (run_ / "repository").string(),
+                                 "--registration-timeout-ms", std::to_string(registration_timeout_ms)},
+        env_);
+    for (int i = 1; i <= nodes; ++i)
+      nodes_.push_back(std::make_unique<ChildProcess>(
+          (kBin / "rsca-noded").string(),
+          std::vector<std::string>{"--dcd",
+                                   (kSource / fmt::format("profiles/dev/nodes/node{}/DeviceManager.dcd.xml", i)).string(),
+                                   "--log-dir", (run_ / "logs").string(), "--exec-path", kBin.string()},
+          env_));
+    auto pp = rsca::test::participant();
+    auto endpoint = rsca::control::Endpoint::open(pp, fmt::format("rsca/cli/test-{}", getpid()));
+    REQUIRE(endpoint.has_value());
+    participant_ = pp;
+    client_ = std::move(*endpoint);
+    REQUIRE(wait_for([&] {
+      auto r = call("domain.nodes");
+      return r && r->at("nodes").size() == static_cast<std::size_t>(nodes);
+    }));
+  }
+
+  ~TestDomain() {
+    for (auto &n : nodes_)
+      if (n) {
+        n->signal(SIGTERM);
+        n->wait_exit(5s);
+      }
+    if (domaind_) {
+      domaind_->signal(SIGTERM);
+      domaind_->wait_exit(5s);
+    }
+    std::error_code ec;
+    fs::remove_all(run_, ec);
+  }
+
+  rsca::control::CallResult<Json> call(const std::string &op, Json body = Json::object(),
+                                       std::chrono::milliseconds timeout = 10s) {
+    return client_->call_sync("rsca/domain", op, std::move(body), timeout);
+  }
+
+  // Runs the CLI against this domain; returns its exit code and output.
+  std::pair<int, std::string> cli(const std::vector<std::string> &args) {
+    const fs::path out = run_ / "cli.out";
+    std::vector<std::string> sh_args{"-c", "\"$0\" \"$@\" > " + out.string() + " 2>&1", (kBin / "rsca").string()};
+    sh_args.insert(sh_args.end(), args.begin(), args.end());
+    ChildProcess cli("/bin/sh", sh_args, env_);
+    auto status = cli.wait_exit(60s);
+    std::ifstream in(out);
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    return {status && WIFEXITED(*status) ? WEXITSTATUS(*status) : -1, text};
+  }
+
+  void install(const std::string &application) {
+    auto [rc, out] = cli({"install", "--sdrroot", kTestSdr.string(),
+                          (kTestSdr / fmt::format("dom/waveforms/{0}/{0}.sad.xml", application)).string()});
+    INFO(out);
+    REQUIRE(rc == 0);
+  }
+
+  // Nothing of any application is left: no application, no allocation, no component process.
+  void require_clean(const std::vector<long> &pids) {
+    auto apps = call("app.list");
+    REQUIRE(apps.has_value());
+    CHECK(apps->at("applications").empty());
+    auto devices = call("domain.devices");
+    REQUIRE(devices.has_value());
+    for (const auto &d : devices->at("devices"))
+      for (const auto &[name, c] : d.at("capacity").items()) {
+        INFO(d.at("id") << " " << name);
+        CHECK(c.at("allocated").get<double>() == Approx(0.0).margin(1e-9));
+      }
+    for (long pid : pids) {
+      INFO("component pid " << pid);
+      CHECK(wait_for([&] { return !process_exists(pid); }));
+    }
+    for (int i = 0; i < static_cast<int>(nodes_.size()); ++i) {
+      if (!nodes_[i])
+        continue;
+      auto status = client_->call_sync(fmt::format("rsca/node/node{}", i + 1), "node.status", Json::object(), 5s);
+      REQUIRE(status.has_value());
+      CHECK(status->at("processes").empty());
+    }
+  }
+
+  // Every component process the nodes run now.
+  std::vector<long> running_pids() {
+    std::vector<long> pids;
+    for (int i = 0; i < static_cast<int>(nodes_.size()); ++i) {
+      if (!nodes_[i])
+        continue;
+      auto status = client_->call_sync(fmt::format("rsca/node/node{}", i + 1), "node.status", Json::object(), 5s);
+      if (status)
+        for (const auto &p : status->at("processes"))
+          pids.push_back(p.at("pid").get<long>());
+    }
+    return pids;
+  }
+
+  void kill_node(int index) {
+    nodes_[index - 1]->signal(SIGKILL);
+    nodes_[index - 1]->wait_exit(5s);
+    nodes_[index - 1].reset();
+  }
+
+  template <typename Predicate>
+  static bool wait_for(Predicate done, std::chrono::milliseconds limit = 10s) {
+    const auto deadline = std::chrono::steady_clock::now() + limit;
+    while (std::chrono::steady_clock::now() < deadline) {
+      if (done())
+        return true;
+      std::this_thread::sleep_for(20ms); // pacing a poll of real processes
+    }
+    return done();
+  }
+
+  const fs::path &run_dir() const { return run_; }
+
+private:
+  fs::path run_;
+  ChildProcess::Environment env_;
+  std::unique_ptr<ChildProcess> domaind_;
+  std::vector<std::unique_ptr<ChildProcess>> nodes_;
+  std::shared_ptr<rsca::dds::Participant> participant_;
+  std::unique_ptr<rsca::control::Endpoint> client_;
+};
+
+std::vector<long> pids_of(const Json &app) {
+  std::vector<long> pids;
+  for (const auto &c : app.at("components"))
+    pids.push_back(c.at("pid").get<long>());
+  return pids;
+}
+
+long received(TestDomain &domain, const std::string &app) {
+  auto q = domain.call("app.query", Json{{"app", app}, {"component", "Consumer_1"}, {"ids", {"received"}}});
+  if (!q)
+    return -1;
+  return q->at("properties").at("received").get<long>();
+}
+
+} // namespace
+
+TEST_CASE("ProducerConsumer: install, launch, data flows, configure, query, stop, release",
+          "[integration][domain]") {
+  TestDomain domain;
+  auto [rc, out] = domain.cli({"launch", (kSource / "profiles/dom/waveforms/ProducerConsumer/ProducerConsumer.sad.xml").string()});
+  INFO(out);
+  REQUIRE(rc == 0);
+  auto app = domain.call("app.show", Json{{"app", "ProducerConsumer"}});
+  REQUIRE(app.has_value());
+  CHECK(app->at("state") == "running");
+  REQUIRE(app->at("components").size() == 2);
+  const auto pids = pids_of(*app);
+  for (long pid : pids)
+    CHECK(process_exists(pid));
+
+  // Data flows across the connection: the consumer's count grows.
+  CHECK(TestDomain::wait_for([&] { return received(domain, "ProducerConsumer") > 20; }));
+
+  // Configure and query, typed against the PRF.
+  auto [crc, cout_text] = domain.cli({"configure", "ProducerConsumer/Producer_1", "rate_hz=200"});
+  INFO(cout_text);
+  CHECK(crc == 0);
+  auto q = domain.call("app.query", Json{{"app", "ProducerConsumer"}, {"component", "Producer_1"}, {"ids", {"rate_hz"}}});
+  REQUIRE(q.has_value());
+  CHECK(q->at("properties").at("rate_hz").get<double>() == 200.0);
+  auto [brc, bad] = domain.cli({"configure", "ProducerConsumer/Producer_1", "rate_hz=fast"});
+  CHECK(brc == 1);
+  CHECK_THAT(bad, Catch::Contains("\"fast\" is not a valid double"));
+  q = domain.call("app.query", Json{{"app", "ProducerConsumer"}, {"component", "Producer_1"}, {"ids", {"rate_hz"}}});
+  CHECK(q->at("properties").at("rate_hz").get<double>() == 200.0); // nothing applied
+
+  // Stop, start, release.
+  REQUIRE(domain.call("app.stop", Json{{"app", "ProducerConsumer"}}).has_value());
+  REQUIRE(domain.call("app.start", Json{{"app", "ProducerConsumer"}}).has_value());
+  auto [rrc, rout] = domain.cli({"release", "ProducerConsumer"});
+  INFO(rout);
+  CHECK(rrc == 0);
+  domain.require_clean(pids);
+}
+
+TEST_CASE("a missing executable fails the launch at execute and rolls back", "[integration][domain][failure]") {
+  TestDomain domain;
+  domain.install("MissingExecutable");
+  auto [rc, out] = domain.cli({"launch", "MissingExecutable"});
+  CHECK(rc == 6);
+  CHECK_THAT(out, Catch::Contains("failed at step 'execute'"));
+  CHECK_THAT(out, Catch::Contains("rsca-no-such-program"));
+  CHECK_THAT(out, Catch::Contains("rolled back"));
+  domain.require_clean({});
+  CHECK(domain.running_pids().empty());
+}
+
+TEST_CASE("a component crashing at start fails the launch and rolls back", "[integration][domain][failure]") {
+  TestDomain domain;
+  domain.install("CrashAtStart");
+  auto [rc, out] = domain.cli({"launch", "CrashAtStart"});
+  CHECK(rc != 0);
+  CHECK_THAT(out, Catch::Contains("failed at step 'start'"));
+  CHECK_THAT(out, Catch::Contains("Victim_1"));
+  CHECK(TestDomain::wait_for([&] { return domain.running_pids().empty(); }));
+  domain.require_clean({});
+}
+
+TEST_CASE("a component that never registers fails the launch at register", "[integration][domain][failure]") {
+  TestDomain domain(2, /*registration_timeout_ms=*/1500);
+  domain.install("NeverRegisters");
+  auto [rc, out] = domain.cli({"launch", "NeverRegisters"});
+  CHECK(rc == 4); // a timeout
+  CHECK_THAT(out, Catch::Contains("failed at step 'register'"));
+  CHECK_THAT(out, Catch::Contains("Victim_1"));
+  domain.require_clean({});
+  CHECK(domain.running_pids().empty());
+}
+
+TEST_CASE("a property value of the wrong type is refused at install, before anything runs",
+          "[integration][domain][failure]") {
+  TestDomain domain;
+  auto [rc, out] = domain.cli({"install", "--sdrroot", kTestSdr.string(),
+                               (kTestSdr / "dom/waveforms/WrongValueType/WrongValueType.sad.xml").string()});
+  CHECK(rc == 1);
+  CHECK_THAT(out, Catch::Contains("WrongValueType.sad.xml:26:52"));
+  CHECK_THAT(out, Catch::Contains("\"eleven\" is not a valid ulong"));
+  auto installed = domain.call("domain.installed");
+  REQUIRE(installed.has_value());
+  CHECK(installed->at("applications").empty());
+}
+
+TEST_CASE("no device that matches: the launch is rejected with the reason per device",
+          "[integration][domain][failure]") {
+  TestDomain domain;
+  domain.install("NoMatchingDevice");
+  auto [rc, out] = domain.cli({"launch", "NoMatchingDevice"});
+  CHECK(rc == 5);
+  CHECK_THAT(out, Catch::Contains("failed at step 'allocate'"));
+  CHECK_THAT(out, Catch::Contains("node1:GPP_1 (cpp): os_name is Linux, implementation cpp needs VxWorks"));
+  CHECK_THAT(out, Catch::Contains("node2:GPP_1"));
+  domain.require_clean({});
+}
+
+TEST_CASE("a node daemon killed during a launch fails it, and the rest is rolled back",
+          "[integration][domain][failure]") {
+  TestDomain domain;
+  domain.install("HangAtConfigure");
+  // Both components land on node1 (first fit); the launch hangs in configure, and node1 dies.
+  auto launch = std::async(std::launch::async, [&] { return domain.cli({"launch", "HangAtConfigure"}); });
+  REQUIRE(TestDomain::wait_for([&] { return domain.running_pids().size() == 2; }));
+  const auto pids = domain.running_pids();
+  domain.kill_node(1);
+  auto [rc, out] = launch.get();
+  INFO(out);
+  CHECK(rc != 0);
+  CHECK_THAT(out, Catch::Contains("failed at step"));
+  // The node's components die with it; nothing stays allocated; the domain forgot node1.
+  domain.require_clean(pids);
+  auto nodes = domain.call("domain.nodes");
+  REQUIRE(nodes.has_value());
+  CHECK(nodes->at("nodes").size() == 1);
+}
