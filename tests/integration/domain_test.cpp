@@ -149,6 +149,18 @@ public:
     return pids;
   }
 
+  // Stops the domain daemon and starts a new one on the same repository.
+  void restart_domaind(int registration_timeout_ms = 3000) {
+    domaind_->signal(SIGTERM);
+    REQUIRE(domaind_->wait_exit(5s).has_value());
+    domaind_ = std::make_unique<ChildProcess>(
+        (kBin / "rsca-domaind").string(),
+        std::vector<std::string>{"--dmd", (kSource / "profiles/dom/domain/DomainManager.dmd.xml").string(),
+                                 "--repository", (run_ / "repository").string(),
+                                 "--registration-timeout-ms", std::to_string(registration_timeout_ms)},
+        env_);
+  }
+
   void kill_node(int index) {
     nodes_[index - 1]->signal(SIGKILL);
     nodes_[index - 1]->wait_exit(5s);
@@ -309,4 +321,51 @@ TEST_CASE("a node daemon killed during a launch fails it, and the rest is rolled
   auto nodes = domain.call("domain.nodes");
   REQUIRE(nodes.has_value());
   CHECK(nodes->at("nodes").size() == 1);
+}
+
+TEST_CASE("a restarted domain daemon sees every node again and keeps what was installed",
+          "[integration][domain][recovery]") {
+  TestDomain domain;
+  domain.install("Healthy");
+  domain.restart_domaind();
+  // The nodes do nothing: their durable announcements reach the new domain daemon.
+  CHECK(TestDomain::wait_for([&] {
+    auto nodes = domain.call("domain.nodes", Json::object(), 2s);
+    return nodes && nodes->at("nodes").size() == 2;
+  }));
+  auto installed = domain.call("domain.installed");
+  REQUIRE(installed.has_value());
+  REQUIRE(installed->at("applications").size() == 1);
+  CHECK(installed->at("applications")[0].at("name") == "Healthy");
+  auto app = domain.call("app.create", Json{{"application", "Healthy"}});
+  INFO((app ? std::string() : app.error().message));
+  REQUIRE(app.has_value());
+  const auto pids = pids_of(*app);
+  REQUIRE(domain.call("app.release", Json{{"app", "Healthy"}}).has_value());
+  domain.require_clean(pids);
+}
+
+TEST_CASE("a component that crashes after launch is reported to the domain",
+          "[integration][domain][failure]") {
+  TestDomain domain;
+  domain.install("Healthy");
+  auto app = domain.call("app.create", Json{{"application", "Healthy"}});
+  REQUIRE(app.has_value());
+  long victim = 0;
+  for (const auto &c : app->at("components"))
+    if (c.at("id") == "Victim_1")
+      victim = c.at("pid").get<long>();
+  REQUIRE(victim > 0);
+  ::kill(static_cast<pid_t>(victim), SIGSEGV);
+  CHECK(TestDomain::wait_for([&] {
+    auto shown = domain.call("app.show", Json{{"app", "Healthy"}});
+    if (!shown)
+      return false;
+    for (const auto &c : shown->at("components"))
+      if (c.at("id") == "Victim_1")
+        return c.at("state") == "exited";
+    return false;
+  }));
+  REQUIRE(domain.call("app.release", Json{{"app", "Healthy"}}).has_value());
+  domain.require_clean(pids_of(*app));
 }
