@@ -180,16 +180,11 @@ void Host::close() {
   participant_.reset();
 }
 
-// Runs `op` for `operation`: exceptions become errors, and running handlers are counted.
+// Runs `op` for `operation`: exceptions become errors.
 void Host::serve(const std::string &operation, Operation op) {
   endpoint_->on(
       operation,
       [this, op](const Json &body, const control::RequestContext &context) -> CallResult<Json> {
-        ++in_flight_;
-        struct Done {
-          std::atomic<int> &count;
-          ~Done() { --count; }
-        } done{in_flight_};
         log().debug("{} from {}", context.operation, context.sender);
         try {
           return (this->*op)(body);

@@ -47,8 +47,6 @@ public:
   // Withdraws the announcement, closes the endpoint (waiting for running operations), stops the
   // threads and destroys the component. Idempotent.
   void close();
-  // No operation handler is running.
-  bool idle() const { return in_flight_.load() == 0; }
 
 private:
   using Operation = CallResult<Json> (Host::*)(const Json &);
@@ -86,7 +84,6 @@ private:
 
   std::mutex lifecycle_; // one lifecycle operation at a time
   std::atomic<bool> delivering_{false};
-  std::atomic<int> in_flight_{0};
 
   std::mutex service_mutex_;
   std::condition_variable service_wake_;

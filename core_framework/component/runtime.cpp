@@ -149,18 +149,10 @@ void wait_for_exit(const ExitEvents &events, detail::Host &host, spdlog::logger 
       host.shutdown(signal == SIGINT ? "SIGINT" : "SIGTERM");
       return;
     }
+    // Closing the host afterwards waits for the release handler and delivers its reply.
     if (event == ExitEvents::Event::Released)
-      break;
+      return;
   }
-  // The release handler has returned or is about to; its reply is written after it returns.
-  // Give that a bounded moment before the endpoint goes.
-  const auto deadline = Clock::now() + 2s;
-  while (!host.idle() && Clock::now() < deadline) {
-    int ignored = 0;
-    events.wait(10ms, ignored);
-  }
-  int ignored = 0;
-  events.wait(100ms, ignored);
 }
 
 int run_host(const ExecParams &params, const ExitEvents &events, const Factory &factory,

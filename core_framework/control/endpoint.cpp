@@ -172,6 +172,10 @@ struct Endpoint::Impl {
   void serve(RequestContext context, Json body);
   void send_request(std::string id, std::string target, std::string operation, std::string body);
   void complete(const std::string &id, CallResult<Json> result);
+  // The writer into `partition`, created when there is none yet.
+  CallResult<dds_entity_t> writer_for(std::map<std::string, PartitionWriter> &cache,
+                                      dds_entity_t topic, const std::string &partition);
+  // The same, once a reader in that partition is matched (or an error at the deadline).
   CallResult<dds_entity_t> writer_to(std::map<std::string, PartitionWriter> &cache,
                                      dds_entity_t topic, const std::string &partition,
                                      Clock::time_point deadline);
@@ -402,35 +406,39 @@ void Endpoint::Impl::expire_calls() {
     promise.set_value(tl::unexpected(std::move(error)));
 }
 
+CallResult<dds_entity_t> Endpoint::Impl::writer_for(std::map<std::string, PartitionWriter> &cache,
+                                                    dds_entity_t topic, const std::string &partition) {
+  std::lock_guard lock(writers_mutex);
+  if (auto it = cache.find(partition); it != cache.end())
+    return it->second.writer.get();
+  auto pqos = partition_qos(partition);
+  auto publisher = dds::checked(dds_create_publisher(participant->get(), pqos.get(), nullptr),
+                                "creating a publisher");
+  if (!publisher)
+    return call_error(Status::Failed, publisher.error().to_string());
+  auto qos = control_qos();
+  auto w = dds::checked(dds_create_writer(publisher->get(), topic, qos.get(), nullptr),
+                        "creating a writer");
+  if (!w)
+    return call_error(Status::Failed, w.error().to_string());
+  dds_set_status_mask(w->get(), DDS_PUBLICATION_MATCHED_STATUS);
+  const dds_entity_t writer = w->get();
+  cache.emplace(partition, PartitionWriter{std::move(*publisher), std::move(*w)});
+  return writer;
+}
+
 CallResult<dds_entity_t> Endpoint::Impl::writer_to(std::map<std::string, PartitionWriter> &cache,
                                                    dds_entity_t topic, const std::string &partition,
                                                    Clock::time_point deadline) {
-  dds_entity_t writer = 0;
-  {
-    std::lock_guard lock(writers_mutex);
-    auto it = cache.find(partition);
-    if (it == cache.end()) {
-      auto pqos = partition_qos(partition);
-      auto publisher = dds::checked(dds_create_publisher(participant->get(), pqos.get(), nullptr),
-                                    "creating a publisher");
-      if (!publisher)
-        return call_error(Status::Failed, publisher.error().to_string());
-      auto qos = control_qos();
-      auto w = dds::checked(dds_create_writer(publisher->get(), topic, qos.get(), nullptr),
-                            "creating a writer");
-      if (!w)
-        return call_error(Status::Failed, w.error().to_string());
-      dds_set_status_mask(w->get(), DDS_PUBLICATION_MATCHED_STATUS);
-      it = cache.emplace(partition, PartitionWriter{std::move(*publisher), std::move(*w)}).first;
-    }
-    writer = it->second.writer.get();
-  }
+  auto writer = writer_for(cache, topic, partition);
+  if (!writer)
+    return writer;
   // Volatile data written before the reader is matched is lost: wait for the match first.
   Entity ws(dds_create_waitset(participant->get()));
-  dds_waitset_attach(ws.get(), writer, writer);
+  dds_waitset_attach(ws.get(), *writer, *writer);
   for (;;) {
     dds_publication_matched_status_t status{};
-    if (dds_get_publication_matched_status(writer, &status) == 0 && status.current_count > 0)
+    if (dds_get_publication_matched_status(*writer, &status) == 0 && status.current_count > 0)
       return writer;
     const auto left = deadline - Clock::now();
     if (left <= Clock::duration::zero() || stopping.load())
@@ -530,6 +538,17 @@ std::future<CallResult<Json>> Endpoint::call(const std::string &target, const st
     impl->send_request(std::move(id), std::move(target), std::move(operation), std::move(text));
   });
   return future;
+}
+
+void Endpoint::prepare(const std::string &target) {
+  if (auto writer = impl_->writer_for(impl_->request_writers, impl_->request_topic.get(), target); !writer)
+    spdlog::debug("preparing the way to {}: {}", target, writer.error().message);
+}
+
+void Endpoint::forget(const std::string &target) {
+  std::lock_guard lock(impl_->writers_mutex);
+  impl_->request_writers.erase(target);
+  impl_->reply_writers.erase(target);
 }
 
 Expected<void> Endpoint::announce(const std::string &kind, const Json &body) {

@@ -74,6 +74,9 @@ class Endpoint {
 public:
   static Expected<std::unique_ptr<Endpoint>> open(std::shared_ptr<dds::Participant> participant,
                                                   std::string address, EndpointOptions options = {});
+  // Closes: running handlers finish and write their replies, then the endpoint's DDS entities
+  // go. Cyclone lingers a deleted reliable writer until its data is acknowledged (bounded by
+  // WriterLingerDuration), so the last replies still reach their callers.
   ~Endpoint();
   Endpoint(const Endpoint &) = delete;
   Endpoint &operator=(const Endpoint &) = delete;
@@ -89,6 +92,12 @@ public:
                              std::chrono::milliseconds timeout) {
     return call(target, operation, std::move(body), timeout).get();
   }
+
+  // Creates the way to `target` ahead of the first call, so that DDS discovery of an endpoint
+  // that is about to appear overlaps with whatever happens before that call.
+  void prepare(const std::string &target);
+  // Drops the way to and from `target` (an endpoint that is gone for good).
+  void forget(const std::string &target);
 
   // Publishes (or updates) this endpoint's announcement; `withdraw` removes it.
   Expected<void> announce(const std::string &kind, const Json &body);

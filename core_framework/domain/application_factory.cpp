@@ -7,6 +7,7 @@
 #include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
+#include "common/elapsed.hpp"
 #include "dds/port_qos.hpp"
 #include "profile/property_binding.hpp"
 #include "profile/property_json.hpp"
@@ -18,10 +19,6 @@ using Clock = std::chrono::steady_clock;
 using control::CallResult;
 using control::Json;
 using control::Status;
-
-double ms_since(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 // One call of many made at once.
 struct Call {
@@ -158,8 +155,11 @@ private:
 
   CallResult<void> execute() {
     std::vector<Call> calls;
-    for (auto &c : app_->components)
+    // Discovery of each component's endpoint starts now and overlaps with its process start.
+    for (auto &c : app_->components) {
       s_.components->expect(c.address);
+      s_.endpoint->prepare(c.address);
+    }
     for (auto &c : app_->components) {
       auto node = s_.node_address(c.node);
       if (!node)
@@ -460,12 +460,20 @@ CallResult<void> ApplicationFactory::stop(Application &app) {
   return ok;
 }
 
-CallResult<void> ApplicationFactory::release(Application &app) {
+CallResult<std::vector<std::string>> ApplicationFactory::release(Application &app) {
   std::vector<Call> releases;
   for (auto &c : app.components)
     if (c.pid != 0 && services_.components->registered(c.address))
       releases.push_back({c.address, "component.release", Json::object(), c.id});
-  call_all(*services_.endpoint, releases, services_.call_timeout);
+  const auto released = call_each_of(*services_.endpoint, releases, services_.call_timeout);
+  std::vector<std::string> unconfirmed;
+  for (std::size_t i = 0; i < released.size(); ++i) {
+    if (released[i])
+      continue;
+    spdlog::warn("{} of application {} did not confirm its release ({}); its node terminates it",
+                 releases[i].what, app.name, released[i].error().message);
+    unconfirmed.push_back(releases[i].what);
+  }
   // Whatever is still running is terminated by its node; the node reaps every process.
   std::vector<Call> terminations;
   for (auto &c : app.components) {
@@ -478,6 +486,7 @@ CallResult<void> ApplicationFactory::release(Application &app) {
   auto terminated = call_each_of(*services_.endpoint, terminations, services_.call_timeout);
   for (auto &c : app.components) {
     services_.components->forget(c.address);
+    services_.endpoint->forget(c.address);
     c.state = "released";
     c.pid = 0;
   }
@@ -487,8 +496,8 @@ CallResult<void> ApplicationFactory::release(Application &app) {
   for (std::size_t i = 0; i < terminated.size(); ++i)
     if (!terminated[i] && terminated[i].error().status != Status::Unavailable &&
         terminated[i].error().status != Status::NotFound)
-      return first_failure(terminations, terminated);
-  return {};
+      return tl::unexpected(first_failure(terminations, terminated).error());
+  return unconfirmed;
 }
 
 } // namespace rsca::domain

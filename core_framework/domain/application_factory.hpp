@@ -56,8 +56,9 @@ public:
   control::CallResult<void> start(Application &app);
   control::CallResult<void> stop(Application &app);
   // Stops, releases and terminates every component, and frees the allocation. Best effort: a
-  // component that does not answer is terminated by its node.
-  control::CallResult<void> release(Application &app);
+  // component that does not confirm its release is terminated by its node all the same, and
+  // named in the result.
+  control::CallResult<std::vector<std::string>> release(Application &app);
 
   // The DDS topic of one connection: unique per domain, application instance and connection.
   static std::string topic_name(const std::string &domain, const std::string &app,

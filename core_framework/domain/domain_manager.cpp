@@ -1,6 +1,7 @@
 #include "domain/domain_manager.hpp"
 
 #include <atomic>
+#include <chrono>
 #include <fstream>
 #include <sstream>
 
@@ -8,6 +9,7 @@
 #include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
+#include "common/elapsed.hpp"
 #include "profile/profile_loader.hpp"
 #include "profile/property_binding.hpp"
 #include "profile/property_json.hpp"
@@ -36,6 +38,14 @@ struct LaunchProgress {
   std::vector<LaunchStep> steps;
   bool done = false;
 };
+
+Json steps_json(const std::vector<LaunchStep> &steps) {
+  Json out = Json::array();
+  for (const auto &s : steps)
+    out.push_back({{"step", s.step}, {"detail", s.detail}, {"ms", s.milliseconds}});
+  return out;
+}
+
 
 template <typename T>
 CallResult<T> required(const Json &body, const char *key) {
@@ -266,6 +276,7 @@ CallResult<Json> DomainManager::Impl::create_application(const Json &body) {
     std::lock_guard lock(mutex);
     progress->steps.push_back(step);
   };
+  const auto began = std::chrono::steady_clock::now();
   auto app = factory().create(request, record);
   std::lock_guard lock(mutex);
   progress->done = true;
@@ -274,7 +285,9 @@ CallResult<Json> DomainManager::Impl::create_application(const Json &body) {
     return tl::unexpected(app.error());
   }
   applications[request.name] = *app;
-  return to_json(**app);
+  Json reply = to_json(**app);
+  reply["launch"] = {{"steps", steps_json(progress->steps)}, {"ms", ms_since(began)}};
+  return reply;
 }
 
 CallResult<Json> DomainManager::Impl::progress(const Json &body) {
@@ -285,10 +298,7 @@ CallResult<Json> DomainManager::Impl::progress(const Json &body) {
   auto it = launches.find(*id);
   if (it == launches.end())
     return control::call_error(Status::NotFound, fmt::format("no launch {}", *id));
-  Json steps = Json::array();
-  for (const auto &s : it->second->steps)
-    steps.push_back({{"step", s.step}, {"detail", s.detail}, {"ms", s.milliseconds}});
-  return Json{{"steps", steps}, {"done", it->second->done}};
+  return Json{{"steps", steps_json(it->second->steps)}, {"done", it->second->done}};
 }
 
 CallResult<std::shared_ptr<Application>> DomainManager::Impl::find_application(const Json &body) {
@@ -310,12 +320,12 @@ CallResult<Json> DomainManager::Impl::release(const Json &body) {
     std::lock_guard lock(mutex);
     applications.erase((*app)->name);
   }
-  auto ok = factory().release(**app);
+  auto unconfirmed = factory().release(**app);
   spdlog::info("application {} released", (*app)->name);
-  if (!ok)
-    return control::call_error(ok.error().status,
-                               fmt::format("released {} with problems: {}", (*app)->name, ok.error().message));
-  return Json{{"name", (*app)->name}};
+  if (!unconfirmed)
+    return control::call_error(unconfirmed.error().status, fmt::format("released {} with problems: {}",
+                                                                       (*app)->name, unconfirmed.error().message));
+  return Json{{"name", (*app)->name}, {"unconfirmed", *unconfirmed}};
 }
 
 // Where configure/query go: the named component, or else the assembly controller (SCA).

@@ -238,9 +238,11 @@ TEST_CASE("ProducerConsumer: install, launch, data flows, configure, query, stop
   // Stop, start, release.
   REQUIRE(domain.call("app.stop", Json{{"app", "ProducerConsumer"}}).has_value());
   REQUIRE(domain.call("app.start", Json{{"app", "ProducerConsumer"}}).has_value());
-  auto [rrc, rout] = domain.cli({"release", "ProducerConsumer"});
+  // Every component confirms its own release: its last reply is delivered before it exits.
+  auto [rrc, rout] = domain.cli({"--json", "release", "ProducerConsumer"});
   INFO(rout);
-  CHECK(rrc == 0);
+  REQUIRE(rrc == 0);
+  CHECK(Json::parse(rout).at("unconfirmed").empty());
   domain.require_clean(pids);
 }
 
@@ -340,6 +342,13 @@ TEST_CASE("a restarted domain daemon sees every node again and keeps what was in
   auto app = domain.call("app.create", Json{{"application", "Healthy"}});
   INFO((app ? std::string() : app.error().message));
   REQUIRE(app.has_value());
+  // The launch reports every step it took, in SCA order, with its time.
+  std::vector<std::string> steps;
+  for (const auto &s : app->at("launch").at("steps"))
+    steps.push_back(s.at("step"));
+  CHECK(steps == std::vector<std::string>{"check", "allocate", "execute", "register", "initialize",
+                                          "configure", "connect", "start"});
+  CHECK(app->at("launch").at("ms").get<double>() > 0);
   const auto pids = pids_of(*app);
   REQUIRE(domain.call("app.release", Json{{"app", "Healthy"}}).has_value());
   domain.require_clean(pids);

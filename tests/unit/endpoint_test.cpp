@@ -131,3 +131,21 @@ TEST_CASE("announcements are seen, updated and withdrawn", "[control]") {
     return ev.back().address == "test/node1" && ev.back().kind == control::AnnouncementEvent::Kind::Gone;
   }));
 }
+
+TEST_CASE("the way to an endpoint can be prepared before it exists and forgotten after", "[control]") {
+  auto pp = test::participant();
+  auto client = open(pp, "test/client");
+  client->prepare("test/later"); // nobody there yet: no error, no wait
+  auto server = open(pp, "test/later");
+  server->on("ping", [](const Json &, const control::RequestContext &) -> control::CallResult<Json> {
+    return Json{{"pong", true}};
+  });
+  auto reply = client->call_sync("test/later", "ping", Json::object(), 5s);
+  REQUIRE(reply.has_value());
+  CHECK(reply->at("pong") == true);
+  // Forgetting drops the writer; a later call makes a new one and still arrives.
+  client->forget("test/later");
+  reply = client->call_sync("test/later", "ping", Json::object(), 5s);
+  REQUIRE(reply.has_value());
+  CHECK(reply->at("pong") == true);
+}

@@ -259,8 +259,11 @@ void add_application_commands(CLI::App &app, const GlobalOptions &global, int &e
     auto target = std::make_shared<std::string>();
     cmd->add_option("app", *target, "Running application")->required();
     cmd->callback([=, verb = std::string(verb), op = std::string(op), &global, &exit_code] {
-      exit_code = simple_call(verb.c_str(), op, Json{{"app", *target}}, global,
-                              [verb](const Json &r) { fmt::print("{}: {}\n", verb, r.value("name", "")); });
+      exit_code = simple_call(verb.c_str(), op, Json{{"app", *target}}, global, [verb](const Json &r) {
+        fmt::print("{}: {}\n", verb, r.value("name", ""));
+        for (const auto &id : r.value("unconfirmed", Json::array()))
+          fmt::print("  {} did not confirm its release and was terminated by its node\n", id.get<std::string>());
+      });
     });
   }
 
