@@ -162,7 +162,8 @@ ResourceAllocator::allocate(const std::vector<Request> &requests) {
         if (!why)
           why = capacity_shortfall(demand, state);
         if (why) {
-          rejection.reasons.push_back(fmt::format("{} ({}): {}", id, impl.implementation->id, *why));
+          rejection.reasons.push_back(
+              fmt::format("{} ({}): {}", id, impl.implementation->id, *why));
           continue;
         }
         for (const auto &[name, amount] : demand)
@@ -178,10 +179,10 @@ ResourceAllocator::allocate(const std::vector<Request> &requests) {
       continue;
     }
     if (rejection.reasons.empty())
-      rejection.reasons.push_back(request.device
-                                      ? fmt::format("the assigned device {} is not in the domain",
-                                                    *request.device)
-                                      : "no device that runs components is in the domain");
+      rejection.reasons.push_back(
+          request.device
+              ? fmt::format("the assigned device {} is not in the domain", *request.device)
+              : "no device that runs components is in the domain");
     rejections.push_back(std::move(rejection));
   }
   if (!rejections.empty())

@@ -61,7 +61,8 @@ public:
   void remove_node(const std::string &node);
 
   // Places every request or none; on success the capacity is reserved.
-  tl::expected<std::vector<Placement>, std::vector<Rejection>> allocate(const std::vector<Request> &requests);
+  tl::expected<std::vector<Placement>, std::vector<Rejection>>
+  allocate(const std::vector<Request> &requests);
   void release(const std::vector<Placement> &placements);
 
   struct DeviceState {

@@ -51,7 +51,8 @@ using Expected = tl::expected<T, Error>;
 
 inline tl::unexpected<Error> make_error(SourceLocation where, std::string rule,
                                         std::string message) {
-  return tl::unexpected<Error>(Error(Diagnostic{std::move(where), std::move(rule), std::move(message)}));
+  return tl::unexpected<Error>(
+      Error(Diagnostic{std::move(where), std::move(rule), std::move(message)}));
 }
 
 std::string to_string(const Diagnostic &diagnostic);

@@ -15,7 +15,9 @@ struct Unit {
   double scale;
 };
 
-bool is_digit(char c) { return c >= '0' && c <= '9'; }
+bool is_digit(char c) {
+  return c >= '0' && c <= '9';
+}
 
 // The length of the number at the start of `text` in the documented form, digits with an
 // optional fraction ("12", "12.5"; not ".5", "5." or a sign), or 0 when there is none.
@@ -37,10 +39,11 @@ tl::expected<std::pair<double, double>, std::string>
 parse_quantity(std::string_view text, const std::array<Unit, N> &units, std::string_view what) {
   const std::size_t length = number_length(text);
   double number = 0;
-  auto [end, ec] = std::from_chars(text.data(), text.data() + length, number,
-                                   std::chars_format::fixed);
+  auto [end, ec] =
+      std::from_chars(text.data(), text.data() + length, number, std::chars_format::fixed);
   if (length == 0 || ec != std::errc() || end != text.data() + length)
-    return tl::unexpected(fmt::format("\"{}\" is not a {}: expected a number and a unit", text, what));
+    return tl::unexpected(
+        fmt::format("\"{}\" is not a {}: expected a number and a unit", text, what));
   std::string_view suffix = text.substr(length);
   for (const auto &unit : units)
     if (unit.suffix == suffix)
@@ -48,17 +51,18 @@ parse_quantity(std::string_view text, const std::array<Unit, N> &units, std::str
   std::string known;
   for (const auto &unit : units)
     known += (known.empty() ? "" : ", ") + std::string(unit.suffix);
-  return tl::unexpected(fmt::format("\"{}\" has no valid {} unit: expected one of {}", text, what, known));
+  return tl::unexpected(
+      fmt::format("\"{}\" has no valid {} unit: expected one of {}", text, what, known));
 }
 
 constexpr std::array<Unit, 4> kTimeUnits{{{"ns", 1}, {"us", 1e3}, {"ms", 1e6}, {"s", 1e9}}};
 constexpr std::array<Unit, 7> kSizeUnits{{{"B", 1},
-                                         {"kB", 1e3},
-                                         {"MB", 1e6},
-                                         {"GB", 1e9},
-                                         {"KiB", 1024.0},
-                                         {"MiB", 1024.0 * 1024},
-                                         {"GiB", 1024.0 * 1024 * 1024}}};
+                                          {"kB", 1e3},
+                                          {"MB", 1e6},
+                                          {"GB", 1e9},
+                                          {"KiB", 1024.0},
+                                          {"MiB", 1024.0 * 1024},
+                                          {"GiB", 1024.0 * 1024 * 1024}}};
 constexpr std::array<Unit, 4> kRateUnits{{{"bps", 1}, {"kbps", 1e3}, {"Mbps", 1e6}, {"Gbps", 1e9}}};
 
 } // namespace
@@ -72,7 +76,8 @@ tl::expected<Duration, std::string> parse_duration(std::string_view text) {
   const double ns = quantity->first * quantity->second;
   // 2^63 ns is about 292 years; anything longer is a mistake, not a period.
   if (ns >= 0x1p63)
-    return tl::unexpected(fmt::format("\"{}\" is too long a duration (at most about 292 years)", text));
+    return tl::unexpected(
+        fmt::format("\"{}\" is too long a duration (at most about 292 years)", text));
   return Duration{std::chrono::nanoseconds(std::llround(ns))};
 }
 

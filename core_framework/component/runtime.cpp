@@ -207,7 +207,7 @@ int run_component(int argc, char **argv, const Factory &factory) {
   const pid_t parent = getppid();
   prctl(PR_SET_PDEATHSIG, SIGKILL);
   if (getppid() != parent)
-    return kExitFailure; // the parent died before the request took effect
+    return kExitFailure;               // the parent died before the request took effect
   auto events = ExitEvents::install(); // first: before any thread starts
   if (!events) {
     spdlog::error("{}", events.error());

@@ -127,7 +127,9 @@ Json parse_body(const char *text) {
   return Json::parse(text, nullptr, /*allow_exceptions=*/false);
 }
 
-std::string str(const char *text) { return text != nullptr ? std::string(text) : std::string(); }
+std::string str(const char *text) {
+  return text != nullptr ? std::string(text) : std::string();
+}
 
 } // namespace
 
@@ -211,16 +213,15 @@ Expected<void> Endpoint::Impl::create_entities() {
                         "creating the subscriber", subscriber);
           })
           .and_then([&] {
-            return make(dds_create_reader(subscriber.get(), request_topic.get(), qos.get(), nullptr),
-                        "creating the request reader", request_reader);
+            return make(
+                dds_create_reader(subscriber.get(), request_topic.get(), qos.get(), nullptr),
+                "creating the request reader", request_reader);
           })
           .and_then([&] {
             return make(dds_create_reader(subscriber.get(), reply_topic.get(), qos.get(), nullptr),
                         "creating the reply reader", reply_reader);
           })
-          .and_then([&] {
-            return make(dds_create_waitset(pp), "creating the waitset", waitset);
-          })
+          .and_then([&] { return make(dds_create_waitset(pp), "creating the waitset", waitset); })
           .and_then([&] {
             return make(dds_create_guardcondition(pp), "creating the guard condition", guard);
           });
@@ -251,9 +252,9 @@ void Endpoint::Impl::receive_loop() {
       const auto now = Clock::now();
       for (const auto &[id, p] : pending)
         timeout = std::min<dds_duration_t>(
-            timeout, std::max<dds_duration_t>(
-                         0, std::chrono::duration_cast<std::chrono::nanoseconds>(p.deadline - now)
-                                .count()));
+            timeout,
+            std::max<dds_duration_t>(
+                0, std::chrono::duration_cast<std::chrono::nanoseconds>(p.deadline - now).count()));
     }
     dds_waitset_wait(waitset.get(), nullptr, 0, timeout);
     bool triggered = false;
@@ -296,9 +297,8 @@ void Endpoint::Impl::serve(RequestContext context, Json body) {
       handler = it->second;
   }
   CallResult<Json> result =
-      body.is_discarded()
-          ? call_error(Status::BadRequest, "the request body is not valid JSON")
-      : handler ? handler(body, context)
+      body.is_discarded() ? call_error(Status::BadRequest, "the request body is not valid JSON")
+      : handler           ? handler(body, context)
                 : call_error(Status::BadRequest, fmt::format("{} does not serve operation \"{}\"",
                                                              address, context.operation));
   const std::string reply_body = result ? result->dump() : std::string();
@@ -336,9 +336,10 @@ void Endpoint::Impl::take_replies() {
         continue;
       }
       Json body = parse_body(r->body);
-      complete(str(r->id), body.is_discarded()
-                               ? CallResult<Json>(call_error(Status::Failed, "the reply is not JSON"))
-                               : CallResult<Json>(std::move(body)));
+      complete(str(r->id),
+               body.is_discarded()
+                   ? CallResult<Json>(call_error(Status::Failed, "the reply is not JSON"))
+                   : CallResult<Json>(std::move(body)));
     }
     dds_return_loan(reply_reader.get(), samples, n);
   }
@@ -396,9 +397,11 @@ void Endpoint::Impl::expire_calls() {
       const auto &p = it->second;
       expired.emplace_back(
           std::move(it->second.promise),
-          p.sent ? CallError{Status::Timeout, fmt::format("no reply from {} to \"{}\" before the deadline",
-                                                          p.target, p.operation)}
-                 : CallError{Status::Unavailable, fmt::format("nobody serves address {}", p.target)});
+          p.sent
+              ? CallError{Status::Timeout,
+                          fmt::format("no reply from {} to \"{}\" before the deadline", p.target,
+                                      p.operation)}
+              : CallError{Status::Unavailable, fmt::format("nobody serves address {}", p.target)});
       it = pending.erase(it);
     }
   }
@@ -407,7 +410,8 @@ void Endpoint::Impl::expire_calls() {
 }
 
 CallResult<dds_entity_t> Endpoint::Impl::writer_for(std::map<std::string, PartitionWriter> &cache,
-                                                    dds_entity_t topic, const std::string &partition) {
+                                                    dds_entity_t topic,
+                                                    const std::string &partition) {
   std::lock_guard lock(writers_mutex);
   if (auto it = cache.find(partition); it != cache.end())
     return it->second.writer.get();
@@ -443,10 +447,10 @@ CallResult<dds_entity_t> Endpoint::Impl::writer_to(std::map<std::string, Partiti
     const auto left = deadline - Clock::now();
     if (left <= Clock::duration::zero() || stopping.load())
       return call_error(Status::Unavailable, fmt::format("no endpoint at address {}", partition));
-    dds_waitset_wait(ws.get(), nullptr, 0,
-                     std::min<dds_duration_t>(
-                         DDS_MSECS(100),
-                         std::chrono::duration_cast<std::chrono::nanoseconds>(left).count()));
+    dds_waitset_wait(
+        ws.get(), nullptr, 0,
+        std::min<dds_duration_t>(
+            DDS_MSECS(100), std::chrono::duration_cast<std::chrono::nanoseconds>(left).count()));
   }
 }
 
@@ -471,8 +475,8 @@ void Endpoint::Impl::send_request(std::string id, std::string target, std::strin
   request.operation = operation.data();
   request.body = body.data();
   if (dds_return_t rc = dds_write(*writer, &request); rc < 0) {
-    complete(id, call_error(Status::Failed, fmt::format("sending to {} failed: {}", target,
-                                                        dds_strretcode(rc))));
+    complete(id, call_error(Status::Failed,
+                            fmt::format("sending to {} failed: {}", target, dds_strretcode(rc))));
     return;
   }
   std::lock_guard lock(state_mutex);
@@ -515,15 +519,18 @@ Endpoint::~Endpoint() {
     p.promise.set_value(call_error(Status::Unavailable, "the endpoint is shutting down"));
 }
 
-const std::string &Endpoint::address() const { return impl_->address; }
+const std::string &Endpoint::address() const {
+  return impl_->address;
+}
 
 void Endpoint::on(const std::string &operation, Handler handler) {
   std::lock_guard lock(impl_->state_mutex);
   impl_->handlers[operation] = std::move(handler);
 }
 
-std::future<CallResult<Json>> Endpoint::call(const std::string &target, const std::string &operation,
-                                             Json body, std::chrono::milliseconds timeout) {
+std::future<CallResult<Json>> Endpoint::call(const std::string &target,
+                                             const std::string &operation, Json body,
+                                             std::chrono::milliseconds timeout) {
   std::future<CallResult<Json>> future;
   std::string id;
   {
@@ -541,7 +548,8 @@ std::future<CallResult<Json>> Endpoint::call(const std::string &target, const st
 }
 
 void Endpoint::prepare(const std::string &target) {
-  if (auto writer = impl_->writer_for(impl_->request_writers, impl_->request_topic.get(), target); !writer)
+  if (auto writer = impl_->writer_for(impl_->request_writers, impl_->request_topic.get(), target);
+      !writer)
     spdlog::debug("preparing the way to {}: {}", target, writer.error().message);
 }
 

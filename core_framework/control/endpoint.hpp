@@ -73,7 +73,8 @@ struct EndpointOptions {
 class Endpoint {
 public:
   static Expected<std::unique_ptr<Endpoint>> open(std::shared_ptr<dds::Participant> participant,
-                                                  std::string address, EndpointOptions options = {});
+                                                  std::string address,
+                                                  EndpointOptions options = {});
   // Closes: running handlers finish and write their replies, then the endpoint's DDS entities
   // go. Cyclone lingers a deleted reliable writer until its data is acknowledged (bounded by
   // WriterLingerDuration), so the last replies still reach their callers.

@@ -40,7 +40,8 @@ DdsSettings DdsSettings::from_environment() {
   s.domain_id = static_cast<std::uint32_t>(env_number_or("RSCA_DDS_DOMAIN", s.domain_id));
   s.interface_name = env_or("RSCA_DDS_INTERFACE", s.interface_name);
   s.peer = env_or("RSCA_DDS_PEER", s.peer);
-  s.lease = std::chrono::milliseconds(env_number_or("RSCA_DDS_LEASE_MS", static_cast<std::uint64_t>(s.lease.count())));
+  s.lease = std::chrono::milliseconds(
+      env_number_or("RSCA_DDS_LEASE_MS", static_cast<std::uint64_t>(s.lease.count())));
   s.trace = env_or("RSCA_DDS_TRACE", s.trace);
   return s;
 }

@@ -44,7 +44,9 @@ struct QosDeleter {
   void operator()(dds_qos_t *qos) const { dds_delete_qos(qos); }
 };
 using Qos = std::unique_ptr<dds_qos_t, QosDeleter>;
-inline Qos make_qos() { return Qos(dds_create_qos()); }
+inline Qos make_qos() {
+  return Qos(dds_create_qos());
+}
 
 // The entity a C call returned, or an error naming `what` and Cyclone's reason.
 Expected<Entity> checked(dds_entity_t result, std::string_view what);

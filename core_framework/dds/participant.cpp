@@ -14,7 +14,8 @@ Expected<Entity> checked(dds_entity_t result, std::string_view what) {
 }
 
 Error dds_error(dds_return_t result, std::string_view what) {
-  return Error(Diagnostic{{"dds", 0, 0}, "dds", fmt::format("{} failed: {}", what, dds_strretcode(result))});
+  return Error(
+      Diagnostic{{"dds", 0, 0}, "dds", fmt::format("{} failed: {}", what, dds_strretcode(result))});
 }
 
 namespace {

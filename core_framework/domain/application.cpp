@@ -44,20 +44,17 @@ nlohmann::json to_json(const Application &app) {
                           {"assembly_controller", c.assembly_controller}});
   nlohmann::json connections = nlohmann::json::array();
   for (const auto &c : app.connections)
-    connections.push_back({{"id", c.id},
-                           {"uses", c.uses.component.empty() ? "" : c.uses.component + "." + c.uses.port},
-                           {"provides", c.provides.component.empty()
-                                            ? ""
-                                            : c.provides.component + "." + c.provides.port},
-                           {"repid", c.repid},
-                           {"topic", c.topic},
-                           {"qos", c.qos}});
-  return {{"name", app.name},
-          {"installed", app.installed},
-          {"sad", app.sad},
-          {"state", to_string(app.state)},
-          {"components", components},
-          {"connections", connections}};
+    connections.push_back(
+        {{"id", c.id},
+         {"uses", c.uses.component.empty() ? "" : c.uses.component + "." + c.uses.port},
+         {"provides",
+          c.provides.component.empty() ? "" : c.provides.component + "." + c.provides.port},
+         {"repid", c.repid},
+         {"topic", c.topic},
+         {"qos", c.qos}});
+  return {{"name", app.name},         {"installed", app.installed},
+          {"sad", app.sad},           {"state", to_string(app.state)},
+          {"components", components}, {"connections", connections}};
 }
 
 } // namespace rsca::domain

@@ -17,15 +17,15 @@ enum class ApplicationState : std::uint8_t { Created, Running, Stopped, Failed }
 std::string_view to_string(ApplicationState state);
 
 struct ComponentInstance {
-  std::string id;         // componentinstantiation id
+  std::string id; // componentinstantiation id
   std::string usage_name;
   std::string node;
   std::string device;
   std::string implementation;
-  std::string address;    // its control endpoint
-  std::string spd;        // the SPD it runs from
+  std::string address; // its control endpoint
+  std::string spd;     // the SPD it runs from
   long pid = 0;
-  std::string state;      // "executed", "registered", "running", "stopped", "exited"
+  std::string state; // "executed", "registered", "running", "stopped", "exited"
   std::uint32_t start_order = 0;
   bool assembly_controller = false;
 };
@@ -45,9 +45,9 @@ struct ConnectionInstance {
 };
 
 struct Application {
-  std::string name;        // instance name, unique in the domain
-  std::string installed;   // the installed application it was created from
-  std::string sad;         // path of the SAD
+  std::string name;      // instance name, unique in the domain
+  std::string installed; // the installed application it was created from
+  std::string sad;       // path of the SAD
   ApplicationState state = ApplicationState::Created;
   std::vector<ComponentInstance> components;
   std::vector<ConnectionInstance> connections;

@@ -29,7 +29,8 @@ struct Call {
 };
 
 // Makes every call at once and waits for all of them; each result in the order of the calls.
-std::vector<CallResult<Json>> call_each_of(control::Endpoint &endpoint, const std::vector<Call> &calls,
+std::vector<CallResult<Json>> call_each_of(control::Endpoint &endpoint,
+                                           const std::vector<Call> &calls,
                                            std::chrono::milliseconds timeout) {
   std::vector<std::future<CallResult<Json>>> futures;
   futures.reserve(calls.size());
@@ -43,7 +44,8 @@ std::vector<CallResult<Json>> call_each_of(control::Endpoint &endpoint, const st
 }
 
 // The first failure among `results`, prefixed with its call's `what`.
-CallResult<void> first_failure(const std::vector<Call> &calls, const std::vector<CallResult<Json>> &results) {
+CallResult<void> first_failure(const std::vector<Call> &calls,
+                               const std::vector<CallResult<Json>> &results) {
   for (std::size_t i = 0; i < results.size(); ++i)
     if (!results[i])
       return control::call_error(results[i].error().status,
@@ -107,8 +109,8 @@ public:
       progress_({name, detail_, ms_since(began)});
     }
     app_->state = request_.start ? ApplicationState::Running : ApplicationState::Created;
-    spdlog::info("application {} launched: {} components on {}", app_->name, app_->components.size(),
-                 fmt::join(nodes_used(), ", "));
+    spdlog::info("application {} launched: {} components on {}", app_->name,
+                 app_->components.size(), fmt::join(nodes_used(), ", "));
     return app_;
   }
 
@@ -192,7 +194,9 @@ private:
     return {};
   }
 
-  CallResult<void> initialize() { return call_each("component.initialize", [](auto &) { return Json::object(); }); }
+  CallResult<void> initialize() {
+    return call_each("component.initialize", [](auto &) { return Json::object(); });
+  }
 
   CallResult<void> configure() {
     std::vector<Call> calls;
@@ -272,8 +276,7 @@ private:
   }
 
   Call connect_call(const ConnectionInstance &ci, const ConnectionEnd &end, const char *direction) {
-    return {app_->find_component(end.component)->address,
-            "component.connect",
+    return {app_->find_component(end.component)->address, "component.connect",
             Json{{"connection", ci.id},
                  {"port", end.port},
                  {"direction", direction},
@@ -310,17 +313,18 @@ private:
   }
 
   Json execute_body(const ComponentInstance &c) const {
-    std::vector<std::string> args = {"COMPONENT_IDENTIFIER", c.id,         "NAME_BINDING",
-                                     c.usage_name,           "PROFILE_NAME", c.spd,
-                                     "DOMAIN_NAME",          s_.domain_name, "APPLICATION",
-                                     app_->name,             "CONTROL_ADDRESS", c.address};
+    std::vector<std::string> args = {
+        "COMPONENT_IDENTIFIER", c.id,       "NAME_BINDING",    c.usage_name,
+        "PROFILE_NAME",         c.spd,      "DOMAIN_NAME",     s_.domain_name,
+        "APPLICATION",          app_->name, "CONTROL_ADDRESS", c.address};
     append_execparams(c, args);
     const auto *impl = placement_of(c.id)->implementation;
     const auto spd_dir = std::filesystem::path(c.spd).parent_path();
     return Json{{"application", app_->name},
                 {"component", c.id},
                 {"device", c.device},
-                {"entrypoint", impl->code.entrypoint.empty() ? impl->code.file.name : impl->code.entrypoint},
+                {"entrypoint",
+                 impl->code.entrypoint.empty() ? impl->code.file.name : impl->code.entrypoint},
                 {"spd_dir", spd_dir.string()},
                 {"args", args}};
   }
@@ -358,7 +362,8 @@ private:
       c.node = p.node;
       c.device = p.device;
       c.implementation = p.implementation->id;
-      c.address = fmt::format("{}/component/{}.{}/{}", s_.domain_name, app_->name, launch_, p.instance);
+      c.address =
+          fmt::format("{}/component/{}.{}/{}", s_.domain_name, app_->name, launch_, p.instance);
       c.spd = request_.profile->softpkg_of(*placement)->spd_path.string();
       c.start_order = ci->start_order.value_or(UINT32_MAX);
       c.assembly_controller = sad.assembly_controller == ci->id;
@@ -400,8 +405,8 @@ private:
       if (std::find(devices.begin(), devices.end(), p.device) == devices.end())
         devices.push_back(p.device);
     ApplicationFactory factory(s_);
-    const std::size_t started =
-        std::count_if(app_->components.begin(), app_->components.end(), [](const auto &c) { return c.pid != 0; });
+    const std::size_t started = std::count_if(app_->components.begin(), app_->components.end(),
+                                              [](const auto &c) { return c.pid != 0; });
     if (started > 0) {
       factory.release(*app_);
       undone.push_back(fmt::format("{} process{} terminated", started, started == 1 ? "" : "es"));
@@ -442,7 +447,8 @@ CallResult<void> ApplicationFactory::start(Application &app) {
     auto ok = services_.endpoint->call_sync(c->address, "component.start", Json::object(),
                                             services_.call_timeout);
     if (!ok)
-      return control::call_error(ok.error().status, fmt::format("{}: {}", c->id, ok.error().message));
+      return control::call_error(ok.error().status,
+                                 fmt::format("{}: {}", c->id, ok.error().message));
     c->state = "running";
   }
   app.state = ApplicationState::Running;

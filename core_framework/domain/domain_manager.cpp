@@ -46,7 +46,6 @@ Json steps_json(const std::vector<LaunchStep> &steps) {
   return out;
 }
 
-
 template <typename T>
 CallResult<T> required(const Json &body, const char *key) {
   if (!body.contains(key))
@@ -153,7 +152,8 @@ Expected<void> DomainManager::Impl::load_installed() {
                    app.error().to_string());
       continue;
     }
-    installed[r.name] = {r.name, sad, std::make_shared<const profile::ResolvedApplication>(std::move(*app))};
+    installed[r.name] = {r.name, sad,
+                         std::make_shared<const profile::ResolvedApplication>(std::move(*app))};
   }
   spdlog::info("{} installed application(s) loaded", installed.size());
   return {};
@@ -165,7 +165,8 @@ CallResult<Json> DomainManager::Impl::install(const Json &body) {
   if (!sad_rel || !files)
     return tl::unexpected(sad_rel ? files.error() : sad_rel.error());
   // Write into a staging folder, load from there, and only then replace what was installed.
-  const std::string staging_name = fmt::format(".staging-{}", std::chrono::steady_clock::now().time_since_epoch().count());
+  const std::string staging_name =
+      fmt::format(".staging-{}", std::chrono::steady_clock::now().time_since_epoch().count());
   const fs::path staging = options.repository / staging_name;
   std::error_code ec;
   fs::remove_all(staging, ec);
@@ -173,8 +174,9 @@ CallResult<Json> DomainManager::Impl::install(const Json &body) {
     auto rel = safe_relative(f.value("path", ""));
     if (!rel) {
       fs::remove_all(staging, ec);
-      return control::call_error(Status::BadRequest,
-                                 fmt::format("file path \"{}\" is not inside an SDR root", f.value("path", "")));
+      return control::call_error(
+          Status::BadRequest,
+          fmt::format("file path \"{}\" is not inside an SDR root", f.value("path", "")));
     }
     fs::create_directories((staging / *rel).parent_path(), ec);
     std::ofstream(staging / *rel, std::ios::binary) << f.value("content", "");
@@ -188,7 +190,8 @@ CallResult<Json> DomainManager::Impl::install(const Json &body) {
     fs::remove_all(staging, ec);
     return control::call_error(Status::BadRequest, app.error().to_string());
   }
-  const std::string name = body.value("name", app->sad->name.empty() ? app->sad->id : app->sad->name);
+  const std::string name =
+      body.value("name", app->sad->name.empty() ? app->sad->id : app->sad->name);
   std::lock_guard lock(mutex);
   const fs::path final_dir = options.repository / name;
   fs::remove_all(final_dir, ec);
@@ -216,7 +219,8 @@ CallResult<Json> DomainManager::Impl::uninstall(const Json &body) {
     return tl::unexpected(name.error());
   std::lock_guard lock(mutex);
   if (installed.erase(*name) == 0)
-    return control::call_error(Status::NotFound, fmt::format("no application {} is installed", *name));
+    return control::call_error(Status::NotFound,
+                               fmt::format("no application {} is installed", *name));
   for (const auto &[app_name, app] : applications)
     if (app->installed == *name)
       spdlog::info("{} stays running after uninstalling {}", app_name, *name);
@@ -262,7 +266,8 @@ CallResult<Json> DomainManager::Impl::create_application(const Json &body) {
     request.profile = it->second.profile;
     const std::string wanted = body.value("name", *installed_name);
     if (body.contains("name") && applications.count(wanted) != 0)
-      return control::call_error(Status::Rejected, fmt::format("an application named {} already runs", wanted));
+      return control::call_error(Status::Rejected,
+                                 fmt::format("an application named {} already runs", wanted));
     request.name = unique_name(wanted);
     // Reserve the name while launching.
     applications[request.name] = nullptr;
@@ -308,7 +313,8 @@ CallResult<std::shared_ptr<Application>> DomainManager::Impl::find_application(c
   std::lock_guard lock(mutex);
   auto it = applications.find(*name);
   if (it == applications.end() || !it->second)
-    return control::call_error(Status::NotFound, fmt::format("no application {} is running", *name));
+    return control::call_error(Status::NotFound,
+                               fmt::format("no application {} is running", *name));
   return it->second;
 }
 
@@ -323,13 +329,15 @@ CallResult<Json> DomainManager::Impl::release(const Json &body) {
   auto unconfirmed = factory().release(**app);
   spdlog::info("application {} released", (*app)->name);
   if (!unconfirmed)
-    return control::call_error(unconfirmed.error().status, fmt::format("released {} with problems: {}",
-                                                                       (*app)->name, unconfirmed.error().message));
+    return control::call_error(
+        unconfirmed.error().status,
+        fmt::format("released {} with problems: {}", (*app)->name, unconfirmed.error().message));
   return Json{{"name", (*app)->name}, {"unconfirmed", *unconfirmed}};
 }
 
 // Where configure/query go: the named component, or else the assembly controller (SCA).
-CallResult<std::string> DomainManager::Impl::target_of(const Application &app, const Json &body) const {
+CallResult<std::string> DomainManager::Impl::target_of(const Application &app,
+                                                       const Json &body) const {
   const std::string component = body.value("component", "");
   for (const auto &c : app.components)
     if (component.empty() ? c.assembly_controller : c.id == component)
@@ -460,7 +468,8 @@ void DomainManager::Impl::on_announcement(const control::AnnouncementEvent &even
     const bool known = nodes.count(node) != 0;
     nodes[node] = {node, event.address, event.body};
     if (!known)
-      spdlog::info("node {} registered with {} device(s)", node, event.body.value("devices", Json::array()).size());
+      spdlog::info("node {} registered with {} device(s)", node,
+                   event.body.value("devices", Json::array()).size());
     return;
   }
   if (event.kind == control::AnnouncementEvent::Kind::Alive && event.endpoint_kind == "component") {
@@ -488,7 +497,9 @@ void DomainManager::Impl::serve() {
     });
   };
   auto bind0 = [this](const char *op, auto method) {
-    endpoint->on(op, [this, method](const Json &, const control::RequestContext &) { return (this->*method)(); });
+    endpoint->on(op, [this, method](const Json &, const control::RequestContext &) {
+      return (this->*method)();
+    });
   };
   bind("domain.install", &Impl::install);
   bind("domain.uninstall", &Impl::uninstall);
@@ -501,33 +512,39 @@ void DomainManager::Impl::serve() {
   bind("app.release", &Impl::release);
   bind("app.configure", &Impl::configure);
   bind("app.query", &Impl::query);
-  endpoint->on("app.list", [this](const Json &, const control::RequestContext &) -> CallResult<Json> {
-    std::lock_guard lock(mutex);
-    Json list = Json::array();
-    for (const auto &[name, app] : applications)
-      if (app)
-        list.push_back({{"name", name}, {"installed", app->installed},
-                        {"state", to_string(app->state)}, {"components", app->components.size()}});
-    return Json{{"applications", list}};
-  });
-  endpoint->on("app.show", [this](const Json &body, const control::RequestContext &) -> CallResult<Json> {
-    auto app = find_application(body);
-    if (!app)
-      return tl::unexpected(app.error());
-    std::lock_guard lock(mutex);
-    return to_json(**app);
-  });
+  endpoint->on("app.list",
+               [this](const Json &, const control::RequestContext &) -> CallResult<Json> {
+                 std::lock_guard lock(mutex);
+                 Json list = Json::array();
+                 for (const auto &[name, app] : applications)
+                   if (app)
+                     list.push_back({{"name", name},
+                                     {"installed", app->installed},
+                                     {"state", to_string(app->state)},
+                                     {"components", app->components.size()}});
+                 return Json{{"applications", list}};
+               });
+  endpoint->on("app.show",
+               [this](const Json &body, const control::RequestContext &) -> CallResult<Json> {
+                 auto app = find_application(body);
+                 if (!app)
+                   return tl::unexpected(app.error());
+                 std::lock_guard lock(mutex);
+                 return to_json(**app);
+               });
   for (const char *op : {"app.start", "app.stop"}) {
     const bool starting = std::string_view(op) == "app.start";
-    endpoint->on(op, [this, starting](const Json &body, const control::RequestContext &) -> CallResult<Json> {
-      auto app = find_application(body);
-      if (!app)
-        return tl::unexpected(app.error());
-      auto ok = starting ? factory().start(**app) : factory().stop(**app);
-      if (!ok)
-        return tl::unexpected(ok.error());
-      return to_json(**app);
-    });
+    endpoint->on(
+        op,
+        [this, starting](const Json &body, const control::RequestContext &) -> CallResult<Json> {
+          auto app = find_application(body);
+          if (!app)
+            return tl::unexpected(app.error());
+          auto ok = starting ? factory().start(**app) : factory().stop(**app);
+          if (!ok)
+            return tl::unexpected(ok.error());
+          return to_json(**app);
+        });
   }
 }
 
@@ -556,7 +573,8 @@ DomainManager::create(std::shared_ptr<dds::Participant> participant, DomainOptio
   Impl *raw = impl.get();
   auto endpoint = control::Endpoint::open(
       participant, address_of(impl->options.name),
-      {.workers = 16, .on_announcement = [raw](const control::AnnouncementEvent &e) { raw->on_announcement(e); }});
+      {.workers = 16,
+       .on_announcement = [raw](const control::AnnouncementEvent &e) { raw->on_announcement(e); }});
   if (!endpoint)
     return tl::unexpected(endpoint.error());
   impl->endpoint = std::move(*endpoint);

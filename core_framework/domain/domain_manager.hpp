@@ -20,16 +20,16 @@
 namespace rsca::domain {
 
 struct DomainOptions {
-  std::string name = "rsca";                // the DMD's name
-  std::filesystem::path repository;         // installed profiles are kept here
+  std::string name = "rsca";        // the DMD's name
+  std::filesystem::path repository; // installed profiles are kept here
   std::chrono::milliseconds registration_timeout{10000};
   std::chrono::milliseconds call_timeout{5000};
 };
 
 class DomainManager {
 public:
-  static Expected<std::unique_ptr<DomainManager>> create(std::shared_ptr<dds::Participant> participant,
-                                                         DomainOptions options);
+  static Expected<std::unique_ptr<DomainManager>>
+  create(std::shared_ptr<dds::Participant> participant, DomainOptions options);
   ~DomainManager();
 
   static std::string address_of(const std::string &domain) { return domain + "/domain"; }

@@ -11,7 +11,8 @@ struct StatementDeleter {
 using Statement = std::unique_ptr<sqlite3_stmt, StatementDeleter>;
 
 tl::unexpected<Error> sqlite_error(sqlite3 *db, std::string_view what) {
-  return make_error({"domain store", 0, 0}, "store", fmt::format("{}: {}", what, sqlite3_errmsg(db)));
+  return make_error({"domain store", 0, 0}, "store",
+                    fmt::format("{}: {}", what, sqlite3_errmsg(db)));
 }
 
 } // namespace
@@ -32,7 +33,8 @@ Expected<DomainStore> DomainStore::open(const std::filesystem::path &file) {
   return store;
 }
 
-Expected<void> DomainStore::exec(const std::string &sql, const std::vector<std::string> &params) const {
+Expected<void> DomainStore::exec(const std::string &sql,
+                                 const std::vector<std::string> &params) const {
   sqlite3_stmt *raw = nullptr;
   if (sqlite3_prepare_v2(db_.get(), sql.c_str(), -1, &raw, nullptr) != SQLITE_OK)
     return sqlite_error(db_.get(), "preparing a statement");
@@ -45,7 +47,8 @@ Expected<void> DomainStore::exec(const std::string &sql, const std::vector<std::
 }
 
 Expected<void> DomainStore::put_installed(const InstalledRecord &record) {
-  return exec("INSERT OR REPLACE INTO installed (name, sad) VALUES (?, ?)", {record.name, record.sad});
+  return exec("INSERT OR REPLACE INTO installed (name, sad) VALUES (?, ?)",
+              {record.name, record.sad});
 }
 
 Expected<void> DomainStore::remove_installed(const std::string &name) {

@@ -10,12 +10,14 @@
 
 int main(int argc, char **argv) {
   rsca::TerminationSignals signals; // before any thread exists
-  CLI::App app{"rsca-domaind — the rsca domain daemon (DomainManager, ApplicationFactory, ResourceAllocator)"};
+  CLI::App app{"rsca-domaind — the rsca domain daemon (DomainManager, ApplicationFactory, "
+               "ResourceAllocator)"};
   std::string dmd;
   std::string repository = "/tmp/rsca/domain";
   std::string level = "info";
   int registration_ms = 10000;
-  app.add_option("--dmd", dmd, "The domain's DMD; its name names the domain")->check(CLI::ExistingFile);
+  app.add_option("--dmd", dmd, "The domain's DMD; its name names the domain")
+      ->check(CLI::ExistingFile);
   app.add_option("--repository", repository, "Where installed applications are kept")
       ->capture_default_str();
   app.add_option("--registration-timeout-ms", registration_ms,

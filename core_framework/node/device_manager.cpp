@@ -99,7 +99,8 @@ Json DeviceManager::Impl::announcement() const {
                     {"capacity", d.device->capacity()}});
   char host[256] = {};
   gethostname(host, sizeof(host) - 1);
-  return {{"node", dcd->name}, {"pid", static_cast<long>(getpid())}, {"host", host}, {"devices", list}};
+  return {
+      {"node", dcd->name}, {"pid", static_cast<long>(getpid())}, {"host", host}, {"devices", list}};
 }
 
 ExecutableDevice *DeviceManager::Impl::executable_device(const std::string &id) const {
@@ -112,42 +113,47 @@ ExecutableDevice *DeviceManager::Impl::executable_device(const std::string &id) 
 void DeviceManager::Impl::report_exit(const Json &report) {
   if (stopping.load() || !endpoint)
     return;
-  spdlog::warn("process {} exited on its own: {}", report.value("pid", 0L), report.value("status", ""));
+  spdlog::warn("process {} exited on its own: {}", report.value("pid", 0L),
+               report.value("status", ""));
   // Fire and forget: the reply is not needed, and the reaper that calls this must not block.
   endpoint->call(options.domain_name + "/domain", "domain.component_exited", report,
                  std::chrono::seconds(2));
 }
 
 void DeviceManager::Impl::serve() {
-  endpoint->on("node.execute", [this](const Json &body, const control::RequestContext &) -> CallResult<Json> {
-    ExecutableDevice *device = executable_device(body.value("device", ""));
-    if (device == nullptr)
-      return control::call_error(Status::NotFound,
-                                 fmt::format("node {} has no executable device {}", dcd->name,
-                                             body.value("device", "")));
-    return device->execute(body);
-  });
-  endpoint->on("node.terminate", [this](const Json &body, const control::RequestContext &) -> CallResult<Json> {
-    for (const auto &d : devices) {
-      if (d.executable() == nullptr)
-        continue;
-      auto result = d.executable()->terminate(body);
-      if (result || result.error().status != Status::NotFound)
-        return result;
-    }
-    return control::call_error(Status::NotFound,
-                               fmt::format("node {} did not start process {}", dcd->name, body.value("pid", 0L)));
-  });
-  endpoint->on("node.status", [this](const Json &, const control::RequestContext &) -> CallResult<Json> {
-    Json processes = Json::array();
-    for (const auto &d : devices)
-      if (d.executable() != nullptr)
-        for (const auto &p : d.executable()->processes())
-          processes.push_back(p);
-    Json status = announcement();
-    status["processes"] = processes;
-    return status;
-  });
+  endpoint->on("node.execute",
+               [this](const Json &body, const control::RequestContext &) -> CallResult<Json> {
+                 ExecutableDevice *device = executable_device(body.value("device", ""));
+                 if (device == nullptr)
+                   return control::call_error(Status::NotFound,
+                                              fmt::format("node {} has no executable device {}",
+                                                          dcd->name, body.value("device", "")));
+                 return device->execute(body);
+               });
+  endpoint->on("node.terminate",
+               [this](const Json &body, const control::RequestContext &) -> CallResult<Json> {
+                 for (const auto &d : devices) {
+                   if (d.executable() == nullptr)
+                     continue;
+                   auto result = d.executable()->terminate(body);
+                   if (result || result.error().status != Status::NotFound)
+                     return result;
+                 }
+                 return control::call_error(Status::NotFound,
+                                            fmt::format("node {} did not start process {}",
+                                                        dcd->name, body.value("pid", 0L)));
+               });
+  endpoint->on("node.status",
+               [this](const Json &, const control::RequestContext &) -> CallResult<Json> {
+                 Json processes = Json::array();
+                 for (const auto &d : devices)
+                   if (d.executable() != nullptr)
+                     for (const auto &p : d.executable()->processes())
+                       processes.push_back(p);
+                 Json status = announcement();
+                 status["processes"] = processes;
+                 return status;
+               });
 }
 
 DeviceManager::DeviceManager(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -159,7 +165,9 @@ DeviceManager::~DeviceManager() {
   impl_->endpoint.reset();
 }
 
-const std::string &DeviceManager::node_name() const { return impl_->dcd->name; }
+const std::string &DeviceManager::node_name() const {
+  return impl_->dcd->name;
+}
 
 Expected<std::unique_ptr<DeviceManager>>
 DeviceManager::create(std::shared_ptr<dds::Participant> participant, NodeOptions options,

@@ -23,9 +23,9 @@ struct NodeOptions {
 
 class DeviceManager {
 public:
-  static Expected<std::unique_ptr<DeviceManager>> create(std::shared_ptr<dds::Participant> participant,
-                                                         NodeOptions options,
-                                                         const DeviceRegistry &registry);
+  static Expected<std::unique_ptr<DeviceManager>>
+  create(std::shared_ptr<dds::Participant> participant, NodeOptions options,
+         const DeviceRegistry &registry);
   ~DeviceManager();
 
   const std::string &node_name() const;

@@ -24,7 +24,7 @@ struct DeviceContext {
   std::string label; // the DCD's usage name
   std::string node;
   const profile::ResolvedSoftPkg *softpkg = nullptr;
-  Json overrides;    // the DCD's property values for this device, by property name and id
+  Json overrides; // the DCD's property values for this device, by property name and id
   std::vector<std::filesystem::path> exec_path; // where bare entrypoint names are looked for
   std::filesystem::path log_dir;                // component logs go here
   dds::DdsSettings dds;                         // what launched processes must join

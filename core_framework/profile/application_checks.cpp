@@ -11,7 +11,9 @@
 namespace rsca::profile {
 namespace {
 
-std::string file_name(const std::filesystem::path &p) { return p.filename().string(); }
+std::string file_name(const std::filesystem::path &p) {
+  return p.filename().string();
+}
 
 // Each override must name a property of the package and carry a value that fits it.
 void check_property_refs(const ResolvedSoftPkg &pkg, const std::vector<PropertyRef> &refs,
@@ -65,8 +67,8 @@ private:
       return nullptr;
     if (!pkg->scd)
       warn(where, "missing-scd",
-                   fmt::format("{}: component \"{}\" ({}) has no SCD, so its ports are unknown",
-                               what, instance, file_name(pkg->spd_path)));
+           fmt::format("{}: component \"{}\" ({}) has no SCD, so its ports are unknown", what,
+                       instance, file_name(pkg->spd_path)));
     return pkg->scd.get();
   }
 
@@ -85,15 +87,16 @@ private:
         names.push_back(p.name);
     const char *kind = direction == PortDirection::Uses ? "uses" : "provides";
     warn(where, "unknown-port",
-                 fmt::format("{}: component \"{}\" has no {} port \"{}\" ({} ports: {})", what,
-                             instance, kind, port, kind,
-                             names.empty() ? std::string("none") : fmt::format("{}", fmt::join(names, ", "))));
+         fmt::format("{}: component \"{}\" has no {} port \"{}\" ({} ports: {})", what, instance,
+                     kind, port, kind,
+                     names.empty() ? std::string("none")
+                                   : fmt::format("{}", fmt::join(names, ", "))));
     return nullptr;
   }
 
   void check_connection(const Connection &c) {
-    const std::string what = c.id.empty() ? std::string("connection")
-                                          : fmt::format("connection \"{}\"", c.id);
+    const std::string what =
+        c.id.empty() ? std::string("connection") : fmt::format("connection \"{}\"", c.id);
     const PortDefinition *uses = nullptr;
     if (c.uses.target.kind == EndpointTarget::Kind::ComponentInstantiation)
       uses = check_port(c.uses.target.refid, c.uses.port, PortDirection::Uses, c.uses.where, what);
@@ -107,9 +110,9 @@ private:
                                                 PortDirection::Provides, c.provides.where, what);
     if (uses != nullptr && provides != nullptr && uses->repid != provides->repid)
       warn(c.where, "port-type",
-                   fmt::format("{}: uses port {}.{} sends {}, but provides port {}.{} takes {}",
-                               what, c.uses.target.refid, uses->name, uses->repid,
-                               c.provides.target.refid, provides->name, provides->repid));
+           fmt::format("{}: uses port {}.{} sends {}, but provides port {}.{} takes {}", what,
+                       c.uses.target.refid, uses->name, uses->repid, c.provides.target.refid,
+                       provides->name, provides->repid));
   }
 
   void check_external_port(const ExternalPort &p) {
@@ -127,8 +130,9 @@ private:
                                  const SourceLocation &where, const std::string &what) {
     const SoftwareComponent *scd = scd_of(instance, where, what);
     if (scd != nullptr && !scd->supports(repid))
-      warn(where, "unknown-interface",
-           fmt::format("{}: component \"{}\" does not support interface {}", what, instance, repid));
+      warn(
+          where, "unknown-interface",
+          fmt::format("{}: component \"{}\" does not support interface {}", what, instance, repid));
   }
 
   void check_external_property(const ExternalProperty &p) {
@@ -170,8 +174,8 @@ std::vector<Diagnostic> check_node(const ResolvedNode &node) {
     if (!device.softpkg)
       continue;
     for (const auto &ci : placement.instantiations) {
-      check_property_refs(*device.softpkg, ci.properties,
-                          fmt::format("device \"{}\"", ci.id), errors);
+      check_property_refs(*device.softpkg, ci.properties, fmt::format("device \"{}\"", ci.id),
+                          errors);
     }
   }
   return errors.diagnostics();

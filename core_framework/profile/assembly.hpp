@@ -38,9 +38,9 @@ struct ComponentInstantiation {
   std::string id;
   std::string usage_name;
   std::optional<std::uint32_t> start_order;
-  std::vector<PropertyRef> properties;       // componentproperties: overrides of PRF values
-  std::vector<PropertyRef> device_requires;  // SAD devicerequires / DCD deployerrequires
-  std::string naming_service_name;           // findcomponent/namingservice, kept for REDHAWK
+  std::vector<PropertyRef> properties;      // componentproperties: overrides of PRF values
+  std::vector<PropertyRef> device_requires; // SAD devicerequires / DCD deployerrequires
+  std::string naming_service_name;          // findcomponent/namingservice, kept for REDHAWK
   std::optional<Timing> timing;
   SourceLocation where;
 };
@@ -83,7 +83,7 @@ struct EndpointTarget {
   std::string refid;     // the component instantiation (for device refs: the component)
   std::string usesrefid; // DeviceUsedByThisComponent: the usesdevice id
   FindBy findby;
-  SourceLocation where;  // the reference element itself
+  SourceLocation where; // the reference element itself
 };
 
 struct UsesEnd {
@@ -137,10 +137,12 @@ struct Connection {
   std::optional<std::string> filter; // content filter of an event-channel subscriber
   SourceLocation where;
 
-  bool publishes_to_channel() const { return provides.kind == ProvidesEnd::Kind::FindBy &&
-                                             provides.target.findby.is_event_channel(); }
+  bool publishes_to_channel() const {
+    return provides.kind == ProvidesEnd::Kind::FindBy && provides.target.findby.is_event_channel();
+  }
   bool subscribes_to_channel() const {
-    return uses.target.kind == EndpointTarget::Kind::FindBy && uses.target.findby.is_event_channel();
+    return uses.target.kind == EndpointTarget::Kind::FindBy &&
+           uses.target.findby.is_event_channel();
   }
 };
 

@@ -101,28 +101,27 @@ const PropertyCommon &common_of(const PropertyDefinition &property) {
 }
 
 std::optional<PropertyValue> default_value(const PropertyDefinition &property) {
-  return std::visit(
-      Overloaded{[](const SimpleProperty &p) -> std::optional<PropertyValue> {
-                   if (!p.value)
-                     return std::nullopt;
-                   return PropertyValue(*p.value);
-                 },
-                 [](const SimpleSequenceProperty &p) -> std::optional<PropertyValue> {
-                   if (!p.values)
-                     return std::nullopt;
-                   return PropertyValue(*p.values);
-                 },
-                 [](const StructProperty &p) -> std::optional<PropertyValue> {
-                   if (!p.value)
-                     return std::nullopt;
-                   return PropertyValue(*p.value);
-                 },
-                 [](const StructSequenceProperty &p) -> std::optional<PropertyValue> {
-                   if (p.values.empty())
-                     return std::nullopt;
-                   return PropertyValue(p.values);
-                 }},
-      property);
+  return std::visit(Overloaded{[](const SimpleProperty &p) -> std::optional<PropertyValue> {
+                                 if (!p.value)
+                                   return std::nullopt;
+                                 return PropertyValue(*p.value);
+                               },
+                               [](const SimpleSequenceProperty &p) -> std::optional<PropertyValue> {
+                                 if (!p.values)
+                                   return std::nullopt;
+                                 return PropertyValue(*p.values);
+                               },
+                               [](const StructProperty &p) -> std::optional<PropertyValue> {
+                                 if (!p.value)
+                                   return std::nullopt;
+                                 return PropertyValue(*p.value);
+                               },
+                               [](const StructSequenceProperty &p) -> std::optional<PropertyValue> {
+                                 if (p.values.empty())
+                                   return std::nullopt;
+                                 return PropertyValue(p.values);
+                               }},
+                    property);
 }
 
 const StructMember *StructProperty::find_member(std::string_view member_id) const {
@@ -192,7 +191,9 @@ std::string_view to_string(Durability v) {
   constexpr std::string_view names[] = {"volatile", "transientlocal", "transient", "persistent"};
   return names[static_cast<std::size_t>(v)];
 }
-std::string_view to_string(History v) { return v == History::KeepAll ? "keepall" : "keeplast"; }
+std::string_view to_string(History v) {
+  return v == History::KeepAll ? "keepall" : "keeplast";
+}
 std::string_view to_string(Liveliness v) {
   constexpr std::string_view names[] = {"automatic", "manualbyparticipant", "manualbytopic"};
   return names[static_cast<std::size_t>(v)];

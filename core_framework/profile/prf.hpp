@@ -34,7 +34,8 @@ struct StructValue {
   std::vector<std::pair<std::string, MemberValue>> members;
 };
 // The value of any property form.
-using PropertyValue = std::variant<Scalar, std::vector<Scalar>, StructValue, std::vector<StructValue>>;
+using PropertyValue =
+    std::variant<Scalar, std::vector<Scalar>, StructValue, std::vector<StructValue>>;
 
 std::string format_value(const PropertyValue &value);
 

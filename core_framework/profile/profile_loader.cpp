@@ -113,10 +113,11 @@ Expected<std::shared_ptr<const T>> ProfileLoader::cached(const fs::path &file,
     return tl::unexpected(descriptor.error());
   const T *typed = std::get_if<T>(descriptor->get());
   if (typed == nullptr)
-    return make_error(referenced_at.file.empty() ? SourceLocation{file.string(), 0, 0} : referenced_at,
-                      "wrong-descriptor",
-                      fmt::format("expected {}, but {} is {}", with_article(descriptor_type_for<T>()),
-                                  file.string(), with_article(type_of(**descriptor))));
+    return make_error(
+        referenced_at.file.empty() ? SourceLocation{file.string(), 0, 0} : referenced_at,
+        "wrong-descriptor",
+        fmt::format("expected {}, but {} is {}", with_article(descriptor_type_for<T>()),
+                    file.string(), with_article(type_of(**descriptor))));
   return std::shared_ptr<const T>(*descriptor, typed);
 }
 
@@ -128,7 +129,8 @@ ProfileLoader::load_softpkg(const fs::path &spd_file) {
 Expected<std::shared_ptr<const ResolvedSoftPkg>>
 ProfileLoader::softpkg(const fs::path &spd_file, const SourceLocation &referenced_at) {
   const fs::path key = fs::absolute(spd_file).lexically_normal();
-  if (auto cycle = std::find(resolving_.begin(), resolving_.end(), key); cycle != resolving_.end()) {
+  if (auto cycle = std::find(resolving_.begin(), resolving_.end(), key);
+      cycle != resolving_.end()) {
     std::vector<std::string> chain;
     for (auto it = cycle; it != resolving_.end(); ++it)
       chain.push_back(it->filename().string());

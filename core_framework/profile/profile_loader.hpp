@@ -25,16 +25,16 @@ struct ResolvedDependency {
 };
 
 struct ResolvedImplementation {
-  const Implementation *implementation = nullptr;   // points into the SPD it belongs to
-  std::shared_ptr<const Properties> properties;     // implementation-specific PRF, may be null
+  const Implementation *implementation = nullptr; // points into the SPD it belongs to
+  std::shared_ptr<const Properties> properties;   // implementation-specific PRF, may be null
   std::vector<ResolvedDependency> dependencies;
 };
 
 struct ResolvedSoftPkg {
   std::filesystem::path spd_path;
   std::shared_ptr<const SoftPkg> spd;
-  std::shared_ptr<const Properties> properties;      // may be null
-  std::shared_ptr<const SoftwareComponent> scd;      // may be null (libraries have none)
+  std::shared_ptr<const Properties> properties; // may be null
+  std::shared_ptr<const SoftwareComponent> scd; // may be null (libraries have none)
   std::vector<ResolvedImplementation> implementations;
 
   // The definition of property `id` in the SPD's PRF or any implementation's PRF.
@@ -53,7 +53,7 @@ struct ResolvedApplication {
 struct ResolvedDevicePlacement {
   const ComponentPlacement *placement = nullptr; // points into the DCD
   std::shared_ptr<const ResolvedSoftPkg> softpkg;
-  std::shared_ptr<const DevicePkg> device_pkg;     // when the placement names a DPD
+  std::shared_ptr<const DevicePkg> device_pkg; // when the placement names a DPD
 };
 
 struct ResolvedNode {
@@ -76,7 +76,8 @@ public:
 
   Expected<ResolvedApplication> load_application(const std::filesystem::path &sad_file);
   Expected<ResolvedNode> load_node(const std::filesystem::path &dcd_file);
-  Expected<std::shared_ptr<const ResolvedSoftPkg>> load_softpkg(const std::filesystem::path &spd_file);
+  Expected<std::shared_ptr<const ResolvedSoftPkg>>
+  load_softpkg(const std::filesystem::path &spd_file);
   Expected<DomainManagerConfiguration> load_domain(const std::filesystem::path &dmd_file);
 
   // Reads any descriptor and resolves what it references (the whole check `rsca validate` does).
@@ -86,8 +87,8 @@ private:
   Expected<SdrRoot> root_for(const std::filesystem::path &file) const;
   Expected<std::shared_ptr<const ResolvedSoftPkg>> softpkg(const std::filesystem::path &spd_file,
                                                            const SourceLocation &referenced_at);
-  Expected<std::shared_ptr<const Descriptor>> cached_descriptor(const std::filesystem::path &file,
-                                                                const SourceLocation &referenced_at);
+  Expected<std::shared_ptr<const Descriptor>>
+  cached_descriptor(const std::filesystem::path &file, const SourceLocation &referenced_at);
   template <typename T>
   Expected<std::shared_ptr<const T>> cached(const std::filesystem::path &file,
                                             const SourceLocation &referenced_at);

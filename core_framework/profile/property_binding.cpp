@@ -40,9 +40,9 @@ Bound<Scalar> bind_scalar(const std::string &id, TypeSpec type,
     return bind_error("value", fmt::format("property \"{}\": {}", id, value.error()));
   if (range && !(satisfies(Action::Ge, *value, range->min).value_or(true) &&
                  satisfies(Action::Le, *value, range->max).value_or(true)))
-    return bind_error("range", fmt::format("property \"{}\": {} is outside its range {}..{}", id,
-                                           text, format_scalar(range->min),
-                                           format_scalar(range->max)));
+    return bind_error("range",
+                      fmt::format("property \"{}\": {} is outside its range {}..{}", id, text,
+                                  format_scalar(range->min), format_scalar(range->max)));
   return *value;
 }
 
@@ -72,8 +72,8 @@ Bound<StructValue> bind_struct(const StructProperty &d, const StructRef &r) {
       const auto *simple_ref = std::get_if<SimpleRef>(&member_ref);
       if (simple_ref == nullptr)
         return bind_error("value", fmt::format("member \"{}\" is a simple: use simpleref", refid));
-      auto v = bind_scalar(refid, simple->type, simple->range, simple->enumerations,
-                           simple_ref->value);
+      auto v =
+          bind_scalar(refid, simple->type, simple->range, simple->enumerations, simple_ref->value);
       if (!v)
         return tl::unexpected(v.error());
       value.members.emplace_back(refid, std::move(*v));
@@ -81,8 +81,8 @@ Bound<StructValue> bind_struct(const StructProperty &d, const StructRef &r) {
     }
     const auto *seq_ref = std::get_if<SimpleSequenceRef>(&member_ref);
     if (seq_ref == nullptr)
-      return bind_error("value",
-                        fmt::format("member \"{}\" is a simplesequence: use simplesequenceref", refid));
+      return bind_error(
+          "value", fmt::format("member \"{}\" is a simplesequence: use simplesequenceref", refid));
     auto v = bind_sequence(std::get<SimpleSequenceProperty>(*member), *seq_ref);
     if (!v)
       return tl::unexpected(v.error());
@@ -127,7 +127,8 @@ Bound<PropertyValue> bind(const PropertyDefinition &definition, const PropertyRe
 
 } // namespace
 
-Expected<PropertyValue> bind_property(const PropertyDefinition &definition, const PropertyRef &ref) {
+Expected<PropertyValue> bind_property(const PropertyDefinition &definition,
+                                      const PropertyRef &ref) {
   auto value = bind(definition, ref);
   if (!value)
     return make_error(location_of(ref), value.error().rule, value.error().message);

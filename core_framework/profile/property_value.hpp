@@ -53,8 +53,8 @@ struct TypeSpec {
 // REDHAWK writes utctime as "YYYY:MM:DD::HH:MM:SS.ffffff"; "now" is resolved when it is used.
 struct UtcTime {
   bool now = false;
-  std::int64_t seconds = 0;   // since 1970-01-01T00:00:00Z
-  std::uint32_t micros = 0;   // fraction of the second
+  std::int64_t seconds = 0; // since 1970-01-01T00:00:00Z
+  std::uint32_t micros = 0; // fraction of the second
   friend bool operator==(const UtcTime &, const UtcTime &) = default;
 };
 

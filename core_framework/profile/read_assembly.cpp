@@ -45,8 +45,8 @@ constexpr std::pair<std::string_view, Liveliness> kLiveliness[] = {
     {"automatic", Liveliness::Automatic},
     {"manualbyparticipant", Liveliness::ManualByParticipant},
     {"manualbytopic", Liveliness::ManualByTopic}};
-constexpr std::pair<std::string_view, Ownership> kOwnership[] = {{"shared", Ownership::Shared},
-                                                                 {"exclusive", Ownership::Exclusive}};
+constexpr std::pair<std::string_view, Ownership> kOwnership[] = {
+    {"shared", Ownership::Shared}, {"exclusive", Ownership::Exclusive}};
 constexpr std::pair<std::string_view, Criticality> kCriticality[] = {
     {"low", Criticality::Low},
     {"medium", Criticality::Medium},
@@ -314,9 +314,9 @@ void check_assembly_references(ReadContext &ctx, const std::vector<ComponentFile
                               p.componentfile_ref, fmt::join(file_ids, ", "))});
     for (const auto &ci : p.instantiations)
       if (!instance_ids.insert(ci.id).second)
-        ctx.report({ci.where, "duplicate-id",
-                    fmt::format("componentinstantiation id \"{}\" is defined more than once",
-                                ci.id)});
+        ctx.report(
+            {ci.where, "duplicate-id",
+             fmt::format("componentinstantiation id \"{}\" is defined more than once", ci.id)});
   }
 
   auto check_target = [&](const EndpointTarget &t, const Connection &c) {

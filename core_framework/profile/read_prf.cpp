@@ -51,13 +51,16 @@ std::optional<ValueRange> read_range(ReadContext &ctx, const XmlElement &e, Type
   const XmlElement *r = e.child("range");
   if (r == nullptr)
     return std::nullopt;
-  auto min = detail::read_scalar(ctx, *r, spec, r->attr("min"), fmt::format("range min of \"{}\"", id));
-  auto max = detail::read_scalar(ctx, *r, spec, r->attr("max"), fmt::format("range max of \"{}\"", id));
+  auto min =
+      detail::read_scalar(ctx, *r, spec, r->attr("min"), fmt::format("range min of \"{}\"", id));
+  auto max =
+      detail::read_scalar(ctx, *r, spec, r->attr("max"), fmt::format("range max of \"{}\"", id));
   if (!min || !max)
     return std::nullopt;
   if (satisfies(Action::Gt, *min, *max).value_or(false)) {
-    ctx.fail(*r, "range", fmt::format("range of \"{}\" is empty: min {} is above max {}", id,
-                                      format_scalar(*min), format_scalar(*max)));
+    ctx.fail(*r, "range",
+             fmt::format("range of \"{}\" is empty: min {} is above max {}", id,
+                         format_scalar(*min), format_scalar(*max)));
     return std::nullopt;
   }
   return ValueRange{*min, *max};
@@ -67,8 +70,8 @@ void check_in_range(ReadContext &ctx, const XmlElement &e, const std::optional<V
                     const Scalar &value, const std::string &id) {
   if (range && !in_range(value, *range))
     ctx.fail(e, "range",
-             fmt::format("value {} of \"{}\" is outside its range {}..{}", format_scalar(value),
-                         id, format_scalar(range->min), format_scalar(range->max)));
+             fmt::format("value {} of \"{}\" is outside its range {}..{}", format_scalar(value), id,
+                         format_scalar(range->min), format_scalar(range->max)));
 }
 
 SimpleProperty read_simple(ReadContext &ctx, const XmlElement &e) {
@@ -91,8 +94,9 @@ SimpleProperty read_simple(ReadContext &ctx, const XmlElement &e) {
       const std::string *text = en.attribute("value");
       if (text == nullptr)
         continue; // a label without a value documents the value itself
-      auto value = detail::read_scalar(ctx, en, p.type, *text,
-                                       fmt::format("enumeration \"{}\" of \"{}\"", en.attr("label"), p.id));
+      auto value =
+          detail::read_scalar(ctx, en, p.type, *text,
+                              fmt::format("enumeration \"{}\" of \"{}\"", en.attr("label"), p.id));
       if (value)
         p.enumerations.push_back({en.attr("label"), *value});
     }
@@ -111,7 +115,8 @@ SimpleSequenceProperty read_simple_sequence(ReadContext &ctx, const XmlElement &
   if (const XmlElement *values = e.child("values")) {
     p.values.emplace();
     for (const auto &v : values->children) {
-      auto value = detail::read_scalar(ctx, v, p.type, v.text, fmt::format("value of \"{}\"", p.id));
+      auto value =
+          detail::read_scalar(ctx, v, p.type, v.text, fmt::format("value of \"{}\"", p.id));
       if (!value)
         continue;
       check_in_range(ctx, v, p.range, *value, p.id);
@@ -167,9 +172,11 @@ StructProperty read_struct(ReadContext &ctx, const XmlElement &e) {
     }
     const PropertyCommon &member = common_of(p.members.back());
     ctx.require_unique(member_ids, member.id, c, fmt::format("member of struct \"{}\"", p.id));
-    if (const auto *simple = std::get_if<SimpleProperty>(&p.members.back()); simple && simple->value)
+    if (const auto *simple = std::get_if<SimpleProperty>(&p.members.back());
+        simple && simple->value)
       defaults.members.emplace_back(member.id, *simple->value);
-    if (const auto *seq = std::get_if<SimpleSequenceProperty>(&p.members.back()); seq && seq->values)
+    if (const auto *seq = std::get_if<SimpleSequenceProperty>(&p.members.back());
+        seq && seq->values)
       defaults.members.emplace_back(member.id, *seq->values);
   }
   if (!defaults.members.empty())

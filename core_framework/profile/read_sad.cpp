@@ -91,8 +91,9 @@ void check_instance_refs(ReadContext &ctx, const SoftwareAssembly &sad) {
   for (const auto &p : sad.external_properties) {
     require(p.component_ref, p.where, fmt::format("external property \"{}\"", p.external_id));
     if (!external_ids.insert(p.external_id).second)
-      ctx.report({p.where, "duplicate-id",
-                  fmt::format("external property \"{}\" is defined more than once", p.external_id)});
+      ctx.report(
+          {p.where, "duplicate-id",
+           fmt::format("external property \"{}\" is defined more than once", p.external_id)});
   }
   for (const auto &path : sad.latency_paths)
     for (std::size_t i = 0; i < path.components.size(); ++i)

@@ -52,8 +52,8 @@ struct SoftwareAssembly {
 
   const ComponentFile *find_component_file(std::string_view id) const;
   // The instantiation with that id and the placement holding it; nullptr when none.
-  const ComponentInstantiation *find_instantiation(std::string_view id,
-                                                   const ComponentPlacement **placement = nullptr) const;
+  const ComponentInstantiation *
+  find_instantiation(std::string_view id, const ComponentPlacement **placement = nullptr) const;
 };
 
 } // namespace rsca::profile

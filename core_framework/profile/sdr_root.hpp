@@ -21,8 +21,8 @@ public:
 
   // Where a name written in `referencing_file` points: "/x/y" under the given tree, "x/y"
   // relative to the referencing file's folder.
-  std::filesystem::path resolve(std::string_view name, const std::filesystem::path &referencing_file,
-                                SdrTree tree) const;
+  std::filesystem::path resolve(std::string_view name,
+                                const std::filesystem::path &referencing_file, SdrTree tree) const;
 
   // Whether `file` (normalised) lies inside this SDR root.
   bool contains(const std::filesystem::path &file) const;

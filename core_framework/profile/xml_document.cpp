@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 #include <xercesc/framework/MemBufInputSource.hpp>
 #include <xercesc/framework/XMLGrammarPoolImpl.hpp>
+#include <xercesc/sax/EntityResolver.hpp>
 #include <xercesc/sax/Locator.hpp>
 #include <xercesc/sax/SAXParseException.hpp>
 #include <xercesc/sax2/Attributes.hpp>
@@ -20,7 +21,6 @@
 #include <xercesc/util/PlatformUtils.hpp>
 #include <xercesc/util/SecurityManager.hpp>
 #include <xercesc/util/TransService.hpp>
-#include <xercesc/sax/EntityResolver.hpp>
 #include <xercesc/util/XMLUni.hpp>
 #include <xercesc/validators/common/Grammar.hpp>
 
@@ -87,7 +87,9 @@ struct XercesRuntime {
   XercesRuntime &operator=(const XercesRuntime &) = delete;
 };
 
-void ensure_xerces() { static XercesRuntime runtime; }
+void ensure_xerces() {
+  static XercesRuntime runtime;
+}
 
 class Utf8 {
 public:
@@ -157,17 +159,21 @@ private:
     std::string message = explain(utf8_(e.getMessage()));
     constexpr std::string_view kUndeclared = "no declaration found for element '";
     if (message.starts_with(kUndeclared)) {
-      std::string name = message.substr(kUndeclared.size(), message.find('\'', kUndeclared.size()) - kUndeclared.size());
+      std::string name = message.substr(kUndeclared.size(), message.find('\'', kUndeclared.size()) -
+                                                                kUndeclared.size());
       if (!root_seen_)
-        message = fmt::format("<{}> is not the root of a domain profile: expected {}", name, kProfileRoots);
+        message = fmt::format("<{}> is not the root of a domain profile: expected {}", name,
+                              kProfileRoots);
       else
         message = fmt::format("<{}> is not an element rsca knows here", name);
       undeclared_.push_back(std::move(name));
     } else if (is_consequence_of_undeclared(message)) {
       return; // the parent's content model fails only because of a child already reported
     }
-    add(Diagnostic{{file_, static_cast<int>(e.getLineNumber()), static_cast<int>(e.getColumnNumber())},
-                   rule, std::move(message)});
+    add(Diagnostic{
+        {file_, static_cast<int>(e.getLineNumber()), static_cast<int>(e.getColumnNumber())},
+        rule,
+        std::move(message)});
   }
 
   bool is_consequence_of_undeclared(const std::string &message) const {
@@ -197,9 +203,10 @@ public:
     if (collector_ != nullptr)
       collector_->set_root_seen(true);
     if (open_.size() >= kMaxDepth)
-      throw ParseStopped{{{file_, line(), column()},
-                          "xml",
-                          fmt::format("elements nest deeper than {} levels; no profile does", kMaxDepth)}};
+      throw ParseStopped{
+          {{file_, line(), column()},
+           "xml",
+           fmt::format("elements nest deeper than {} levels; no profile does", kMaxDepth)}};
     XmlElement element;
     element.name = utf8_(local_name);
     if (locator_ != nullptr) {
@@ -263,7 +270,6 @@ void set_validating_features(x::SAX2XMLReader &reader) {
   reader.setFeature(x::XMLUni::fgXercesDisableDefaultEntityResolution, true);
 }
 
-
 // The schemas, compiled once per process and shared read-only by every reader.
 class SchemaCache {
 public:
@@ -309,8 +315,8 @@ const SchemaCache &schema_cache() {
 class ProfileReader {
 public:
   ProfileReader() : cache_(schema_cache()) {
-    reader_.reset(x::XMLReaderFactory::createXMLReader(x::XMLPlatformUtils::fgMemoryManager,
-                                                       cache_.pool()));
+    reader_.reset(
+        x::XMLReaderFactory::createXMLReader(x::XMLPlatformUtils::fgMemoryManager, cache_.pool()));
     set_validating_features(*reader_);
     reader_->setFeature(x::XMLUni::fgXercesUseCachedGrammarInParse, true);
     reader_->setFeature(x::XMLUni::fgXercesLoadSchema, false);
@@ -453,7 +459,9 @@ std::string XmlElement::child_text(std::string_view child_name) const {
   return c != nullptr ? c->trimmed_text() : std::string();
 }
 
-std::string XmlElement::trimmed_text() const { return std::string(trim(text)); }
+std::string XmlElement::trimmed_text() const {
+  return std::string(trim(text));
+}
 
 std::string_view embedded_schema(std::string_view file_name) {
   std::size_t count = 0;

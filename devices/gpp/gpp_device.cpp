@@ -33,16 +33,19 @@ GppDevice::GppDevice(node::DeviceContext context)
     : context_(std::move(context)),
       launcher_([this](ProcessId pid, ExitStatus status) { on_exit(pid, status); }) {
   const HostInfo host = read_host_info();
-  properties_ = {{"os_name", override_of(context_, "os_name").value_or(host.os_name)},
-                 {"processor_name", override_of(context_, "processor_name").value_or(host.processor_name)},
-                 {"hostname", host.hostname}};
-  capacity_ = {{"cpu_capacity", override_of(context_, "cpu_capacity").value_or(Json(host.cpu_cores * 100.0))},
-               {"mem_capacity",
-                override_of(context_, "mem_capacity")
-                    .value_or(Json(static_cast<double>(host.memory_total_bytes) / (1024.0 * 1024.0)))}};
+  properties_ = {
+      {"os_name", override_of(context_, "os_name").value_or(host.os_name)},
+      {"processor_name", override_of(context_, "processor_name").value_or(host.processor_name)},
+      {"hostname", host.hostname}};
+  capacity_ = {{"cpu_capacity",
+                override_of(context_, "cpu_capacity").value_or(Json(host.cpu_cores * 100.0))},
+               {"mem_capacity", override_of(context_, "mem_capacity")
+                                    .value_or(Json(static_cast<double>(host.memory_total_bytes) /
+                                                   (1024.0 * 1024.0)))}};
 }
 
-Expected<std::unique_ptr<node::LogicalDevice>> GppDevice::create(const node::DeviceContext &context) {
+Expected<std::unique_ptr<node::LogicalDevice>>
+GppDevice::create(const node::DeviceContext &context) {
   return std::unique_ptr<node::LogicalDevice>(std::make_unique<GppDevice>(context));
 }
 
@@ -72,10 +75,12 @@ CallResult<Json> GppDevice::execute(const Json &body) {
   request.label = fmt::format("{}/{}", application, component);
   auto pid = launcher_.execute(request);
   if (!pid)
-    return control::call_error(Status::Failed, fmt::format("{}: {}", context_.id, pid.error().to_string()));
+    return control::call_error(Status::Failed,
+                               fmt::format("{}: {}", context_.id, pid.error().to_string()));
   {
     std::lock_guard lock(mutex_);
-    owners_[*pid] = {{"application", application}, {"component", component},
+    owners_[*pid] = {{"application", application},
+                     {"component", component},
                      {"address", [&] {
                         const auto &args = request.args;
                         for (std::size_t i = 0; i + 1 < args.size(); ++i)
@@ -94,7 +99,8 @@ CallResult<Json> GppDevice::terminate(const Json &body) {
   {
     std::lock_guard lock(mutex_);
     if (owners_.count(pid) == 0)
-      return control::call_error(Status::NotFound, fmt::format("{} did not start pid {}", context_.id, pid));
+      return control::call_error(Status::NotFound,
+                                 fmt::format("{} did not start pid {}", context_.id, pid));
   }
   auto ok = launcher_.terminate(pid);
   if (!ok)

@@ -25,7 +25,8 @@ public:
   explicit GppDevice(node::DeviceContext context);
 
 private:
-  std::filesystem::path find_executable(const std::string &entrypoint, const std::string &spd_dir) const;
+  std::filesystem::path find_executable(const std::string &entrypoint,
+                                        const std::string &spd_dir) const;
   void on_exit(ProcessId pid, const ExitStatus &status);
 
   node::DeviceContext context_;

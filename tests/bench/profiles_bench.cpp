@@ -40,7 +40,8 @@ void BM_ValidateWholeCorpus(benchmark::State &state) {
 BENCHMARK(BM_ValidateWholeCorpus)->Unit(benchmark::kMillisecond);
 
 void BM_LoadApplication(benchmark::State &state) {
-  const fs::path sad = fs::path(RSCA_CORPUS_DIR) / "dom/waveforms/rh/FM_RBDS_demo/FM_RBDS_demo.sad.xml";
+  const fs::path sad =
+      fs::path(RSCA_CORPUS_DIR) / "dom/waveforms/rh/FM_RBDS_demo/FM_RBDS_demo.sad.xml";
   for (auto _ : state) {
     ProfileLoader loader;
     auto app = loader.load_application(sad);

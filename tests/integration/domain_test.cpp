@@ -13,9 +13,9 @@
 #include <fmt/format.h>
 #include <future>
 
+#include "../unit/test_domain.hpp"
 #include "child_process.hpp"
 #include "control/endpoint.hpp"
-#include "../unit/test_domain.hpp"
 
 namespace {
 
@@ -45,21 +45,25 @@ bool process_exists(long pid) {
 class TestDomain {
 public:
   explicit TestDomain(int nodes = 2, int registration_timeout_ms = 3000)
-      : run_(fs::temp_directory_path() / fmt::format("rsca-it-{}-{}", getpid(), std::random_device{}())) {
+      : run_(fs::temp_directory_path() /
+             fmt::format("rsca-it-{}-{}", getpid(), std::random_device{}())) {
     fs::create_directories(run_ / "logs");
     env_ = {{"RSCA_DDS_DOMAIN", std::to_string(rsca::test::isolated_domain_id())}};
     domaind_ = std::make_unique<ChildProcess>(
         (kBin / "rsca-domaind").string(),
-        std::vector<std::string>{"--dmd", (kSource / "profiles/dom/domain/DomainManager.dmd.xml").string(),
-                                 "--repository", (run_ / "repository").string(),
-                                 "--registration-timeout-ms", std::to_string(registration_timeout_ms)},
+        std::vector<std::string>{
+            "--dmd", (kSource / "profiles/dom/domain/DomainManager.dmd.xml").string(),
+            "--repository", (run_ / "repository").string(), "--registration-timeout-ms",
+            std::to_string(registration_timeout_ms)},
         env_);
     for (int i = 1; i <= nodes; ++i)
       nodes_.push_back(std::make_unique<ChildProcess>(
           (kBin / "rsca-noded").string(),
-          std::vector<std::string>{"--dcd",
-                                   (kSource / fmt::format("profiles/dev/nodes/node{}/DeviceManager.dcd.xml", i)).string(),
-                                   "--log-dir", (run_ / "logs").string(), "--exec-path", kBin.string()},
+          std::vector<std::string>{
+              "--dcd",
+              (kSource / fmt::format("profiles/dev/nodes/node{}/DeviceManager.dcd.xml", i))
+                  .string(),
+              "--log-dir", (run_ / "logs").string(), "--exec-path", kBin.string()},
           env_));
     auto pp = rsca::test::participant();
     auto endpoint = rsca::control::Endpoint::open(pp, fmt::format("rsca/cli/test-{}", getpid()));
@@ -94,7 +98,8 @@ public:
   // Runs the CLI against this domain; returns its exit code and output.
   std::pair<int, std::string> cli(const std::vector<std::string> &args) {
     const fs::path out = run_ / "cli.out";
-    std::vector<std::string> sh_args{"-c", "\"$0\" \"$@\" > " + out.string() + " 2>&1", (kBin / "rsca").string()};
+    std::vector<std::string> sh_args{"-c", "\"$0\" \"$@\" > " + out.string() + " 2>&1",
+                                     (kBin / "rsca").string()};
     sh_args.insert(sh_args.end(), args.begin(), args.end());
     ChildProcess cli("/bin/sh", sh_args, env_);
     auto status = cli.wait_exit(60s);
@@ -104,8 +109,9 @@ public:
   }
 
   void install(const std::string &application) {
-    auto [rc, out] = cli({"install", "--sdrroot", kTestSdr.string(),
-                          (kTestSdr / fmt::format("dom/waveforms/{0}/{0}.sad.xml", application)).string()});
+    auto [rc, out] =
+        cli({"install", "--sdrroot", kTestSdr.string(),
+             (kTestSdr / fmt::format("dom/waveforms/{0}/{0}.sad.xml", application)).string()});
     INFO(out);
     REQUIRE(rc == 0);
   }
@@ -129,7 +135,8 @@ public:
     for (int i = 0; i < static_cast<int>(nodes_.size()); ++i) {
       if (!nodes_[i])
         continue;
-      auto status = client_->call_sync(fmt::format("rsca/node/node{}", i + 1), "node.status", Json::object(), 5s);
+      auto status = client_->call_sync(fmt::format("rsca/node/node{}", i + 1), "node.status",
+                                       Json::object(), 5s);
       REQUIRE(status.has_value());
       CHECK(status->at("processes").empty());
     }
@@ -141,7 +148,8 @@ public:
     for (int i = 0; i < static_cast<int>(nodes_.size()); ++i) {
       if (!nodes_[i])
         continue;
-      auto status = client_->call_sync(fmt::format("rsca/node/node{}", i + 1), "node.status", Json::object(), 5s);
+      auto status = client_->call_sync(fmt::format("rsca/node/node{}", i + 1), "node.status",
+                                       Json::object(), 5s);
       if (status)
         for (const auto &p : status->at("processes"))
           pids.push_back(p.at("pid").get<long>());
@@ -155,9 +163,10 @@ public:
     REQUIRE(domaind_->wait_exit(5s).has_value());
     domaind_ = std::make_unique<ChildProcess>(
         (kBin / "rsca-domaind").string(),
-        std::vector<std::string>{"--dmd", (kSource / "profiles/dom/domain/DomainManager.dmd.xml").string(),
-                                 "--repository", (run_ / "repository").string(),
-                                 "--registration-timeout-ms", std::to_string(registration_timeout_ms)},
+        std::vector<std::string>{
+            "--dmd", (kSource / "profiles/dom/domain/DomainManager.dmd.xml").string(),
+            "--repository", (run_ / "repository").string(), "--registration-timeout-ms",
+            std::to_string(registration_timeout_ms)},
         env_);
   }
 
@@ -197,7 +206,8 @@ std::vector<long> pids_of(const Json &app) {
 }
 
 long received(TestDomain &domain, const std::string &app) {
-  auto q = domain.call("app.query", Json{{"app", app}, {"component", "Consumer_1"}, {"ids", {"received"}}});
+  auto q = domain.call("app.query",
+                       Json{{"app", app}, {"component", "Consumer_1"}, {"ids", {"received"}}});
   if (!q)
     return -1;
   return q->at("properties").at("received").get<long>();
@@ -208,7 +218,9 @@ long received(TestDomain &domain, const std::string &app) {
 TEST_CASE("ProducerConsumer: install, launch, data flows, configure, query, stop, release",
           "[integration][domain]") {
   TestDomain domain;
-  auto [rc, out] = domain.cli({"launch", (kSource / "profiles/dom/waveforms/ProducerConsumer/ProducerConsumer.sad.xml").string()});
+  auto [rc, out] = domain.cli(
+      {"launch",
+       (kSource / "profiles/dom/waveforms/ProducerConsumer/ProducerConsumer.sad.xml").string()});
   INFO(out);
   REQUIRE(rc == 0);
   auto app = domain.call("app.show", Json{{"app", "ProducerConsumer"}});
@@ -226,13 +238,17 @@ TEST_CASE("ProducerConsumer: install, launch, data flows, configure, query, stop
   auto [crc, cout_text] = domain.cli({"configure", "ProducerConsumer/Producer_1", "rate_hz=200"});
   INFO(cout_text);
   CHECK(crc == 0);
-  auto q = domain.call("app.query", Json{{"app", "ProducerConsumer"}, {"component", "Producer_1"}, {"ids", {"rate_hz"}}});
+  auto q = domain.call(
+      "app.query",
+      Json{{"app", "ProducerConsumer"}, {"component", "Producer_1"}, {"ids", {"rate_hz"}}});
   REQUIRE(q.has_value());
   CHECK(q->at("properties").at("rate_hz").get<double>() == 200.0);
   auto [brc, bad] = domain.cli({"configure", "ProducerConsumer/Producer_1", "rate_hz=fast"});
   CHECK(brc == 1);
   CHECK_THAT(bad, Catch::Contains("\"fast\" is not a valid double"));
-  q = domain.call("app.query", Json{{"app", "ProducerConsumer"}, {"component", "Producer_1"}, {"ids", {"rate_hz"}}});
+  q = domain.call(
+      "app.query",
+      Json{{"app", "ProducerConsumer"}, {"component", "Producer_1"}, {"ids", {"rate_hz"}}});
   CHECK(q->at("properties").at("rate_hz").get<double>() == 200.0); // nothing applied
 
   // Stop, start, release.
@@ -246,7 +262,8 @@ TEST_CASE("ProducerConsumer: install, launch, data flows, configure, query, stop
   domain.require_clean(pids);
 }
 
-TEST_CASE("a missing executable fails the launch at execute and rolls back", "[integration][domain][failure]") {
+TEST_CASE("a missing executable fails the launch at execute and rolls back",
+          "[integration][domain][failure]") {
   TestDomain domain;
   domain.install("MissingExecutable");
   auto [rc, out] = domain.cli({"launch", "MissingExecutable"});
@@ -258,7 +275,8 @@ TEST_CASE("a missing executable fails the launch at execute and rolls back", "[i
   CHECK(domain.running_pids().empty());
 }
 
-TEST_CASE("a component crashing at start fails the launch and rolls back", "[integration][domain][failure]") {
+TEST_CASE("a component crashing at start fails the launch and rolls back",
+          "[integration][domain][failure]") {
   TestDomain domain;
   domain.install("CrashAtStart");
   auto [rc, out] = domain.cli({"launch", "CrashAtStart"});
@@ -269,7 +287,8 @@ TEST_CASE("a component crashing at start fails the launch and rolls back", "[int
   domain.require_clean({});
 }
 
-TEST_CASE("a component that never registers fails the launch at register", "[integration][domain][failure]") {
+TEST_CASE("a component that never registers fails the launch at register",
+          "[integration][domain][failure]") {
   TestDomain domain(2, /*registration_timeout_ms=*/1500);
   domain.install("NeverRegisters");
   auto [rc, out] = domain.cli({"launch", "NeverRegisters"});
@@ -283,8 +302,9 @@ TEST_CASE("a component that never registers fails the launch at register", "[int
 TEST_CASE("a property value of the wrong type is refused at install, before anything runs",
           "[integration][domain][failure]") {
   TestDomain domain;
-  auto [rc, out] = domain.cli({"install", "--sdrroot", kTestSdr.string(),
-                               (kTestSdr / "dom/waveforms/WrongValueType/WrongValueType.sad.xml").string()});
+  auto [rc, out] =
+      domain.cli({"install", "--sdrroot", kTestSdr.string(),
+                  (kTestSdr / "dom/waveforms/WrongValueType/WrongValueType.sad.xml").string()});
   CHECK(rc == 1);
   CHECK_THAT(out, Catch::Contains("WrongValueType.sad.xml:26:52"));
   CHECK_THAT(out, Catch::Contains("\"eleven\" is not a valid ulong"));
@@ -300,7 +320,8 @@ TEST_CASE("no device that matches: the launch is rejected with the reason per de
   auto [rc, out] = domain.cli({"launch", "NoMatchingDevice"});
   CHECK(rc == 5);
   CHECK_THAT(out, Catch::Contains("failed at step 'allocate'"));
-  CHECK_THAT(out, Catch::Contains("node1:GPP_1 (cpp): os_name is Linux, implementation cpp needs VxWorks"));
+  CHECK_THAT(out, Catch::Contains(
+                      "node1:GPP_1 (cpp): os_name is Linux, implementation cpp needs VxWorks"));
   CHECK_THAT(out, Catch::Contains("node2:GPP_1"));
   domain.require_clean({});
 }
@@ -310,7 +331,9 @@ TEST_CASE("a node daemon killed during a launch fails it, and the rest is rolled
   TestDomain domain;
   domain.install("HangAtConfigure");
   // Both components land on node1 (first fit); the launch hangs in configure, and node1 dies.
-  auto launch = std::async(std::launch::async, [&] { return domain.cli({"launch", "HangAtConfigure"}); });
+  auto launch = std::async(std::launch::async, [&] {
+    return domain.cli({"launch", "HangAtConfigure"});
+  });
   REQUIRE(TestDomain::wait_for([&] { return domain.running_pids().size() == 2; }));
   const auto pids = domain.running_pids();
   domain.kill_node(1);

@@ -33,7 +33,8 @@ public:
       if (g_fault == "hang_at_configure")
         std::this_thread::sleep_for(std::chrono::hours(1)); // the fault itself: never answer
     });
-    provides_port<rsca::port::Samples>("samples_in", [this](const rsca::port::Samples &) { ++received_; });
+    provides_port<rsca::port::Samples>("samples_in",
+                                       [this](const rsca::port::Samples &) { ++received_; });
   }
 
 private:

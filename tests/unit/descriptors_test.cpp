@@ -348,8 +348,7 @@ TEST_CASE("SCD: ports, repids and directions", "[descriptors][scd]") {
   CHECK(gpp.interfaces[0].inherits == std::vector<std::string>{"IDL:CF/LoadableDevice:1.0"});
 }
 
-TEST_CASE("SAD: an external port naming a supported interface",
-          "[descriptors][sad]") {
+TEST_CASE("SAD: an external port naming a supported interface", "[descriptors][sad]") {
   ScratchSdrRoot root;
   const fs::path sad =
       root.sad_with("<usesidentifier>samples_out</usesidentifier>\n      "

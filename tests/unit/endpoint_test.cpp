@@ -17,8 +17,8 @@ using control::Status;
 
 namespace {
 
-std::unique_ptr<Endpoint> open(const std::shared_ptr<dds::Participant> &pp, const std::string &address,
-                               control::EndpointOptions options = {}) {
+std::unique_ptr<Endpoint> open(const std::shared_ptr<dds::Participant> &pp,
+                               const std::string &address, control::EndpointOptions options = {}) {
   auto endpoint = Endpoint::open(pp, address, options);
   REQUIRE(endpoint.has_value());
   return std::move(*endpoint);
@@ -31,9 +31,11 @@ TEST_CASE("a call reaches the addressed endpoint and its reply comes back", "[co
   auto server = open(pp, "test/server");
   auto other = open(pp, "test/other");
   std::atomic<int> other_calls{0};
-  server->on("add", [](const Json &body, const control::RequestContext &ctx) -> control::CallResult<Json> {
-    return Json{{"sum", body.at("a").get<int>() + body.at("b").get<int>()}, {"from", ctx.sender}};
-  });
+  server->on("add",
+             [](const Json &body, const control::RequestContext &ctx) -> control::CallResult<Json> {
+               return Json{{"sum", body.at("a").get<int>() + body.at("b").get<int>()},
+                           {"from", ctx.sender}};
+             });
   other->on("add", [&](const Json &, const control::RequestContext &) -> control::CallResult<Json> {
     ++other_calls;
     return Json{};
@@ -49,9 +51,10 @@ TEST_CASE("a call reaches the addressed endpoint and its reply comes back", "[co
 TEST_CASE("errors travel back with their status", "[control]") {
   auto pp = test::participant();
   auto server = open(pp, "test/server");
-  server->on("fail", [](const Json &, const control::RequestContext &) -> control::CallResult<Json> {
-    return control::call_error(Status::Rejected, "not enough memory on gpp@node2");
-  });
+  server->on("fail",
+             [](const Json &, const control::RequestContext &) -> control::CallResult<Json> {
+               return control::call_error(Status::Rejected, "not enough memory on gpp@node2");
+             });
   auto client = open(pp, "test/client");
   auto reply = client->call_sync("test/server", "fail", Json::object(), 5s);
   REQUIRE_FALSE(reply.has_value());
@@ -80,14 +83,16 @@ TEST_CASE("a slow handler times out the caller but does not block other calls", 
   std::mutex m;
   std::condition_variable cv;
   bool release = false;
-  server->on("slow", [&](const Json &, const control::RequestContext &) -> control::CallResult<Json> {
-    std::unique_lock lock(m);
-    cv.wait(lock, [&] { return release; });
-    return Json{};
-  });
-  server->on("fast", [](const Json &, const control::RequestContext &) -> control::CallResult<Json> {
-    return Json{{"ok", true}};
-  });
+  server->on("slow",
+             [&](const Json &, const control::RequestContext &) -> control::CallResult<Json> {
+               std::unique_lock lock(m);
+               cv.wait(lock, [&] { return release; });
+               return Json{};
+             });
+  server->on("fast",
+             [](const Json &, const control::RequestContext &) -> control::CallResult<Json> {
+               return Json{{"ok", true}};
+             });
   auto client = open(pp, "test/client");
   auto slow = client->call("test/server", "slow", Json::object(), 300ms);
   auto fast = client->call_sync("test/server", "fast", Json::object(), 5s);
@@ -122,24 +127,28 @@ TEST_CASE("announcements are seen, updated and withdrawn", "[control]") {
     REQUIRE(node->announce("node", Json{{"devices", 1}}).has_value());
     CHECK(wait_for([](const auto &ev) {
       return !ev.empty() && ev.back().address == "test/node1" &&
-             ev.back().kind == control::AnnouncementEvent::Kind::Alive && ev.back().body.at("devices") == 1;
+             ev.back().kind == control::AnnouncementEvent::Kind::Alive &&
+             ev.back().body.at("devices") == 1;
     }));
     REQUIRE(node->announce("node", Json{{"devices", 2}}).has_value());
     CHECK(wait_for([](const auto &ev) { return ev.back().body.value("devices", 0) == 2; }));
   } // the endpoint goes: its announcement is disposed
   CHECK(wait_for([](const auto &ev) {
-    return ev.back().address == "test/node1" && ev.back().kind == control::AnnouncementEvent::Kind::Gone;
+    return ev.back().address == "test/node1" &&
+           ev.back().kind == control::AnnouncementEvent::Kind::Gone;
   }));
 }
 
-TEST_CASE("the way to an endpoint can be prepared before it exists and forgotten after", "[control]") {
+TEST_CASE("the way to an endpoint can be prepared before it exists and forgotten after",
+          "[control]") {
   auto pp = test::participant();
   auto client = open(pp, "test/client");
   client->prepare("test/later"); // nobody there yet: no error, no wait
   auto server = open(pp, "test/later");
-  server->on("ping", [](const Json &, const control::RequestContext &) -> control::CallResult<Json> {
-    return Json{{"pong", true}};
-  });
+  server->on("ping",
+             [](const Json &, const control::RequestContext &) -> control::CallResult<Json> {
+               return Json{{"pong", true}};
+             });
   auto reply = client->call_sync("test/later", "ping", Json::object(), 5s);
   REQUIRE(reply.has_value());
   CHECK(reply->at("pong") == true);

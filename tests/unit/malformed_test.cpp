@@ -48,8 +48,8 @@ const Error &error_of(const Expected<T> &result) {
 const Diagnostic &find_rule(const Error &error, std::string_view rule) {
   INFO("diagnostics:\n" << error.to_string());
   const auto &all = error.diagnostics();
-  auto it = std::find_if(all.begin(), all.end(),
-                         [&](const Diagnostic &d) { return d.rule == rule; });
+  auto it =
+      std::find_if(all.begin(), all.end(), [&](const Diagnostic &d) { return d.rule == rule; });
   REQUIRE(it != all.end());
   return *it;
 }
@@ -109,24 +109,23 @@ void write_file(const fs::path &file, std::string_view text) {
 // A valid SAD with `padding` bytes of comment inside, so tests can make it any size.
 std::string padded_sad(std::size_t padding) {
   const std::string head = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<!--";
-  const std::string tail =
-      "-->\n"
-      "<softwareassembly id=\"DCE:big\" name=\"big\">\n"
-      "  <componentfiles>\n"
-      "    <componentfile id=\"comp_spd\" type=\"SPD\">\n"
-      "      <localfile name=\"/components/comp/comp.spd.xml\"/>\n"
-      "    </componentfile>\n"
-      "  </componentfiles>\n"
-      "  <partitioning>\n"
-      "    <componentplacement>\n"
-      "      <componentfileref refid=\"comp_spd\"/>\n"
-      "      <componentinstantiation id=\"comp_1\"/>\n"
-      "    </componentplacement>\n"
-      "  </partitioning>\n"
-      "  <assemblycontroller>\n"
-      "    <componentinstantiationref refid=\"comp_1\"/>\n"
-      "  </assemblycontroller>\n"
-      "</softwareassembly>\n";
+  const std::string tail = "-->\n"
+                           "<softwareassembly id=\"DCE:big\" name=\"big\">\n"
+                           "  <componentfiles>\n"
+                           "    <componentfile id=\"comp_spd\" type=\"SPD\">\n"
+                           "      <localfile name=\"/components/comp/comp.spd.xml\"/>\n"
+                           "    </componentfile>\n"
+                           "  </componentfiles>\n"
+                           "  <partitioning>\n"
+                           "    <componentplacement>\n"
+                           "      <componentfileref refid=\"comp_spd\"/>\n"
+                           "      <componentinstantiation id=\"comp_1\"/>\n"
+                           "    </componentplacement>\n"
+                           "  </partitioning>\n"
+                           "  <assemblycontroller>\n"
+                           "    <componentinstantiationref refid=\"comp_1\"/>\n"
+                           "  </assemblycontroller>\n"
+                           "</softwareassembly>\n";
   std::string text = head;
   text.append(padding, 'x');
   text += tail;
@@ -282,9 +281,9 @@ TEST_CASE("a SAD override outside the PRF range", "[malformed][range]") {
 // Dangling references.
 
 TEST_CASE("a componentfileref naming no componentfile", "[malformed][dangling]") {
-  single_file_error(fixture("dangling/componentfileref.sad.xml"), "dangling-ref", 11, 46,
-                    {"componentfileref refid \"missing_spd\" names no componentfile",
-                     "(known: comp_spd)"});
+  single_file_error(
+      fixture("dangling/componentfileref.sad.xml"), "dangling-ref", 11, 46,
+      {"componentfileref refid \"missing_spd\" names no componentfile", "(known: comp_spd)"});
 }
 
 TEST_CASE("a connection naming no componentinstantiation", "[malformed][dangling]") {
@@ -297,7 +296,8 @@ TEST_CASE("a connection naming no componentinstantiation", "[malformed][dangling
   CHECK(d.rule == "dangling-ref");
   CHECK(d.where.file == file.string());
   CHECK(d.where.line == 26); // the <componentinstantiationref refid="ghost_1"/> itself
-  CHECK_THAT(d.message, Contains("connection \"link\" refers to componentinstantiation \"ghost_1\""));
+  CHECK_THAT(d.message,
+             Contains("connection \"link\" refers to componentinstantiation \"ghost_1\""));
   CHECK_THAT(d.message, Contains("which this file does not define"));
 }
 
@@ -395,8 +395,7 @@ TEST_CASE("softpkg dependencies forming a cycle", "[malformed][dependency-cycle]
     const Error &error = error_of(result);
     check(find_rule(error, "dependency-cycle"), "dependency-cycle", loader_name(b), 13, 46,
           {"a.spd.xml -> b.spd.xml -> a.spd.xml"});
-    check(find_rule(error, "invalid-ref"), "invalid-ref", loader_name(a), 13, 46,
-          {loader_name(b)});
+    check(find_rule(error, "invalid-ref"), "invalid-ref", loader_name(a), 13, 46, {loader_name(b)});
   }
   SECTION("starting from b") {
     ProfileLoader loader(root);
@@ -552,7 +551,8 @@ TEST_CASE("one dangling reference deep inside leaves no partial model", "[malfor
   CHECK(d.rule == "dangling-ref");
   CHECK(d.where.file == file.string());
   CHECK(d.where.line == 49); // the <componentinstantiationref refid="ghost_1"/> itself
-  CHECK_THAT(d.message, Contains("latency path \"to_nowhere\" names componentinstantiation \"ghost_1\""));
+  CHECK_THAT(d.message,
+             Contains("latency path \"to_nowhere\" names componentinstantiation \"ghost_1\""));
 
   auto descriptor = read_descriptor(file);
   CHECK_FALSE(descriptor.has_value());

@@ -55,11 +55,13 @@ std::optional<fs::path> sdrroot_of(const fs::path &file, const GlobalOptions &gl
 
 // The install request for a SAD: the application's files, read here and carried to the domain,
 // so that the CLI may run on another host than the domain daemon.
-Expected<Json> install_request(const fs::path &sad, const GlobalOptions &global, const std::string &name) {
+Expected<Json> install_request(const fs::path &sad, const GlobalOptions &global,
+                               const std::string &name) {
   auto root = sdrroot_of(sad, global);
   if (!root)
-    return make_error({sad.string(), 0, 0}, "sdrroot",
-                      "no SDR root found: no folder above this file holds dom/ or dev/ (give --sdrroot)");
+    return make_error(
+        {sad.string(), 0, 0}, "sdrroot",
+        "no SDR root found: no folder above this file holds dom/ or dev/ (give --sdrroot)");
   profile::ProfileLoader loader(*root);
   auto app = loader.load_application(sad);
   if (!app)
@@ -69,7 +71,8 @@ Expected<Json> install_request(const fs::path &sad, const GlobalOptions &global,
     collect(*pkg, files);
   Json list = Json::array();
   for (const auto &f : files)
-    list.push_back({{"path", fs::path(f).lexically_relative(*root).string()}, {"content", read_text(f)}});
+    list.push_back(
+        {{"path", fs::path(f).lexically_relative(*root).string()}, {"content", read_text(f)}});
   Json request{{"sad", app->sad_path.lexically_relative(*root).string()}, {"files", list}};
   if (!name.empty())
     request["name"] = name;
@@ -88,7 +91,8 @@ int install(const std::string &sad, const std::string &name, const GlobalOptions
     fmt::print(stderr, "rsca install: {}\n", client.error().to_string());
     return kFailed;
   }
-  auto reply = client->call("domain.install", *request, std::chrono::milliseconds(global.timeout_ms) * 2);
+  auto reply =
+      client->call("domain.install", *request, std::chrono::milliseconds(global.timeout_ms) * 2);
   if (!reply)
     return report_failure(global, "install", reply.error());
   if (installed_name != nullptr)
@@ -96,7 +100,8 @@ int install(const std::string &sad, const std::string &name, const GlobalOptions
   if (global.json && installed_name == nullptr)
     print_json(*reply);
   else if (!global.json)
-    fmt::print("installed {} ({} files)\n", reply->at("name").get<std::string>(), (*request)["files"].size());
+    fmt::print("installed {} ({} files)\n", reply->at("name").get<std::string>(),
+               (*request)["files"].size());
   return kOk;
 }
 
@@ -142,14 +147,19 @@ int launch(const std::string &what, const std::string &name, bool no_start,
     fmt::print(stderr, "rsca launch: {}\n", client.error().to_string());
     return kFailed;
   }
-  const std::string launch_id = fmt::format("{}-{}", getpid(), std::chrono::steady_clock::now().time_since_epoch().count());
-  Json request{{"application", application}, {"start", !no_start}, {"assign", assign}, {"launch_id", launch_id}};
+  const std::string launch_id =
+      fmt::format("{}-{}", getpid(), std::chrono::steady_clock::now().time_since_epoch().count());
+  Json request{{"application", application},
+               {"start", !no_start},
+               {"assign", assign},
+               {"launch_id", launch_id}};
   if (!name.empty())
     request["name"] = name;
   const bool show_progress = !global.json && isatty(STDOUT_FILENO);
   if (show_progress)
     fmt::print("launching {}\n", application);
-  auto future = client->call_async("app.create", request, std::chrono::milliseconds(global.timeout_ms) * 6);
+  auto future =
+      client->call_async("app.create", request, std::chrono::milliseconds(global.timeout_ms) * 6);
   if (show_progress)
     follow_progress(*client, launch_id, future);
   auto reply = future.get();
@@ -159,19 +169,20 @@ int launch(const std::string &what, const std::string &name, bool no_start,
     print_json(*reply);
     return kOk;
   }
-  fmt::print("{} {} ({} components)\n", no_start ? "created" : "launched", reply->at("name").get<std::string>(),
-             reply->at("components").size());
+  fmt::print("{} {} ({} components)\n", no_start ? "created" : "launched",
+             reply->at("name").get<std::string>(), reply->at("components").size());
   return kOk;
 }
 
-int simple_call(const char *what, const std::string &operation, Json body, const GlobalOptions &global,
-                const std::function<void(const Json &)> &print_text) {
+int simple_call(const char *what, const std::string &operation, Json body,
+                const GlobalOptions &global, const std::function<void(const Json &)> &print_text) {
   auto client = DomainClient::connect(global);
   if (!client) {
     fmt::print(stderr, "rsca {}: {}\n", what, client.error().to_string());
     return kFailed;
   }
-  auto reply = client->call(operation, std::move(body), std::chrono::milliseconds(global.timeout_ms) * 2);
+  auto reply =
+      client->call(operation, std::move(body), std::chrono::milliseconds(global.timeout_ms) * 2);
   if (!reply)
     return report_failure(global, what, reply.error());
   if (global.json)
@@ -201,7 +212,9 @@ std::optional<Json> parse_assignments(const std::vector<std::string> &args) {
   return values;
 }
 
-std::string scalar_text(const Json &v) { return v.is_string() ? v.get<std::string>() : v.dump(); }
+std::string scalar_text(const Json &v) {
+  return v.is_string() ? v.get<std::string>() : v.dump();
+}
 
 } // namespace
 
@@ -223,10 +236,13 @@ int show_application(const std::string &name, const GlobalOptions &global) {
 }
 
 void add_application_commands(CLI::App &app, const GlobalOptions &global, int &exit_code) {
-  auto *install_cmd = app.add_subcommand("install", "Install an application (its SAD and every profile it names) in the domain");
+  auto *install_cmd = app.add_subcommand(
+      "install", "Install an application (its SAD and every profile it names) in the domain");
   auto sad = std::make_shared<std::string>();
   auto name = std::make_shared<std::string>();
-  install_cmd->add_option("sad", *sad, "The application's SAD")->required()->check(CLI::ExistingFile);
+  install_cmd->add_option("sad", *sad, "The application's SAD")
+      ->required()
+      ->check(CLI::ExistingFile);
   install_cmd->add_option("--name", *name, "Install under this name (default: the SAD's name)");
   install_cmd->callback([=, &global, &exit_code] { exit_code = install(*sad, *name, global); });
 
@@ -234,19 +250,23 @@ void add_application_commands(CLI::App &app, const GlobalOptions &global, int &e
   auto installed = std::make_shared<std::string>();
   uninstall_cmd->add_option("name", *installed, "Installed application")->required();
   uninstall_cmd->callback([=, &global, &exit_code] {
-    exit_code = simple_call("uninstall", "domain.uninstall", Json{{"name", *installed}}, global,
-                            [](const Json &r) { fmt::print("uninstalled {}\n", r.value("name", "")); });
+    exit_code =
+        simple_call("uninstall", "domain.uninstall", Json{{"name", *installed}}, global,
+                    [](const Json &r) { fmt::print("uninstalled {}\n", r.value("name", "")); });
   });
 
-  auto *launch_cmd = app.add_subcommand("launch", "Create (and start) an application from a SAD or an installed name");
+  auto *launch_cmd = app.add_subcommand(
+      "launch", "Create (and start) an application from a SAD or an installed name");
   auto what = std::make_shared<std::string>();
   auto instance = std::make_shared<std::string>();
   auto no_start = std::make_shared<bool>(false);
   auto assign = std::make_shared<std::vector<std::string>>();
-  launch_cmd->add_option("application", *what, "SAD file or installed application name")->required();
+  launch_cmd->add_option("application", *what, "SAD file or installed application name")
+      ->required();
   launch_cmd->add_option("--name", *instance, "Name of the running application");
   launch_cmd->add_flag("--no-start", *no_start, "Create and connect, but do not start");
-  launch_cmd->add_option("--assign", *assign, "Place a component on a device: COMPONENT=DEVICE (repeatable)");
+  launch_cmd->add_option("--assign", *assign,
+                         "Place a component on a device: COMPONENT=DEVICE (repeatable)");
   launch_cmd->callback([=, &global, &exit_code] {
     exit_code = launch(*what, *instance, *no_start, *assign, global);
   });
@@ -254,20 +274,24 @@ void add_application_commands(CLI::App &app, const GlobalOptions &global, int &e
   for (const auto &[verb, op, help] :
        {std::tuple{"start", "app.start", "Start a created or stopped application"},
         std::tuple{"stop", "app.stop", "Stop a running application"},
-        std::tuple{"release", "app.release", "Tear an application down: its processes, connections and allocations"}}) {
+        std::tuple{"release", "app.release",
+                   "Tear an application down: its processes, connections and allocations"}}) {
     auto *cmd = app.add_subcommand(verb, help);
     auto target = std::make_shared<std::string>();
     cmd->add_option("app", *target, "Running application")->required();
     cmd->callback([=, verb = std::string(verb), op = std::string(op), &global, &exit_code] {
-      exit_code = simple_call(verb.c_str(), op, Json{{"app", *target}}, global, [verb](const Json &r) {
-        fmt::print("{}: {}\n", verb, r.value("name", ""));
-        for (const auto &id : r.value("unconfirmed", Json::array()))
-          fmt::print("  {} did not confirm its release and was terminated by its node\n", id.get<std::string>());
-      });
+      exit_code =
+          simple_call(verb.c_str(), op, Json{{"app", *target}}, global, [verb](const Json &r) {
+            fmt::print("{}: {}\n", verb, r.value("name", ""));
+            for (const auto &id : r.value("unconfirmed", Json::array()))
+              fmt::print("  {} did not confirm its release and was terminated by its node\n",
+                         id.get<std::string>());
+          });
     });
   }
 
-  auto *configure_cmd = app.add_subcommand("configure", "Set properties of an application's assembly controller or one component");
+  auto *configure_cmd = app.add_subcommand(
+      "configure", "Set properties of an application's assembly controller or one component");
   auto configure_target = std::make_shared<std::string>();
   auto assignments = std::make_shared<std::vector<std::string>>();
   configure_cmd->add_option("target", *configure_target, "APP or APP/COMPONENT")->required();
@@ -281,11 +305,12 @@ void add_application_commands(CLI::App &app, const GlobalOptions &global, int &e
     }
     auto [app_name, component] = split_target(*configure_target);
     exit_code = simple_call("configure", "app.configure",
-                            Json{{"app", app_name}, {"component", component}, {"values", *values}}, global,
-                            [](const Json &) { fmt::print("configured\n"); });
+                            Json{{"app", app_name}, {"component", component}, {"values", *values}},
+                            global, [](const Json &) { fmt::print("configured\n"); });
   });
 
-  auto *query_cmd = app.add_subcommand("query", "Read properties of an application's assembly controller or one component");
+  auto *query_cmd = app.add_subcommand(
+      "query", "Read properties of an application's assembly controller or one component");
   auto query_target = std::make_shared<std::string>();
   auto ids = std::make_shared<std::vector<std::string>>();
   query_cmd->add_option("target", *query_target, "APP or APP/COMPONENT")->required();
@@ -293,8 +318,8 @@ void add_application_commands(CLI::App &app, const GlobalOptions &global, int &e
   query_cmd->callback([=, &global, &exit_code] {
     auto [app_name, component] = split_target(*query_target);
     exit_code = simple_call("query", "app.query",
-                            Json{{"app", app_name}, {"component", component}, {"ids", *ids}}, global,
-                            [](const Json &r) {
+                            Json{{"app", app_name}, {"component", component}, {"ids", *ids}},
+                            global, [](const Json &r) {
                               const Json properties = r.value("properties", Json::object());
                               for (const auto &[id, value] : properties.items())
                                 fmt::print("{} = {}\n", id, scalar_text(value));

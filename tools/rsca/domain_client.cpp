@@ -21,8 +21,10 @@ Expected<DomainClient> DomainClient::connect(const GlobalOptions &global) {
   char host[128] = {};
   gethostname(host, sizeof(host) - 1);
   static std::atomic<int> counter{0};
-  const std::string address = fmt::format("{}/cli/{}-{}-{}", global.domain, host, getpid(), ++counter);
-  auto endpoint = control::Endpoint::open(*participant, address, {.workers = 1, .on_announcement = {}});
+  const std::string address =
+      fmt::format("{}/cli/{}-{}-{}", global.domain, host, getpid(), ++counter);
+  auto endpoint =
+      control::Endpoint::open(*participant, address, {.workers = 1, .on_announcement = {}});
   if (!endpoint)
     return tl::unexpected(endpoint.error());
   DomainClient client;
@@ -38,7 +40,8 @@ DomainClient::call_async(const std::string &operation, control::Json body,
   return endpoint_->call(domain_ + "/domain", operation, std::move(body), timeout);
 }
 
-control::CallResult<control::Json> DomainClient::call(const std::string &operation, control::Json body,
+control::CallResult<control::Json> DomainClient::call(const std::string &operation,
+                                                      control::Json body,
                                                       std::chrono::milliseconds timeout) const {
   return call_async(operation, std::move(body), timeout).get();
 }
@@ -62,14 +65,15 @@ int exit_code_of(control::Status status) {
   return kFailed;
 }
 
-int report_failure(const GlobalOptions &global, const std::string &what, const control::CallError &error) {
+int report_failure(const GlobalOptions &global, const std::string &what,
+                   const control::CallError &error) {
   std::string message = error.message;
   // The hint only when the domain itself did not answer, not a component during a launch.
   const bool domain_silent = message.find(global.domain + "/domain") != std::string::npos &&
                              message.find("launch of") == std::string::npos;
   if (domain_silent)
-    message += fmt::format(" (is the domain \"{}\" up on DDS domain {}? see `rsca domain up`)", global.domain,
-                           dds::DdsSettings::from_environment().domain_id);
+    message += fmt::format(" (is the domain \"{}\" up on DDS domain {}? see `rsca domain up`)",
+                           global.domain, dds::DdsSettings::from_environment().domain_id);
   if (global.json) {
     print_json({{"error", {{"status", control::to_string(error.status)}, {"message", message}}}});
   } else {
@@ -78,6 +82,8 @@ int report_failure(const GlobalOptions &global, const std::string &what, const c
   return exit_code_of(error.status);
 }
 
-void print_json(const control::Json &value) { std::cout << value.dump(2) << '\n'; }
+void print_json(const control::Json &value) {
+  std::cout << value.dump(2) << '\n';
+}
 
 } // namespace rsca::cli

@@ -18,8 +18,9 @@ public:
 
   control::CallResult<control::Json> call(const std::string &operation, control::Json body,
                                           std::chrono::milliseconds timeout) const;
-  std::future<control::CallResult<control::Json>> call_async(const std::string &operation, control::Json body,
-                                                             std::chrono::milliseconds timeout) const;
+  std::future<control::CallResult<control::Json>>
+  call_async(const std::string &operation, control::Json body,
+             std::chrono::milliseconds timeout) const;
   const std::string &domain() const { return domain_; }
 
 private:
@@ -30,7 +31,8 @@ private:
 
 int exit_code_of(control::Status status);
 // Prints a failed call (text or JSON) and returns its exit code.
-int report_failure(const GlobalOptions &global, const std::string &what, const control::CallError &error);
+int report_failure(const GlobalOptions &global, const std::string &what,
+                   const control::CallError &error);
 // Prints a reply as JSON.
 void print_json(const control::Json &value);
 

@@ -48,7 +48,9 @@ fs::path default_sdrroot(const GlobalOptions &global) {
   return (own_folder() / "../../profiles").lexically_normal();
 }
 
-bool alive(pid_t pid) { return pid > 0 && ::kill(pid, 0) == 0; }
+bool alive(pid_t pid) {
+  return pid > 0 && ::kill(pid, 0) == 0;
+}
 
 std::optional<pid_t> read_pid(const fs::path &file) {
   std::ifstream in(file);
@@ -65,7 +67,8 @@ Expected<pid_t> spawn_daemon(const fs::path &program, const std::vector<std::str
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
   posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
-  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(),
+                                   O_WRONLY | O_CREAT | O_APPEND, 0644);
   posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
   posix_spawnattr_t attributes;
   posix_spawnattr_init(&attributes);
@@ -116,7 +119,8 @@ Expected<fs::path> node_dcd(int i, const fs::path &sdrroot, const fs::path &run)
     return own;
   const fs::path templ = sdrroot / "dev/nodes/node1/DeviceManager.dcd.xml";
   if (!fs::is_regular_file(templ))
-    return make_error({templ.string(), 0, 0}, "missing-file", "no node DCD to make more nodes from");
+    return make_error({templ.string(), 0, 0}, "missing-file",
+                      "no node DCD to make more nodes from");
   const fs::path sdr = run / "sdr";
   std::error_code ec;
   fs::create_directories(sdr / "dev/nodes", ec);
@@ -140,8 +144,10 @@ int up(int nodes, const fs::path &run, const GlobalOptions &global) {
   std::error_code ec;
   fs::create_directories(run / "logs", ec);
   if (auto pid = read_pid(run / "domaind.pid"); pid && alive(*pid)) {
-    fmt::print(stderr, "rsca domain up: a domain is already up in {} (domaind pid {}); `rsca domain down` first\n",
-               run.string(), *pid);
+    fmt::print(
+        stderr,
+        "rsca domain up: a domain is already up in {} (domaind pid {}); `rsca domain down` first\n",
+        run.string(), *pid);
     return kRejected;
   }
   const fs::path bin = own_folder();
@@ -177,12 +183,14 @@ int up(int nodes, const fs::path &run, const GlobalOptions &global) {
     fmt::print(stderr, "rsca domain up: {}\n", client.error().to_string());
     return kFailed;
   }
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(global.timeout_ms) * 4;
+  const auto deadline =
+      std::chrono::steady_clock::now() + std::chrono::milliseconds(global.timeout_ms) * 4;
   Json reply;
   for (;;) {
     for (const auto &[pid, log] : started)
       if (!alive(pid)) {
-        fmt::print(stderr, "rsca domain up: a daemon (pid {}) stopped; its log ends:\n{}", pid, tail(log));
+        fmt::print(stderr, "rsca domain up: a daemon (pid {}) stopped; its log ends:\n{}", pid,
+                   tail(log));
         return kFailed;
       }
     auto listed = client->call("domain.nodes", Json::object(), 1s);
@@ -191,7 +199,8 @@ int up(int nodes, const fs::path &run, const GlobalOptions &global) {
       break;
     }
     if (std::chrono::steady_clock::now() > deadline) {
-      fmt::print(stderr, "rsca domain up: the nodes did not all register in time (see {})\n", run.string());
+      fmt::print(stderr, "rsca domain up: the nodes did not all register in time (see {})\n",
+                 run.string());
       return kUnreachable;
     }
     std::this_thread::sleep_for(50ms); // pacing a poll of the domain, not a wait for a condition
@@ -200,14 +209,16 @@ int up(int nodes, const fs::path &run, const GlobalOptions &global) {
     reply["run_dir"] = run.string();
     print_json(reply);
   } else {
-    fmt::print("domain {} up: domaind pid {}, {} node(s); logs in {}\n", global.domain, *domaind, nodes, run.string());
+    fmt::print("domain {} up: domaind pid {}, {} node(s); logs in {}\n", global.domain, *domaind,
+               nodes, run.string());
   }
   return kOk;
 }
 
 int down(const fs::path &run, const GlobalOptions &global) {
   std::vector<fs::path> pid_files;
-  for (const auto &e : fs::directory_iterator(run, std::filesystem::directory_options::skip_permission_denied))
+  for (const auto &e :
+       fs::directory_iterator(run, std::filesystem::directory_options::skip_permission_denied))
     if (e.path().extension() == ".pid" && e.path().filename() != "domaind.pid")
       pid_files.push_back(e.path());
   pid_files.push_back(run / "domaind.pid"); // nodes first: they stop their components
@@ -235,16 +246,21 @@ int down(const fs::path &run, const GlobalOptions &global) {
 } // namespace
 
 void add_domain_command(CLI::App &app, const GlobalOptions &global, int &exit_code) {
-  auto *domain = app.add_subcommand("domain", "Start or stop a local domain (daemons in the background)");
+  auto *domain =
+      app.add_subcommand("domain", "Start or stop a local domain (daemons in the background)");
   domain->require_subcommand(1);
   auto run = std::make_shared<std::string>(default_run_dir().string());
   auto nodes = std::make_shared<int>(2);
-  auto *up_cmd = domain->add_subcommand("up", "Start a domain daemon and N node daemons; return when all are registered");
-  up_cmd->add_option("--nodes", *nodes, "How many node daemons")->capture_default_str()->check(CLI::Range(1, 100));
+  auto *up_cmd = domain->add_subcommand(
+      "up", "Start a domain daemon and N node daemons; return when all are registered");
+  up_cmd->add_option("--nodes", *nodes, "How many node daemons")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 100));
   up_cmd->add_option("--run-dir", *run, "Logs and pid files go here")->capture_default_str();
   up_cmd->callback([=, &global, &exit_code] { exit_code = up(*nodes, *run, global); });
   auto *down_cmd = domain->add_subcommand("down", "Stop the daemons started by `rsca domain up`");
-  down_cmd->add_option("--run-dir", *run, "Where `domain up` put its pid files")->capture_default_str();
+  down_cmd->add_option("--run-dir", *run, "Where `domain up` put its pid files")
+      ->capture_default_str();
   down_cmd->callback([=, &global, &exit_code] { exit_code = down(*run, global); });
 }
 

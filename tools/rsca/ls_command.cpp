@@ -20,19 +20,20 @@ void print_apps(const Json &r) {
 void print_installed(const Json &r) {
   fmt::print("{:<24} {:<10} {}\n", "INSTALLED", "COMPONENTS", "SAD");
   for (const auto &a : r.at("applications"))
-    fmt::print("{:<24} {:<10} {}\n", a.value("name", ""), a.value("components", 0), a.value("sad", ""));
+    fmt::print("{:<24} {:<10} {}\n", a.value("name", ""), a.value("components", 0),
+               a.value("sad", ""));
 }
 
 void print_nodes(const Json &r) {
   fmt::print("{:<16} {:<8} {:<8} {}\n", "NODE", "PID", "DEVICES", "ADDRESS");
   for (const auto &n : r.at("nodes"))
-    fmt::print("{:<16} {:<8} {:<8} {}\n", n.value("name", ""), n.value("pid", 0L), n.value("devices", 0),
-               n.value("address", ""));
+    fmt::print("{:<16} {:<8} {:<8} {}\n", n.value("name", ""), n.value("pid", 0L),
+               n.value("devices", 0), n.value("address", ""));
 }
 
 void print_devices(const Json &r) {
-  fmt::print("{:<20} {:<8} {:<6} {:>28} {:>34}\n", "DEVICE", "NODE", "KIND", "CPU % (total/alloc/free)",
-             "MEMORY MiB (total/alloc/free)");
+  fmt::print("{:<20} {:<8} {:<6} {:>28} {:>34}\n", "DEVICE", "NODE", "KIND",
+             "CPU % (total/alloc/free)", "MEMORY MiB (total/alloc/free)");
   for (const auto &d : r.at("devices")) {
     auto cap = [&](const char *name) {
       const auto &c = d.at("capacity");
@@ -50,7 +51,8 @@ void print_devices(const Json &r) {
 } // namespace
 
 void add_ls_command(CLI::App &app, const GlobalOptions &global, int &exit_code) {
-  auto *cmd = app.add_subcommand("ls", "List what the domain holds: apps, nodes, devices or installed");
+  auto *cmd =
+      app.add_subcommand("ls", "List what the domain holds: apps, nodes, devices or installed");
   auto what = std::make_shared<std::string>("apps");
   cmd->add_option("what", *what, "apps, nodes, devices or installed")
       ->check(CLI::IsMember({"apps", "nodes", "devices", "installed"}));
@@ -69,7 +71,8 @@ void add_ls_command(CLI::App &app, const GlobalOptions &global, int &exit_code) 
       exit_code = kFailed;
       return;
     }
-    auto reply = client->call(view.operation, Json::object(), std::chrono::milliseconds(global.timeout_ms));
+    auto reply =
+        client->call(view.operation, Json::object(), std::chrono::milliseconds(global.timeout_ms));
     if (!reply) {
       exit_code = report_failure(global, "ls", reply.error());
       return;

@@ -16,9 +16,10 @@ int main(int argc, char **argv) {
   app.add_option("--domain", global.domain, "The domain's name")->capture_default_str();
   app.add_option("--timeout-ms", global.timeout_ms, "Timeout of each request to the domain")
       ->capture_default_str();
-  app.footer("Exit codes: 0 ok, 1 invalid profile or request, 2 usage error, 3 not found,\n"
-             "4 domain unreachable, 5 rejected by the domain, 6 failed (e.g. a launch, rolled back).\n"
-             "The DDS domain is chosen with RSCA_DDS_DOMAIN (default 0).");
+  app.footer(
+      "Exit codes: 0 ok, 1 invalid profile or request, 2 usage error, 3 not found,\n"
+      "4 domain unreachable, 5 rejected by the domain, 6 failed (e.g. a launch, rolled back).\n"
+      "The DDS domain is chosen with RSCA_DDS_DOMAIN (default 0).");
 
   int exit_code = rsca::cli::kOk;
   rsca::cli::add_validate_command(app, global, exit_code);

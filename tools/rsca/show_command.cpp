@@ -36,7 +36,8 @@ private:
 };
 
 std::string type_name(TypeSpec spec) {
-  return spec.complex ? fmt::format("complex {}", to_string(spec.type)) : std::string(to_string(spec.type));
+  return spec.complex ? fmt::format("complex {}", to_string(spec.type))
+                      : std::string(to_string(spec.type));
 }
 
 std::string kinds_of(const PropertyCommon &p) {
@@ -52,19 +53,20 @@ std::string describe(const PropertyDefinition &d) {
   const PropertyCommon &c = common_of(d);
   std::string head = c.id == c.label() ? c.id : fmt::format("{} ({})", c.label(), c.id);
   std::string form = std::visit(
-      Overloaded{[](const SimpleProperty &p) {
-                   std::string s = type_name(p.type);
-                   if (!p.units.empty())
-                     s += fmt::format(" [{}]", p.units);
-                   if (p.action)
-                     s += fmt::format(" action={}", to_string(*p.action));
-                   return s;
-                 },
-                 [](const SimpleSequenceProperty &p) { return "sequence of " + type_name(p.type); },
-                 [](const StructProperty &p) { return fmt::format("struct of {}", p.members.size()); },
-                 [](const StructSequenceProperty &p) {
-                   return fmt::format("sequence of struct of {}", p.element.members.size());
-                 }},
+      Overloaded{
+          [](const SimpleProperty &p) {
+            std::string s = type_name(p.type);
+            if (!p.units.empty())
+              s += fmt::format(" [{}]", p.units);
+            if (p.action)
+              s += fmt::format(" action={}", to_string(*p.action));
+            return s;
+          },
+          [](const SimpleSequenceProperty &p) { return "sequence of " + type_name(p.type); },
+          [](const StructProperty &p) { return fmt::format("struct of {}", p.members.size()); },
+          [](const StructSequenceProperty &p) {
+            return fmt::format("sequence of struct of {}", p.element.members.size());
+          }},
       d);
   std::string text = fmt::format("{}: {} {} {}", head, form, to_string(c.mode), kinds_of(c));
   if (auto value = default_value(d))
@@ -79,8 +81,9 @@ void show_properties(Tree &t, int depth, const Properties &prf) {
 
 void show_ports(Tree &t, int depth, const SoftwareComponent &scd) {
   for (const auto &p : scd.ports)
-    t.line(depth, fmt::format("{} {} : {}", p.direction == PortDirection::Uses ? "uses    " : "provides",
-                              p.name, p.repid));
+    t.line(depth,
+           fmt::format("{} {} : {}", p.direction == PortDirection::Uses ? "uses    " : "provides",
+                       p.name, p.repid));
 }
 
 std::string describe(const ResourceDemand &d) {
@@ -146,7 +149,8 @@ std::string describe(const ConnectionQos &q) {
   if (q.durability)
     parts.emplace_back(to_string(*q.durability));
   if (q.history)
-    parts.push_back(fmt::format("{}{}", to_string(*q.history), q.depth ? fmt::format("({})", *q.depth) : ""));
+    parts.push_back(
+        fmt::format("{}{}", to_string(*q.history), q.depth ? fmt::format("({})", *q.depth) : ""));
   if (q.deadline)
     parts.push_back("deadline " + format_duration(*q.deadline));
   if (q.latency_budget)
@@ -215,7 +219,8 @@ void show_application(Tree &t, const ResolvedApplication &app) {
   for (const auto &p : sad.external_ports)
     t.line(1, fmt::format("external port {} = {}.{}", p.external_name, p.component_ref, p.port));
   for (const auto &p : sad.external_properties)
-    t.line(1, fmt::format("external property {} = {}.{}", p.external_id, p.component_ref, p.property_id));
+    t.line(1, fmt::format("external property {} = {}.{}", p.external_id, p.component_ref,
+                          p.property_id));
   for (const auto &p : sad.latency_paths)
     t.line(1, fmt::format("latency path {} <= {}: {}", p.id, format_duration(p.bound),
                           fmt::join(p.components, " -> ")));
@@ -285,9 +290,11 @@ int run(const std::string &path, const GlobalOptions &global) {
 } // namespace
 
 void add_show_command(CLI::App &app, const GlobalOptions &global, int &exit_code) {
-  auto *cmd = app.add_subcommand("show", "Show a profile's resolved model, or a running application");
+  auto *cmd =
+      app.add_subcommand("show", "Show a profile's resolved model, or a running application");
   auto path = std::make_shared<std::string>();
-  cmd->add_option("what", *path, "Profile file (SAD, SPD, SCD, PRF, DCD, DMD or DPD) or application name")
+  cmd->add_option("what", *path,
+                  "Profile file (SAD, SPD, SCD, PRF, DCD, DMD or DPD) or application name")
       ->required();
   cmd->callback([path, &global, &exit_code] { exit_code = run(*path, global); });
 }

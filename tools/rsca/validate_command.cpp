@@ -32,7 +32,8 @@ std::optional<DescriptorType> type_from_name(const fs::path &file) {
 }
 
 // The files named: files as given, folders searched for profiles.
-std::vector<fs::path> collect(const std::vector<std::string> &paths, std::vector<std::string> &missing) {
+std::vector<fs::path> collect(const std::vector<std::string> &paths,
+                              std::vector<std::string> &missing) {
   std::vector<fs::path> files;
   for (const auto &p : paths) {
     std::error_code ec;
@@ -79,7 +80,9 @@ void print_json(const std::vector<Outcome> &outcomes, const std::vector<std::str
     for (const auto &d : o.warnings)
       diagnostics.push_back(to_json(d));
     invalid += o.valid() ? 0 : 1;
-    files.push_back({{"file", o.file.string()}, {"type", o.type}, {"valid", o.valid()},
+    files.push_back({{"file", o.file.string()},
+                     {"type", o.type},
+                     {"valid", o.valid()},
                      {"diagnostics", diagnostics}});
   }
   nlohmann::json out{{"files", files},
@@ -139,8 +142,9 @@ int run(const std::vector<std::string> &paths, bool strict, const GlobalOptions 
 } // namespace
 
 void add_validate_command(CLI::App &app, const GlobalOptions &global, int &exit_code) {
-  auto *cmd = app.add_subcommand("validate", "Validate profiles (files, or folders searched for "
-                                             "*.sad.xml, *.spd.xml, ... ) and everything they reference");
+  auto *cmd =
+      app.add_subcommand("validate", "Validate profiles (files, or folders searched for "
+                                     "*.sad.xml, *.spd.xml, ... ) and everything they reference");
   auto paths = std::make_shared<std::vector<std::string>>();
   auto strict = std::make_shared<bool>(false);
   cmd->add_option("paths", *paths, "Profile files or folders")->required();
