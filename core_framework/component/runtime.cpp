@@ -157,8 +157,8 @@ void wait_for_exit(const ExitEvents &events, detail::Host &host, spdlog::logger 
 
 int run_host(const ExecParams &params, const ExitEvents &events, const Factory &factory,
              std::shared_ptr<spdlog::logger> logger) {
-  profile::ProfileLoader loader;
-  auto softpkg = loader.load_softpkg(params.profile);
+  // The loader goes at once: the XML reader it held is unloaded before the component runs.
+  auto softpkg = profile::ProfileLoader().load_softpkg(params.profile);
   if (!softpkg) {
     logger->error("cannot load the profile {}:\n{}", params.profile, softpkg.error().to_string());
     return kExitProfile;

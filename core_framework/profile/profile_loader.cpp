@@ -82,6 +82,12 @@ Expected<SdrRoot> ProfileLoader::root_for(const fs::path &file) const {
 
 Expected<std::shared_ptr<const Descriptor>>
 ProfileLoader::cached_descriptor(const fs::path &file, const SourceLocation &referenced_at) {
+  if (!xml_reader_) {
+    auto reader = XmlReader::acquire();
+    if (!reader)
+      return tl::unexpected(reader.error());
+    xml_reader_ = std::move(*reader);
+  }
   const fs::path key = fs::absolute(file).lexically_normal();
   std::error_code ec;
   if (!referenced_at.file.empty()) {

@@ -14,6 +14,7 @@
 #include "common/diagnostic.hpp"
 #include "profile/descriptor.hpp"
 #include "profile/sdr_root.hpp"
+#include "profile/xml_reader.hpp"
 
 namespace rsca::profile {
 
@@ -69,6 +70,8 @@ struct ValidatedDescriptor {
   std::vector<Diagnostic> warnings;
 };
 
+// Reading needs the XML reader module, loaded while any loader that has read a file lives: a
+// process that reads its profiles once (a node daemon, a component) lets its loader go.
 class ProfileLoader {
 public:
   // `sdrroot`: where absolute profile paths resolve; when empty, found from each file's location.
@@ -97,6 +100,8 @@ private:
   std::map<std::filesystem::path, Expected<std::shared_ptr<const Descriptor>>> files_;
   std::map<std::filesystem::path, Expected<std::shared_ptr<const ResolvedSoftPkg>>> softpkgs_;
   std::vector<std::filesystem::path> resolving_; // SPDs being resolved, to find cycles
+  // Held from the first file read to the loader's end: its files share one load of the reader.
+  std::shared_ptr<XmlReader> xml_reader_;
 };
 
 } // namespace rsca::profile

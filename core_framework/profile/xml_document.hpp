@@ -50,7 +50,4 @@ Expected<XmlDocument> read_xml_profile(const std::filesystem::path &file);
 // Same, for text already in memory; `file_name` is used in messages.
 Expected<XmlDocument> read_xml_profile_text(std::string_view text, std::string file_name);
 
-// The text of one of the project's schemas (compiled into the binary), e.g. "sad.xsd".
-std::string_view embedded_schema(std::string_view file_name);
-
 } // namespace rsca::profile

@@ -1,0 +1,81 @@
+#include "profile/xml_reader.hpp"
+
+#include <dlfcn.h>
+#include <malloc.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <mutex>
+
+#include <fmt/format.h>
+
+namespace rsca::profile {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr const char *kModuleName = "librsca_xml_reader.so";
+
+// Where the module is: $RSCA_XML_READER alone when set; else lib/ beside the running program's
+// bin/ (the build tree and an installed tree alike), then the build tree this library was built in.
+std::vector<fs::path> module_candidates() {
+  if (const char *path = std::getenv("RSCA_XML_READER"); path != nullptr && *path != '\0')
+    return {fs::path(path)};
+  std::vector<fs::path> out;
+  std::error_code ec;
+  if (auto self = fs::read_symlink("/proc/self/exe", ec); !ec)
+    out.push_back(self.parent_path().parent_path() / "lib" / kModuleName);
+  out.push_back(fs::path(RSCA_XML_READER_BUILD_DIR) / kModuleName);
+  return out;
+}
+
+std::mutex g_mutex;
+std::weak_ptr<XmlReader> g_reader; // guarded by g_mutex
+
+} // namespace
+
+Expected<std::shared_ptr<XmlReader>> XmlReader::acquire() {
+  std::lock_guard lock(g_mutex);
+  if (auto held = g_reader.lock())
+    return held;
+  std::string tried;
+  for (const auto &candidate : module_candidates()) {
+    void *handle = dlopen(candidate.c_str(), RTLD_NOW | RTLD_LOCAL);
+    if (handle == nullptr) {
+      tried += fmt::format("\n  {}", dlerror());
+      continue;
+    }
+    auto read = reinterpret_cast<ReadFunction>(dlsym(handle, "rsca_xml_reader_read"));
+    if (read == nullptr) {
+      tried += fmt::format("\n  {}: no rsca_xml_reader_read", candidate.string());
+      dlclose(handle);
+      continue;
+    }
+    auto reader = std::make_shared<XmlReader>(Token{}, handle, read);
+    g_reader = reader;
+    return reader;
+  }
+  return make_error({kModuleName, 0, 0}, "io",
+                    fmt::format("cannot load the XML reader module:{}", tried));
+}
+
+bool XmlReader::loaded() {
+  std::lock_guard lock(g_mutex);
+  return !g_reader.expired();
+}
+
+XmlReader::~XmlReader() {
+  // Serialised with acquire(), so a new load never overlaps this unload.
+  std::lock_guard lock(g_mutex);
+  dlclose(handle_);
+  // Give the heap Xerces used (compiled schemas, readers) back to the system.
+  malloc_trim(0);
+}
+
+Expected<XmlDocument> XmlReader::read(std::string_view text, const std::string &file) const {
+  Expected<XmlDocument> out = make_error({file, 0, 0}, "xml", "the reader gave no result");
+  read_(text, file, out);
+  return out;
+}
+
+} // namespace rsca::profile
