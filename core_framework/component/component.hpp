@@ -52,6 +52,17 @@ enum class State : std::uint8_t { Loaded, Initialized, Started, Stopped, Release
 std::string_view to_string(State state);
 
 // Who the component is: from its exec parameters.
+// What timing admission decided for a periodic component (RSCA): the CPU it runs on (the
+// runtime pins the process there), its priority, its period, its execution budget per period
+// and its deadline. The component paces itself by it.
+struct Schedule {
+  unsigned cpu = 0;
+  std::uint32_t priority = 0;
+  std::chrono::nanoseconds period{0};
+  std::chrono::nanoseconds budget{0};
+  std::chrono::nanoseconds deadline{0};
+};
+
 struct Context {
   std::string identifier;                 // COMPONENT_IDENTIFIER
   std::string name;                       // NAME_BINDING (the identifier when not given)
@@ -60,6 +71,7 @@ struct Context {
   std::filesystem::path profile;          // PROFILE_NAME: the SPD
   std::string control_address;            // CONTROL_ADDRESS
   std::shared_ptr<spdlog::logger> logger; // named after the instance
+  std::optional<Schedule> schedule;       // periodic components only
 };
 
 namespace detail {

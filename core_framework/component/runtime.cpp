@@ -1,8 +1,13 @@
 #include "component/runtime.hpp"
 
+#include <sched.h>
+
 #include <cerrno>
+#include <charconv>
 #include <csignal>
 #include <cstring>
+#include <functional>
+#include <map>
 
 #include <fmt/format.h>
 #include <poll.h>
@@ -103,6 +108,48 @@ std::shared_ptr<spdlog::logger> make_logger(const std::string &name) {
 
 // ---------------------------------------------------------------------------------------------
 
+namespace {
+
+// The schedule's exec parameters (the ApplicationFactory passes them for periodic components).
+// Returns whether `key` was one of them, or an error for a malformed value.
+tl::expected<bool, std::string> take_schedule_param(const std::string &key,
+                                                    const std::string &value,
+                                                    std::optional<Schedule> &schedule) {
+  static const std::map<std::string, std::function<void(Schedule &, std::uint64_t)>> kFields{
+      {"RSCA_CPU", [](Schedule &s, std::uint64_t v) { s.cpu = static_cast<unsigned>(v); }},
+      {"RSCA_PRIORITY",
+       [](Schedule &s, std::uint64_t v) { s.priority = static_cast<std::uint32_t>(v); }},
+      {"RSCA_PERIOD_NS",
+       [](Schedule &s, std::uint64_t v) { s.period = std::chrono::nanoseconds(v); }},
+      {"RSCA_BUDGET_NS",
+       [](Schedule &s, std::uint64_t v) { s.budget = std::chrono::nanoseconds(v); }},
+      {"RSCA_DEADLINE_NS",
+       [](Schedule &s, std::uint64_t v) { s.deadline = std::chrono::nanoseconds(v); }},
+  };
+  auto field = kFields.find(key);
+  if (field == kFields.end())
+    return false;
+  std::uint64_t number = 0;
+  auto [end, ec] = std::from_chars(value.data(), value.data() + value.size(), number);
+  if (ec != std::errc() || end != value.data() + value.size())
+    return tl::unexpected(fmt::format("the exec parameter {} is not a number: \"{}\"", key, value));
+  if (!schedule)
+    schedule = Schedule{};
+  field->second(*schedule, number);
+  return true;
+}
+
+// Runs the process on the CPU admission chose, so that the analysis holds for what runs.
+void pin_to_cpu(unsigned cpu, spdlog::logger &log) {
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  CPU_SET(cpu, &set);
+  if (sched_setaffinity(0, sizeof(set), &set) != 0)
+    log.warn("cannot run on cpu {} as admitted: {}", cpu, std::strerror(errno));
+}
+
+} // namespace
+
 tl::expected<ExecParams, std::string> parse_exec_params(int argc, const char *const *argv) {
   ExecParams params;
   if ((argc - 1) % 2 != 0)
@@ -123,7 +170,9 @@ tl::expected<ExecParams, std::string> parse_exec_params(int argc, const char *co
       params.application = std::move(value);
     else if (key == "CONTROL_ADDRESS")
       params.control_address = std::move(value);
-    else
+    else if (auto taken = take_schedule_param(key, value, params.schedule); !taken)
+      return tl::unexpected(taken.error());
+    else if (!*taken)
       params.others.emplace_back(key, std::move(value));
   }
   for (const auto &[key, value] : {std::pair{"COMPONENT_IDENTIFIER", &params.identifier},
@@ -169,7 +218,10 @@ int run_host(const ExecParams &params, const ExitEvents &events, const Factory &
                   params.domain,
                   params.profile,
                   params.control_address,
-                  logger};
+                  logger,
+                  params.schedule};
+  if (params.schedule)
+    pin_to_cpu(params.schedule->cpu, *logger);
   std::unique_ptr<Component> component;
   try {
     component = factory(context);

@@ -39,6 +39,7 @@ struct ExecParams {
   std::string application;     // APPLICATION
   std::string control_address; // CONTROL_ADDRESS (required)
   std::vector<std::pair<std::string, std::string>> others; // execparam properties and the rest
+  std::optional<Schedule> schedule; // RSCA_CPU, RSCA_PRIORITY, RSCA_PERIOD_NS, ... (admission)
 };
 
 // The exec parameters of argv[1..], in pairs.

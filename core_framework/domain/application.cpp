@@ -1,5 +1,7 @@
 #include "domain/application.hpp"
 
+#include "allocator/plan_json.hpp"
+
 namespace rsca::domain {
 
 std::string_view to_string(ApplicationState state) {
@@ -32,16 +34,21 @@ const ComponentInstance *Application::find_component(std::string_view id) const 
 
 nlohmann::json to_json(const Application &app) {
   nlohmann::json components = nlohmann::json::array();
-  for (const auto &c : app.components)
-    components.push_back({{"id", c.id},
-                          {"usage_name", c.usage_name},
-                          {"node", c.node},
-                          {"device", c.device},
-                          {"implementation", c.implementation},
-                          {"address", c.address},
-                          {"pid", c.pid},
-                          {"state", c.state},
-                          {"assembly_controller", c.assembly_controller}});
+  for (const auto &c : app.components) {
+    nlohmann::json entry{{"id", c.id},
+                         {"usage_name", c.usage_name},
+                         {"node", c.node},
+                         {"device", c.device},
+                         {"implementation", c.implementation},
+                         {"address", c.address},
+                         {"pid", c.pid},
+                         {"state", c.state},
+                         {"assembly_controller", c.assembly_controller}};
+    for (const auto &p : app.plan.placements)
+      if (p.instance == c.id && p.schedule)
+        entry["schedule"] = allocator::to_json(*p.schedule);
+    components.push_back(std::move(entry));
+  }
   nlohmann::json connections = nlohmann::json::array();
   for (const auto &c : app.connections)
     connections.push_back(

@@ -51,7 +51,7 @@ struct Application {
   ApplicationState state = ApplicationState::Created;
   std::vector<ComponentInstance> components;
   std::vector<ConnectionInstance> connections;
-  std::vector<allocator::Placement> placements;
+  allocator::Plan plan; // what the allocator placed and reserved
   std::shared_ptr<const profile::ResolvedApplication> profile;
 
   ComponentInstance *find_component(std::string_view id);

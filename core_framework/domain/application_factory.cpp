@@ -129,27 +129,21 @@ private:
   }
 
   CallResult<void> allocate() {
-    std::vector<allocator::Request> requests;
-    for (const auto &placement : request_.profile->sad->placements) {
-      const auto *pkg = request_.profile->softpkg_of(placement);
-      for (const auto &ci : placement.instantiations) {
-        allocator::Request r{ci.id, pkg, std::nullopt};
-        if (auto it = request_.assignments.find(ci.id); it != request_.assignments.end())
-          r.device = it->second;
-        requests.push_back(std::move(r));
-      }
+    const allocator::PlanOptions options{request_.strategy.value_or(s_.strategy)};
+    auto plan = s_.allocator->allocate(
+        allocator::plan_request_of(*request_.profile, request_.assignments), options);
+    if (!plan) {
+      spdlog::warn("application {} rejected:\n{}", app_->name, allocator::to_string(plan.error()));
+      return control::call_error(Status::Rejected, allocator::to_string(plan.error()));
     }
-    auto placements = s_.allocator->allocate(requests);
-    if (!placements)
-      return control::call_error(Status::Rejected, allocator::to_string(placements.error()));
-    app_->placements = std::move(*placements);
+    app_->plan = std::move(*plan);
     allocated_ = true;
     build_components();
     std::vector<std::string> where;
-    for (const auto &p : app_->placements)
+    for (const auto &p : app_->plan.placements)
       where.push_back(fmt::format("{}→{}", p.instance, p.device));
     detail_ = fmt::format("{}", fmt::join(where, ", "));
-    for (const auto &p : app_->placements)
+    for (const auto &p : app_->plan.placements)
       spdlog::info("placing {}/{} on {} (implementation {})", app_->name, p.instance, p.device,
                    p.implementation->id);
     return {};
@@ -318,7 +312,10 @@ private:
         "PROFILE_NAME",         c.spd,      "DOMAIN_NAME",     s_.domain_name,
         "APPLICATION",          app_->name, "CONTROL_ADDRESS", c.address};
     append_execparams(c, args);
-    const auto *impl = placement_of(c.id)->implementation;
+    const auto *placement = placement_of(c.id);
+    if (placement->schedule)
+      append_schedule(*placement->schedule, args);
+    const auto *impl = placement->implementation;
     const auto spd_dir = std::filesystem::path(c.spd).parent_path();
     return Json{{"application", app_->name},
                 {"component", c.id},
@@ -327,6 +324,19 @@ private:
                  impl->code.entrypoint.empty() ? impl->code.file.name : impl->code.entrypoint},
                 {"spd_dir", spd_dir.string()},
                 {"args", args}};
+  }
+
+  // What timing admission decided, for the component to run by (component/runtime.hpp).
+  static void append_schedule(const allocator::Schedule &s, std::vector<std::string> &args) {
+    for (const auto &[key, value] :
+         {std::pair{"RSCA_CPU", static_cast<std::int64_t>(s.cpu)},
+          std::pair{"RSCA_PRIORITY", static_cast<std::int64_t>(s.priority)},
+          std::pair{"RSCA_PERIOD_NS", static_cast<std::int64_t>(s.period.count())},
+          std::pair{"RSCA_BUDGET_NS", static_cast<std::int64_t>(s.budget.count())},
+          std::pair{"RSCA_DEADLINE_NS", static_cast<std::int64_t>(s.deadline.count())}}) {
+      args.emplace_back(key);
+      args.push_back(std::to_string(value));
+    }
   }
 
   void append_execparams(const ComponentInstance &c, std::vector<std::string> &args) const {
@@ -345,7 +355,7 @@ private:
   }
 
   const allocator::Placement *placement_of(const std::string &instance) const {
-    for (const auto &p : app_->placements)
+    for (const auto &p : app_->plan.placements)
       if (p.instance == instance)
         return &p;
     return nullptr;
@@ -353,7 +363,7 @@ private:
 
   void build_components() {
     const auto &sad = *request_.profile->sad;
-    for (const auto &p : app_->placements) {
+    for (const auto &p : app_->plan.placements) {
       const profile::ComponentPlacement *placement = nullptr;
       const auto *ci = sad.find_instantiation(p.instance, &placement);
       ComponentInstance c;
@@ -401,7 +411,7 @@ private:
   std::string roll_back() {
     std::vector<std::string> undone;
     std::vector<std::string> devices;
-    for (const auto &p : app_->placements)
+    for (const auto &p : app_->plan.placements)
       if (std::find(devices.begin(), devices.end(), p.device) == devices.end())
         devices.push_back(p.device);
     ApplicationFactory factory(s_);
@@ -411,7 +421,7 @@ private:
       factory.release(*app_);
       undone.push_back(fmt::format("{} process{} terminated", started, started == 1 ? "" : "es"));
     } else if (allocated_) {
-      s_.allocator->release(app_->placements);
+      s_.allocator->release(app_->plan);
     }
     if (allocated_) {
       undone.push_back(fmt::format("allocations on {} released", fmt::join(devices, ", ")));
@@ -496,8 +506,8 @@ CallResult<std::vector<std::string>> ApplicationFactory::release(Application &ap
     c.state = "released";
     c.pid = 0;
   }
-  services_.allocator->release(app.placements);
-  app.placements.clear();
+  services_.allocator->release(app.plan);
+  app.plan = {};
   // A component whose node is gone cannot be terminated by it, and is gone with it.
   for (std::size_t i = 0; i < terminated.size(); ++i)
     if (!terminated[i] && terminated[i].error().status != Status::Unavailable &&

@@ -30,6 +30,7 @@ struct LaunchRequest {
   std::string installed; // the installed application
   std::shared_ptr<const profile::ResolvedApplication> profile;
   std::map<std::string, std::string> assignments; // instance id → device id
+  std::optional<allocator::Strategy> strategy;    // the domain's when not given
   bool start = true;
 };
 
@@ -45,6 +46,7 @@ struct DomainServices {
   std::function<std::uint64_t()> next_launch;
   std::chrono::milliseconds call_timeout{5000};
   std::chrono::milliseconds registration_timeout{10000};
+  allocator::Strategy strategy = allocator::Strategy::Pack;
 };
 
 class ApplicationFactory {

@@ -9,6 +9,7 @@
 #include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
+#include "allocator/plan_json.hpp"
 #include "common/elapsed.hpp"
 #include "profile/profile_loader.hpp"
 #include "profile/property_binding.hpp"
@@ -67,21 +68,27 @@ std::optional<fs::path> safe_relative(const std::string &path) {
 
 std::vector<allocator::Device> devices_of(const std::string &node, const Json &body) {
   std::vector<allocator::Device> devices;
-  for (const auto &d : body.value("devices", Json::array())) {
-    allocator::Device device;
-    device.id = d.value("id", "");
-    device.node = node;
-    device.kind = d.value("kind", "device");
-    const Json properties = d.value("properties", Json::object());
-    const Json capacity = d.value("capacity", Json::object());
-    for (const auto &[k, v] : properties.items())
-      device.properties[k] = v.is_string() ? v.get<std::string>() : v.dump();
-    for (const auto &[k, v] : capacity.items())
-      if (v.is_number())
-        device.capacity[k] = v.get<double>();
-    devices.push_back(std::move(device));
-  }
+  for (const auto &d : body.value("devices", Json::array()))
+    devices.push_back(allocator::device_from_announcement(node, d));
   return devices;
+}
+
+// The assignments and strategy a launch or plan request gives.
+CallResult<std::pair<std::map<std::string, std::string>, std::optional<allocator::Strategy>>>
+placement_options(const Json &body) {
+  std::map<std::string, std::string> assignments;
+  const Json assign = body.value("assign", Json::object());
+  for (const auto &[k, v] : assign.items())
+    assignments[k] = v.get<std::string>();
+  std::optional<allocator::Strategy> strategy;
+  if (body.contains("strategy")) {
+    strategy = allocator::parse_strategy(body.value("strategy", ""));
+    if (!strategy)
+      return control::call_error(Status::BadRequest,
+                                 fmt::format("unknown placement strategy \"{}\": pack or spread",
+                                             body.value("strategy", "")));
+  }
+  return std::pair{assignments, strategy};
 }
 
 } // namespace
@@ -117,6 +124,7 @@ struct DomainManager::Impl {
     s.next_launch = [this] { return ++launch_counter; };
     s.call_timeout = options.call_timeout;
     s.registration_timeout = options.registration_timeout;
+    s.strategy = options.strategy;
     return ApplicationFactory(std::move(s));
   }
 
@@ -134,6 +142,7 @@ struct DomainManager::Impl {
   CallResult<Json> query(const Json &body);
   CallResult<Json> list_nodes();
   CallResult<Json> list_devices();
+  CallResult<Json> plan_application(const Json &body);
   CallResult<Json> component_exited(const Json &body);
   std::string unique_name(const std::string &wanted) const;
   CallResult<std::string> target_of(const Application &app, const Json &body) const;
@@ -274,9 +283,13 @@ CallResult<Json> DomainManager::Impl::create_application(const Json &body) {
     launches[body.value("launch_id", request.name)] = progress;
   }
   request.start = body.value("start", true);
-  const Json assign = body.value("assign", Json::object());
-  for (const auto &[k, v] : assign.items())
-    request.assignments[k] = v.get<std::string>();
+  auto placement = placement_options(body);
+  if (!placement) {
+    std::lock_guard lock(mutex);
+    applications.erase(request.name);
+    return tl::unexpected(placement.error());
+  }
+  std::tie(request.assignments, request.strategy) = *placement;
   auto record = [this, progress](const LaunchStep &step) {
     std::lock_guard lock(mutex);
     progress->steps.push_back(step);
@@ -425,21 +438,34 @@ CallResult<Json> DomainManager::Impl::list_nodes() {
 }
 
 CallResult<Json> DomainManager::Impl::list_devices() {
-  Json list = Json::array();
-  for (const auto &state : allocator.snapshot()) {
-    Json capacity = Json::object();
-    for (const auto &[name, total] : state.device.capacity) {
-      auto used = state.allocated.find(name);
-      const double allocated = used == state.allocated.end() ? 0.0 : used->second;
-      capacity[name] = {{"total", total}, {"allocated", allocated}, {"free", total - allocated}};
-    }
-    list.push_back({{"id", state.device.id},
-                    {"node", state.device.node},
-                    {"kind", state.device.kind},
-                    {"properties", state.device.properties},
-                    {"capacity", capacity}});
+  return Json{{"devices", allocator::to_json(allocator.snapshot())}};
+}
+
+// Admission and placement of an installed application on the domain as it is, reserving nothing.
+CallResult<Json> DomainManager::Impl::plan_application(const Json &body) {
+  auto name = required<std::string>(body, "application");
+  if (!name)
+    return tl::unexpected(name.error());
+  auto placement = placement_options(body);
+  if (!placement)
+    return tl::unexpected(placement.error());
+  std::shared_ptr<const profile::ResolvedApplication> profile;
+  {
+    std::lock_guard lock(mutex);
+    auto it = installed.find(*name);
+    if (it == installed.end())
+      return control::call_error(Status::NotFound,
+                                 fmt::format("no application {} is installed", *name));
+    profile = it->second.profile;
   }
-  return Json{{"devices", list}};
+  const allocator::PlanOptions plan_options{placement->second.value_or(options.strategy)};
+  auto plan = allocator.plan(allocator::plan_request_of(*profile, placement->first), plan_options);
+  const std::string strategy(to_string(plan_options.strategy));
+  if (!plan)
+    return Json{{"admitted", false},
+                {"rejections", allocator::to_json(plan.error())},
+                {"strategy", strategy}};
+  return Json{{"admitted", true}, {"plan", allocator::to_json(*plan)}, {"strategy", strategy}};
 }
 
 CallResult<Json> DomainManager::Impl::component_exited(const Json &body) {
@@ -508,6 +534,7 @@ void DomainManager::Impl::serve() {
   bind0("domain.devices", &Impl::list_devices);
   bind("domain.component_exited", &Impl::component_exited);
   bind("app.create", &Impl::create_application);
+  bind("app.plan", &Impl::plan_application);
   bind("app.progress", &Impl::progress);
   bind("app.release", &Impl::release);
   bind("app.configure", &Impl::configure);

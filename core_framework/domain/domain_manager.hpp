@@ -24,6 +24,7 @@ struct DomainOptions {
   std::filesystem::path repository; // installed profiles are kept here
   std::chrono::milliseconds registration_timeout{10000};
   std::chrono::milliseconds call_timeout{5000};
+  allocator::Strategy strategy = allocator::Strategy::Pack; // placement, unless a launch says
 };
 
 class DomainManager {

@@ -1,5 +1,7 @@
 #include "node/device_manager.hpp"
 
+#include "allocator/device.hpp"
+
 #include <atomic>
 #include <unistd.h>
 
@@ -19,6 +21,9 @@ struct RunningDevice {
   std::string label;
   std::string softpkg;
   std::unique_ptr<LogicalDevice> device;
+  // For the allocator: the PRF's allocation properties and the DCD's deployerrequires.
+  Json allocation;
+  Json deployer_requires;
   ExecutableDevice *executable() const { return dynamic_cast<ExecutableDevice *>(device.get()); }
 };
 
@@ -82,7 +87,12 @@ Expected<void> DeviceManager::Impl::start_devices(const DeviceRegistry &registry
       if (!device)
         return tl::unexpected(device.error());
       spdlog::info("device {} ({}) started", id, placed.softpkg->spd->name);
-      devices.push_back({id, label, placed.softpkg->spd->name, std::move(*device)});
+      Json offers = Json::object();
+      for (const auto &ref : ci.device_requires)
+        if (const auto *simple = std::get_if<profile::SimpleRef>(&ref))
+          offers[simple->refid] = simple->value;
+      devices.push_back({id, label, placed.softpkg->spd->name, std::move(*device),
+                         allocator::allocation_properties_json(*placed.softpkg), offers});
     }
   }
   return {};
@@ -96,7 +106,9 @@ Json DeviceManager::Impl::announcement() const {
                     {"softpkg", d.softpkg},
                     {"kind", d.device->kind()},
                     {"properties", d.device->properties()},
-                    {"capacity", d.device->capacity()}});
+                    {"capacity", d.device->capacity()},
+                    {"allocation", d.allocation},
+                    {"deployerrequires", d.deployer_requires}});
   char host[256] = {};
   gethostname(host, sizeof(host) - 1);
   return {

@@ -9,8 +9,8 @@
 #include <fstream>
 #include <memory>
 #include <mutex>
-#include <vector>
 #include <sstream>
+#include <vector>
 
 #include <fmt/format.h>
 #include <xercesc/framework/MemBufInputSource.hpp>

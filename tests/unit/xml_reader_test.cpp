@@ -1,7 +1,7 @@
 // The XML reader module is loaded while profiles are read and unloaded afterwards, taking Xerces
 // and its libraries out of the process.
-#include <fstream>
 #include <cstdlib>
+#include <fstream>
 #include <string>
 
 #include <catch2/catch.hpp>
@@ -27,7 +27,8 @@ const std::filesystem::path kProducer =
 
 } // namespace
 
-TEST_CASE("Xerces is in the process only while a loader that read profiles lives", "[profile][xml]") {
+TEST_CASE("Xerces is in the process only while a loader that read profiles lives",
+          "[profile][xml]") {
   REQUIRE_FALSE(mapped("libxerces-c"));
   std::shared_ptr<const profile::ResolvedSoftPkg> softpkg;
   {
@@ -62,7 +63,8 @@ TEST_CASE("a missing XML reader module is a clear error, not a crash", "[profile
   auto document = profile::read_xml_profile(kProducer);
   ::unsetenv("RSCA_XML_READER");
   REQUIRE_FALSE(document.has_value());
-  CHECK_THAT(document.error().to_string(), Catch::Contains("cannot load the XML reader module") &&
-                                               Catch::Contains("/nonexistent/librsca_xml_reader.so"));
+  CHECK_THAT(document.error().to_string(),
+             Catch::Contains("cannot load the XML reader module") &&
+                 Catch::Contains("/nonexistent/librsca_xml_reader.so"));
   CHECK(profile::read_xml_profile(kProducer).has_value()); // found where it is by default
 }

@@ -79,8 +79,10 @@ Expected<Json> install_request(const fs::path &sad, const GlobalOptions &global,
   return request;
 }
 
+} // namespace
+
 int install(const std::string &sad, const std::string &name, const GlobalOptions &global,
-            std::string *installed_name = nullptr) {
+            std::string *installed_name) {
   auto request = install_request(sad, global, name);
   if (!request) {
     fmt::print(stderr, "rsca install: {}\n", request.error().to_string());
@@ -105,6 +107,30 @@ int install(const std::string &sad, const std::string &name, const GlobalOptions
   return kOk;
 }
 
+std::optional<Json> assignments_json(const std::vector<std::string> &assignments,
+                                     const char *command) {
+  Json assign = Json::object();
+  for (const auto &a : assignments) {
+    auto eq = a.find('=');
+    if (eq == std::string::npos || eq == 0) {
+      fmt::print(stderr, "rsca {}: --assign takes COMPONENT=DEVICE, not \"{}\"\n", command, a);
+      return std::nullopt;
+    }
+    assign[a.substr(0, eq)] = a.substr(eq + 1);
+  }
+  return assign;
+}
+
+std::string installed_name_of(const std::string &what, const GlobalOptions &global, int &rc) {
+  std::string application = what;
+  rc = kOk;
+  if (fs::is_regular_file(what))
+    rc = install(what, "", global, &application);
+  return application;
+}
+
+namespace {
+
 // Prints each launch step as the domain completes it, while the launch runs.
 void follow_progress(const DomainClient &client, const std::string &launch_id,
                      std::future<control::CallResult<Json>> &launch) {
@@ -127,21 +153,15 @@ void follow_progress(const DomainClient &client, const std::string &launch_id,
 }
 
 int launch(const std::string &what, const std::string &name, bool no_start,
-           const std::vector<std::string> &assignments, const GlobalOptions &global) {
-  std::string application = what;
-  if (fs::is_regular_file(what)) {
-    if (int rc = install(what, "", global, &application); rc != kOk)
-      return rc;
-  }
-  Json assign = Json::object();
-  for (const auto &a : assignments) {
-    auto eq = a.find('=');
-    if (eq == std::string::npos) {
-      fmt::print(stderr, "rsca launch: --assign takes COMPONENT=DEVICE, not \"{}\"\n", a);
-      return kUsage;
-    }
-    assign[a.substr(0, eq)] = a.substr(eq + 1);
-  }
+           const std::vector<std::string> &assignments, const std::string &strategy,
+           const GlobalOptions &global) {
+  auto assign = assignments_json(assignments, "launch");
+  if (!assign)
+    return kUsage;
+  int rc = kOk;
+  const std::string application = installed_name_of(what, global, rc);
+  if (rc != kOk)
+    return rc;
   auto client = DomainClient::connect(global);
   if (!client) {
     fmt::print(stderr, "rsca launch: {}\n", client.error().to_string());
@@ -151,8 +171,10 @@ int launch(const std::string &what, const std::string &name, bool no_start,
       fmt::format("{}-{}", getpid(), std::chrono::steady_clock::now().time_since_epoch().count());
   Json request{{"application", application},
                {"start", !no_start},
-               {"assign", assign},
+               {"assign", *assign},
                {"launch_id", launch_id}};
+  if (!strategy.empty())
+    request["strategy"] = strategy;
   if (!name.empty())
     request["name"] = name;
   const bool show_progress = !global.json && isatty(STDOUT_FILENO);
@@ -267,8 +289,12 @@ void add_application_commands(CLI::App &app, const GlobalOptions &global, int &e
   launch_cmd->add_flag("--no-start", *no_start, "Create and connect, but do not start");
   launch_cmd->add_option("--assign", *assign,
                          "Place a component on a device: COMPONENT=DEVICE (repeatable)");
+  auto strategy = std::make_shared<std::string>();
+  launch_cmd
+      ->add_option("--strategy", *strategy, "Placement: pack or spread (default: the domain's)")
+      ->check(CLI::IsMember({"pack", "spread"}));
   launch_cmd->callback([=, &global, &exit_code] {
-    exit_code = launch(*what, *instance, *no_start, *assign, global);
+    exit_code = launch(*what, *instance, *no_start, *assign, *strategy, global);
   });
 
   for (const auto &[verb, op, help] :

@@ -1,7 +1,12 @@
 // The rsca subcommands; each registers itself on the CLI11 app and runs when chosen.
 #pragma once
 
+#include <optional>
+#include <string>
+#include <vector>
+
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 
 namespace rsca::cli {
 
@@ -18,6 +23,18 @@ void add_show_command(CLI::App &app, const GlobalOptions &global, int &exit_code
 void add_application_commands(CLI::App &app, const GlobalOptions &global, int &exit_code);
 void add_ls_command(CLI::App &app, const GlobalOptions &global, int &exit_code);
 void add_domain_command(CLI::App &app, const GlobalOptions &global, int &exit_code);
+void add_plan_command(CLI::App &app, const GlobalOptions &global, int &exit_code);
+
+// Installs the application of `sad` in the domain; its installed name goes to `installed_name`
+// (and nothing is printed in --json mode) when given. An exit code.
+int install(const std::string &sad, const std::string &name, const GlobalOptions &global,
+            std::string *installed_name = nullptr);
+// `what` is a SAD file (installed first) or an installed name; the installed name. rc: exit code.
+std::string installed_name_of(const std::string &what, const GlobalOptions &global, int &rc);
+// --assign COMPONENT=DEVICE arguments as a JSON object; nullopt (after saying why) when malformed.
+std::optional<nlohmann::json> assignments_json(const std::vector<std::string> &assignments,
+                                               const char *command);
+
 // rsca show APP when the argument is not a profile file.
 int show_application(const std::string &name, const GlobalOptions &global);
 

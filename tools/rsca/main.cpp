@@ -25,6 +25,7 @@ int main(int argc, char **argv) {
   rsca::cli::add_validate_command(app, global, exit_code);
   rsca::cli::add_show_command(app, global, exit_code);
   rsca::cli::add_application_commands(app, global, exit_code);
+  rsca::cli::add_plan_command(app, global, exit_code);
   rsca::cli::add_ls_command(app, global, exit_code);
   rsca::cli::add_domain_command(app, global, exit_code);
   try {

@@ -1,0 +1,713 @@
+#include "allocator/planner.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+namespace rsca::allocator {
+namespace {
+
+using profile::Implementation;
+using profile::ResolvedImplementation;
+
+constexpr double kMiB = 1024.0 * 1024.0;
+constexpr double kEpsilon = 1e-9;
+// An affinity this heavy (about 9 Mbps and more) keeps its pair on one host even when spreading.
+constexpr double kHeavyAffinity = 10.0;
+constexpr int kMaxDependencyDepth = 32;
+
+Nanos nanos_of(const Duration &d) {
+  return std::chrono::duration_cast<Nanos>(*d.value);
+}
+bool finite(const std::optional<Duration> &d) {
+  return d && !d->infinite();
+}
+
+// ---- static checks: whether an implementation can run on a device at all ----------------------
+
+std::optional<std::string> os_processor_mismatch(const Implementation &impl, const Device &device) {
+  const std::string os = device.property_value("os_name");
+  if (!impl.os.empty() &&
+      std::none_of(impl.os.begin(), impl.os.end(), [&](const auto &o) { return o.name == os; })) {
+    std::vector<std::string> wanted;
+    for (const auto &o : impl.os)
+      wanted.push_back(o.name);
+    return fmt::format("os_name is {}, implementation {} needs {}", os.empty() ? "unknown" : os,
+                       impl.id, fmt::join(wanted, " or "));
+  }
+  const std::string processor = device.property_value("processor_name");
+  if (!impl.processors.empty() &&
+      std::find(impl.processors.begin(), impl.processors.end(), processor) == impl.processors.end())
+    return fmt::format("processor_name is {}, implementation {} needs {}",
+                       processor.empty() ? "unknown" : processor, impl.id,
+                       fmt::join(impl.processors, " or "));
+  return std::nullopt;
+}
+
+// A requirement (propertyref / simpleref) against the device's matching property of that id.
+std::optional<std::string> requirement_mismatch(const profile::PropertyRef &ref, const Device &device) {
+  const auto *simple = std::get_if<profile::SimpleRef>(&ref);
+  if (simple == nullptr)
+    return std::nullopt; // structured requirements are capacities of their own kind: not matched
+  if (device.capacity.count(simple->refid) != 0)
+    return std::nullopt; // a capacity, allocated rather than matched
+  const auto *property = device.find_property(simple->refid);
+  if (property == nullptr)
+    return fmt::format("has no allocation property {}", simple->refid);
+  if (!satisfies(*property, simple->value))
+    return fmt::format("{} is {}, needs {} {}", property->name,
+                       property->value.empty() ? "unknown" : property->value,
+                       profile::to_string(property->action), simple->value);
+  return std::nullopt;
+}
+
+std::optional<std::string> property_dependency_mismatch(const Implementation &impl,
+                                                        const Device &device) {
+  for (const auto &dep : impl.property_dependencies)
+    if (auto why = requirement_mismatch(dep.requirement, device))
+      return fmt::format("implementation {} depends on a device that {}", impl.id, *why);
+  return std::nullopt;
+}
+
+std::optional<std::string> implementation_mismatch(const Implementation &impl, const Device &device) {
+  if (auto why = os_processor_mismatch(impl, device))
+    return why;
+  return property_dependency_mismatch(impl, device);
+}
+
+// Whether every softpkg dependency of `impl` has an implementation that fits the same device
+// (recursively, as SCA requires: dependencies load where the component loads).
+std::optional<std::string> dependency_mismatch(const ResolvedImplementation &impl,
+                                               const Device &device, int depth = 0) {
+  if (depth > kMaxDependencyDepth)
+    return "softpkg dependencies nest too deep";
+  for (const auto &dep : impl.dependencies) {
+    std::string why = "no implementation";
+    const bool fits = std::any_of(
+        dep.softpkg->implementations.begin(), dep.softpkg->implementations.end(),
+        [&](const ResolvedImplementation &candidate) {
+          if (dep.implref && candidate.implementation->id != *dep.implref)
+            return false;
+          auto m = implementation_mismatch(*candidate.implementation, device);
+          if (!m)
+            m = dependency_mismatch(candidate, device, depth + 1);
+          if (m)
+            why = *m;
+          return !m.has_value();
+        });
+    if (!fits)
+      return fmt::format("dependency {}: {}", dep.softpkg->spd->name, why);
+  }
+  return std::nullopt;
+}
+
+// SCA devicerequires / deployerrequires: a component that requires goes only to a device that
+// offers, and a device that offers takes only components that require exactly what it offers.
+std::optional<std::string> requires_mismatch(const ComponentRequest &c, const Device &device) {
+  std::map<std::string, std::string> wanted;
+  for (const auto &ref : c.device_requires)
+    if (const auto *simple = std::get_if<profile::SimpleRef>(&ref))
+      wanted[simple->refid] = simple->value;
+  for (const auto &[id, value] : wanted) {
+    auto it = device.deployer_requires.find(id);
+    if (it == device.deployer_requires.end() || it->second != value)
+      return fmt::format("devicerequires {}={}, the device's deployerrequires do not offer it", id,
+                         value);
+  }
+  for (const auto &[id, value] : device.deployer_requires) {
+    auto it = wanted.find(id);
+    if (it == wanted.end() || it->second != value)
+      return fmt::format("deployerrequires {}={}: the device takes only components that require it",
+                         id, value);
+  }
+  return std::nullopt;
+}
+
+// ---- capacities ---------------------------------------------------------------------------------
+
+double free_of(const DeviceState &state, const std::string &capacity) {
+  auto total = state.device.capacity.find(capacity);
+  if (total == state.device.capacity.end())
+    return 0;
+  auto used = state.load.allocated.find(capacity);
+  return total->second - (used == state.load.allocated.end() ? 0.0 : used->second);
+}
+
+std::optional<std::string> capacity_shortfall(const std::map<std::string, double> &demand,
+                                              const DeviceState &state) {
+  for (const auto &[name, amount] : demand) {
+    if (amount <= 0)
+      continue;
+    if (state.device.capacity.count(name) == 0)
+      return fmt::format("{}: the device has no {} capacity", name, name);
+    const double free = free_of(state, name);
+    if (amount > free + kEpsilon)
+      return fmt::format("{} needs {}, {} free", name, describe_amount(name, amount),
+                         describe_amount(name, std::max(0.0, free)));
+  }
+  return std::nullopt;
+}
+
+// How full a device is, 0 to 1: its fullest finite capacity.
+double load_of(const DeviceState &state) {
+  double load = 0;
+  for (const auto &[name, total] : state.device.capacity)
+    if (std::isfinite(total) && total > 0)
+      load = std::max(load, 1.0 - free_of(state, name) / total);
+  return load;
+}
+
+void add(std::map<std::string, double> &to, const std::map<std::string, double> &amounts, double sign) {
+  for (const auto &[name, amount] : amounts) {
+    double &v = to[name];
+    v = std::max(0.0, v + sign * amount);
+  }
+}
+
+// What a usesdevice reserves (its external requirements) and whether a device matches the rest.
+std::map<std::string, double> uses_demand(const profile::UsesDevice &uses, const Device &device) {
+  std::map<std::string, double> demand;
+  for (const auto &ref : uses.requirements) {
+    const auto *simple = std::get_if<profile::SimpleRef>(&ref);
+    if (simple == nullptr)
+      continue;
+    auto capacity = device.capacity.find(simple->refid);
+    if (capacity == device.capacity.end()) {
+      const auto *p = device.find_property(simple->refid);
+      if (p == nullptr || p->id == p->name)
+        continue;
+      capacity = device.capacity.find(p->name);
+      if (capacity == device.capacity.end())
+        continue;
+    }
+    try {
+      demand[capacity->first] = std::stod(simple->value);
+    } catch (const std::exception &) {
+      demand[capacity->first] = 0;
+    }
+  }
+  return demand;
+}
+
+std::optional<std::string> uses_mismatch(const profile::UsesDevice &uses, const DeviceState &state) {
+  for (const auto &ref : uses.requirements)
+    if (auto why = requirement_mismatch(ref, state.device))
+      return why;
+  return capacity_shortfall(uses_demand(uses, state.device), state);
+}
+
+// ---- timing -------------------------------------------------------------------------------------
+
+// Tries the task on the device's CPUs (most loaded first when packing, least loaded when
+// spreading); the CPU and the analysis of its task set with the task added, or why none fits.
+tl::expected<std::pair<unsigned, Schedulability>, std::string>
+admit(const Task &task, const DeviceState &state, Strategy strategy) {
+  const unsigned cpus = std::max(1u, state.device.cpus);
+  std::vector<std::pair<double, unsigned>> order;
+  for (unsigned cpu = 0; cpu < cpus; ++cpu) {
+    const double u = cpu < state.load.cpu_tasks.size() ? utilization(state.load.cpu_tasks[cpu]) : 0.0;
+    order.emplace_back(strategy == Strategy::Pack ? -u : u, cpu);
+  }
+  std::sort(order.begin(), order.end());
+  std::string first_reason;
+  for (const auto &[key, cpu] : order) {
+    std::vector<Task> tasks =
+        cpu < state.load.cpu_tasks.size() ? state.load.cpu_tasks[cpu] : std::vector<Task>{};
+    tasks.push_back(task);
+    auto verdict = analyse(tasks, state.device.policy);
+    if (verdict.schedulable)
+      return std::pair{cpu, std::move(verdict)};
+    if (first_reason.empty())
+      first_reason = fmt::format("cpu {} ({}): {}", cpu, to_string(state.device.policy), verdict.reason);
+  }
+  return tl::unexpected(fmt::format("timing admission failed on every CPU; {}", first_reason));
+}
+
+Schedule schedule_of(const Task &task, unsigned cpu, const Schedulability &verdict,
+                     SchedulingPolicy policy) {
+  Schedule s{cpu, policy, 0, task.period, task.execution, task.deadline, task.deadline};
+  for (const auto &v : verdict.tasks)
+    if (v.id == task.id) {
+      s.priority = v.priority;
+      s.response_time = v.response_time;
+    }
+  return s;
+}
+
+// ---- the search ---------------------------------------------------------------------------------
+
+struct Candidate {
+  std::string device;
+  const ResolvedImplementation *implementation = nullptr;
+};
+
+// One way to place a component, with what it changes in the state.
+struct Step {
+  Placement placement;
+  std::optional<Task> task;
+};
+
+class Search {
+public:
+  Search(const DomainState &state, const PlanRequest &request, const PlanOptions &options)
+      : state_(state), request_(request), options_(options) {}
+
+  tl::expected<Plan, std::vector<Rejection>> run() {
+    if (auto unplaceable = find_candidates(); !unplaceable.empty())
+      return tl::unexpected(std::move(unplaceable));
+    order_components();
+    steps_.resize(order_.size());
+    if (place(0))
+      return finish();
+    return tl::unexpected(explain());
+  }
+
+private:
+  // Static candidates per component; the components that have none, with every reason.
+  std::vector<Rejection> find_candidates() {
+    std::vector<Rejection> rejections;
+    candidates_.resize(request_.components.size());
+    first_reasons_.resize(request_.components.size());
+    for (std::size_t i = 0; i < request_.components.size(); ++i) {
+      const auto &c = request_.components[i];
+      Rejection rejection{c.instance, {}};
+      for (const auto &impl : c.softpkg->implementations)
+        for (const auto &[id, s] : state_) {
+          if (s.device.kind != "gpp" || (c.device && *c.device != id))
+            continue;
+          auto why = implementation_mismatch(*impl.implementation, s.device);
+          if (!why)
+            why = dependency_mismatch(impl, s.device);
+          if (!why)
+            why = requires_mismatch(c, s.device);
+          if (why)
+            rejection.reasons.push_back(fmt::format("{} ({}): {}", id, impl.implementation->id, *why));
+          else
+            candidates_[i].push_back({id, &impl});
+        }
+      first_reasons_[i] = rejection.reasons;
+      if (!candidates_[i].empty())
+        continue;
+      if (rejection.reasons.empty())
+        rejection.reasons.push_back(
+            c.device ? fmt::format("the assigned device {} is not in the domain", *c.device)
+                     : "no device that runs components is in the domain");
+      rejections.push_back(std::move(rejection));
+    }
+    return rejections;
+  }
+
+  // Fewest candidates first; a collocation group's members next to each other.
+  void order_components() {
+    std::vector<std::size_t> order(request_.components.size());
+    for (std::size_t i = 0; i < order.size(); ++i)
+      order[i] = i;
+    auto key = [&](std::size_t i) {
+      const auto &c = request_.components[i];
+      // A group sorts by its most constrained member, so that its members stay together.
+      std::size_t n = candidates_[i].size();
+      if (!c.collocation.empty())
+        for (std::size_t j = 0; j < order.size(); ++j)
+          if (request_.components[j].collocation == c.collocation)
+            n = std::min(n, candidates_[j].size());
+      return std::tuple(n, c.collocation, i);
+    };
+    std::stable_sort(order.begin(), order.end(), [&](auto a, auto b) { return key(a) < key(b); });
+    order_ = std::move(order);
+  }
+
+  double affinity_on(const std::string &instance, const std::string &node, bool heavy_only) const {
+    double sum = 0;
+    for (const auto &a : request_.affinities) {
+      if (heavy_only && a.weight < kHeavyAffinity)
+        continue;
+      const std::string *other = a.a == instance ? &a.b : (a.b == instance ? &a.a : nullptr);
+      if (other == nullptr)
+        continue;
+      auto it = node_of_.find(*other);
+      if (it != node_of_.end() && it->second == node)
+        sum += a.weight;
+    }
+    return sum;
+  }
+
+  // The candidates of component `i` in the order the strategy prefers them.
+  std::vector<Candidate> ranked(std::size_t i) const {
+    const auto &c = request_.components[i];
+    const bool pack = options_.strategy == Strategy::Pack;
+    std::vector<std::tuple<double, double, std::size_t>> keyed;
+    const auto &list = candidates_[i];
+    for (std::size_t k = 0; k < list.size(); ++k) {
+      const auto &s = working_.at(list[k].device);
+      const double affinity = affinity_on(c.instance, s.device.node, !pack);
+      const double load = load_of(s);
+      keyed.emplace_back(-affinity, pack ? -load : load, k);
+    }
+    std::stable_sort(keyed.begin(), keyed.end());
+    std::vector<Candidate> out;
+    out.reserve(keyed.size());
+    for (const auto &[a, l, k] : keyed)
+      out.push_back(list[k]);
+    return out;
+  }
+
+  // The step that places component `i` on the candidate, or why it does not fit now.
+  tl::expected<Step, std::string> try_candidate(std::size_t i, const Candidate &candidate) const {
+    const auto &c = request_.components[i];
+    const auto &s = working_.at(candidate.device);
+    const auto &impl = *candidate.implementation->implementation;
+    if (!c.collocation.empty())
+      if (auto it = group_node_.find(c.collocation); it != group_node_.end() && it->second != s.device.node)
+        return tl::unexpected(fmt::format("hostcollocation {} is on node {}", c.collocation, it->second));
+    Step step{{c.instance, candidate.device, s.device.node, &impl, demand_of(impl, c.timing), {}, {}},
+              task_of(c.instance, impl, c.timing)};
+    if (auto why = capacity_shortfall(step.placement.demand, s))
+      return tl::unexpected(*why);
+    if (step.task) {
+      auto admitted = admit(*step.task, s, options_.strategy);
+      if (!admitted)
+        return tl::unexpected(admitted.error());
+      step.placement.schedule =
+          schedule_of(*step.task, admitted->first, admitted->second, s.device.policy);
+    }
+    for (const auto &uses : impl.uses_devices) {
+      auto used = find_used_device(uses, s.device.node);
+      if (!used)
+        return tl::unexpected(used.error());
+      step.placement.used_devices.push_back(std::move(*used));
+    }
+    return step;
+  }
+
+  // A device on `node` (any node when empty) that satisfies `uses`, with its demand.
+  tl::expected<UsedDevice, std::string> find_used_device(const profile::UsesDevice &uses,
+                                                         const std::string &node) const {
+    std::string first_reason;
+    for (const auto &[id, s] : working_) {
+      if (!node.empty() && s.device.node != node)
+        continue;
+      auto why = uses_mismatch(uses, s);
+      if (!why)
+        return UsedDevice{uses.id, id, uses_demand(uses, s.device)};
+      if (first_reason.empty())
+        first_reason = fmt::format("{}: {}", id, *why);
+    }
+    return tl::unexpected(fmt::format("usesdevice {}: no device {}{}", uses.id,
+                                      node.empty() ? "in the domain" : "on node " + node + " fits",
+                                      first_reason.empty() ? "" : " (" + first_reason + ")"));
+  }
+
+  void apply(const Step &step, double sign) {
+    auto &s = working_.at(step.placement.device);
+    add(s.load.allocated, step.placement.demand, sign);
+    for (const auto &used : step.placement.used_devices)
+      add(working_.at(used.device).load.allocated, used.demand, sign);
+    if (step.task && step.placement.schedule) {
+      const unsigned cpu = step.placement.schedule->cpu;
+      if (s.load.cpu_tasks.size() <= cpu)
+        s.load.cpu_tasks.resize(cpu + 1);
+      auto &tasks = s.load.cpu_tasks[cpu];
+      if (sign > 0)
+        tasks.push_back(*step.task);
+      else
+        tasks.pop_back(); // steps are undone in reverse order
+    }
+  }
+
+  bool place(std::size_t k) {
+    if (k == order_.size())
+      return complete();
+    const std::size_t i = order_[k];
+    const auto &c = request_.components[i];
+    bool any_fit = false;
+    std::vector<std::string> reasons;
+    for (const auto &candidate : ranked(i)) {
+      if (++tries_ > options_.budget) {
+        budget_exhausted_ = true;
+        return false;
+      }
+      auto step = try_candidate(i, candidate);
+      if (!step) {
+        reasons.push_back(fmt::format("{} ({}): {}", candidate.device,
+                                      candidate.implementation->implementation->id, step.error()));
+        continue;
+      }
+      any_fit = true;
+      const bool opens_group = !c.collocation.empty() && group_node_.count(c.collocation) == 0;
+      if (opens_group)
+        group_node_[c.collocation] = step->placement.node;
+      node_of_[c.instance] = step->placement.node;
+      apply(*step, +1);
+      steps_[k] = std::move(*step);
+      if (place(k + 1))
+        return true;
+      apply(steps_[k], -1);
+      node_of_.erase(c.instance);
+      if (opens_group)
+        group_node_.erase(c.collocation);
+      if (budget_exhausted_)
+        return false;
+    }
+    if (!any_fit && blocked_ == nullptr_index) {
+      blocked_ = i;
+      blocked_reasons_ = std::move(reasons);
+      blocked_reasons_.insert(blocked_reasons_.end(), first_reasons_[i].begin(), first_reasons_[i].end());
+    }
+    return false;
+  }
+
+  // Every component is placed: the SAD's own usesdevice and the latency bounds decide.
+  bool complete() {
+    application_devices_.clear();
+    for (const auto &uses : request_.uses_devices) {
+      auto used = find_used_device(uses, "");
+      if (!used) {
+        leaf_failure_ = used.error();
+        return false;
+      }
+      add(working_.at(used->device).load.allocated, used->demand, +1);
+      application_devices_.push_back(std::move(*used));
+    }
+    if (auto why = latency_violation()) {
+      for (const auto &used : application_devices_)
+        add(working_.at(used.device).load.allocated, used.demand, -1);
+      leaf_failure_ = *why;
+      return false;
+    }
+    return true;
+  }
+
+  // A latency path whose worst case exceeds its bound: the first component's response time,
+  // then per hop the receiver's period (it samples its input once a period) and response time.
+  std::optional<std::string> latency_violation() const {
+    for (const auto &path : request_.latency_paths) {
+      Nanos worst{0};
+      for (std::size_t n = 0; n < path.components.size(); ++n) {
+        const Schedule *s = schedule_of_instance(path.components[n]);
+        if (s == nullptr)
+          continue;
+        worst += s->response_time + (n > 0 ? s->period : Nanos{0});
+      }
+      if (!path.bound.infinite() && worst > nanos_of(path.bound))
+        return fmt::format("latency path {}: worst case {} exceeds its bound {}", path.id,
+                           format_duration(worst), format_duration(nanos_of(path.bound)));
+    }
+    return std::nullopt;
+  }
+
+  const Schedule *schedule_of_instance(const std::string &instance) const {
+    for (const auto &step : steps_)
+      if (step.placement.instance == instance && step.placement.schedule)
+        return &*step.placement.schedule;
+    return nullptr;
+  }
+
+  static std::string format_duration(Nanos d) { return rsca::format_duration(Duration{d}); }
+
+  Plan finish() const {
+    Plan plan;
+    std::vector<Placement> by_request(request_.components.size());
+    for (std::size_t k = 0; k < order_.size(); ++k)
+      by_request[order_[k]] = steps_[k].placement;
+    plan.placements = std::move(by_request);
+    plan.application_devices = application_devices_;
+    std::set<std::string> unknown;
+    for (const auto &p : plan.placements)
+      for (const auto &[name, total] : state_.at(p.device).device.capacity)
+        if (!std::isfinite(total))
+          unknown.insert(fmt::format("{} of {}", name, p.device));
+    for (const auto &u : unknown)
+      plan.notes.push_back(fmt::format("{} is not known: not checked", u));
+    return plan;
+  }
+
+  std::vector<Rejection> explain() const {
+    std::vector<Rejection> out;
+    if (blocked_ != nullptr_index)
+      out.push_back({request_.components[blocked_].instance, blocked_reasons_});
+    if (!leaf_failure_.empty())
+      out.push_back({"(application)", {leaf_failure_}});
+    if (budget_exhausted_)
+      out.push_back({"(search)",
+                     {fmt::format("no plan found within {} placements tried; the domain may still "
+                                  "fit the application in a way not searched",
+                                  options_.budget)}});
+    if (out.empty())
+      out.push_back({"(application)", {"no placement satisfies every constraint together"}});
+    return out;
+  }
+
+  static constexpr std::size_t nullptr_index = static_cast<std::size_t>(-1);
+
+  const DomainState &state_;
+  const PlanRequest &request_;
+  const PlanOptions &options_;
+  DomainState working_ = state_;
+  std::vector<std::vector<Candidate>> candidates_;
+  std::vector<std::vector<std::string>> first_reasons_; // static reasons, per component
+  std::vector<std::size_t> order_;
+  std::vector<Step> steps_; // by search position
+  std::map<std::string, std::string> node_of_;    // placed instance -> node
+  std::map<std::string, std::string> group_node_; // hostcollocation -> node
+  std::vector<UsedDevice> application_devices_;
+  std::size_t tries_ = 0;
+  bool budget_exhausted_ = false;
+  std::size_t blocked_ = nullptr_index;
+  std::vector<std::string> blocked_reasons_;
+  std::string leaf_failure_;
+};
+
+void apply_plan(DomainState &state, const Plan &plan, double sign) {
+  auto device = [&](const std::string &id) -> DeviceState * {
+    auto it = state.find(id);
+    return it == state.end() ? nullptr : &it->second; // a node gone takes its allocations along
+  };
+  for (const auto &p : plan.placements) {
+    if (auto *s = device(p.device)) {
+      add(s->load.allocated, p.demand, sign);
+      if (p.schedule) {
+        const Task task{p.instance, p.schedule->period, p.schedule->budget, p.schedule->deadline,
+                        p.schedule->priority == 0 ? std::nullopt
+                                                  : std::optional<std::uint32_t>(p.schedule->priority)};
+        if (s->load.cpu_tasks.size() <= p.schedule->cpu)
+          s->load.cpu_tasks.resize(p.schedule->cpu + 1);
+        auto &tasks = s->load.cpu_tasks[p.schedule->cpu];
+        if (sign > 0) {
+          tasks.push_back(task);
+        } else {
+          auto it = std::find_if(tasks.begin(), tasks.end(), [&](const Task &t) {
+            return t.id == task.id && t.period == task.period && t.execution == task.execution;
+          });
+          if (it != tasks.end())
+            tasks.erase(it);
+        }
+      }
+    }
+    for (const auto &used : p.used_devices)
+      if (auto *s = device(used.device))
+        add(s->load.allocated, used.demand, sign);
+  }
+  for (const auto &used : plan.application_devices)
+    if (auto *s = device(used.device))
+      add(s->load.allocated, used.demand, sign);
+}
+
+} // namespace
+
+std::string_view to_string(Strategy strategy) {
+  return strategy == Strategy::Pack ? "pack" : "spread";
+}
+
+std::optional<Strategy> parse_strategy(std::string_view text) {
+  if (text == "pack")
+    return Strategy::Pack;
+  if (text == "spread")
+    return Strategy::Spread;
+  return std::nullopt;
+}
+
+std::string to_string(const std::vector<Rejection> &rejections) {
+  std::string out;
+  for (const auto &r : rejections) {
+    out += fmt::format("{}{}: cannot be placed", out.empty() ? "" : "\n", r.instance);
+    for (const auto &reason : r.reasons)
+      out += fmt::format("\n  {}", reason);
+  }
+  return out;
+}
+
+std::optional<Task> task_of(const std::string &instance, const Implementation &implementation,
+                            const std::optional<profile::Timing> &timing) {
+  const auto &demand = implementation.resource_demand;
+  std::optional<Duration> period = timing && finite(timing->period) ? timing->period : std::nullopt;
+  if (!period && demand && finite(demand->period))
+    period = demand->period;
+  if (!period || nanos_of(*period).count() <= 0)
+    return std::nullopt;
+  const Nanos t = nanos_of(*period);
+  Nanos c{0};
+  if (timing && finite(timing->execution_time))
+    c = nanos_of(*timing->execution_time);
+  else if (demand && finite(demand->execution_time))
+    c = nanos_of(*demand->execution_time);
+  else if (demand && demand->utilization)
+    c = Nanos(static_cast<Nanos::rep>(std::llround(*demand->utilization * static_cast<double>(t.count()))));
+  if (c.count() <= 0)
+    return std::nullopt;
+  const Nanos d = timing && finite(timing->deadline) ? nanos_of(*timing->deadline) : t;
+  return Task{instance, t, c, d, timing ? timing->priority : std::nullopt};
+}
+
+std::map<std::string, double> demand_of(const Implementation &implementation,
+                                        const std::optional<profile::Timing> &timing) {
+  std::map<std::string, double> demand;
+  if (auto task = task_of("", implementation, timing))
+    demand[kCpuCapacity] = 100.0 * static_cast<double>(task->execution.count()) /
+                           static_cast<double>(task->period.count());
+  if (!implementation.resource_demand)
+    return demand;
+  const auto &d = *implementation.resource_demand;
+  if (d.utilization && demand.count(kCpuCapacity) == 0)
+    demand[kCpuCapacity] = *d.utilization * 100.0;
+  if (d.memory_bytes)
+    demand[kMemCapacity] = static_cast<double>(*d.memory_bytes) / kMiB;
+  if (d.bandwidth_bps)
+    demand[kNetCapacity] = *d.bandwidth_bps / 1e6;
+  return demand;
+}
+
+tl::expected<Plan, std::vector<Rejection>> make_plan(const DomainState &state,
+                                                     const PlanRequest &request,
+                                                     const PlanOptions &options) {
+  return Search(state, request, options).run();
+}
+
+void commit(DomainState &state, const Plan &plan) {
+  apply_plan(state, plan, +1);
+}
+
+void release(DomainState &state, const Plan &plan) {
+  apply_plan(state, plan, -1);
+}
+
+PlanRequest plan_request_of(const profile::ResolvedApplication &application,
+                            const std::map<std::string, std::string> &assignments) {
+  PlanRequest request;
+  const auto &sad = *application.sad;
+  std::map<std::string, double> bandwidth; // Mbps each instance declares
+  for (const auto &placement : sad.placements) {
+    const auto *pkg = application.softpkg_of(placement);
+    for (const auto &ci : placement.instantiations) {
+      ComponentRequest c{ci.id, pkg, std::nullopt, placement.host_collocation, ci.device_requires,
+                         ci.timing};
+      if (auto it = assignments.find(ci.id); it != assignments.end())
+        c.device = it->second;
+      double mbps = 0;
+      if (pkg != nullptr)
+        for (const auto &impl : pkg->implementations)
+          if (impl.implementation->resource_demand && impl.implementation->resource_demand->bandwidth_bps)
+            mbps = std::max(mbps, *impl.implementation->resource_demand->bandwidth_bps / 1e6);
+      bandwidth[ci.id] = mbps;
+      request.components.push_back(std::move(c));
+    }
+  }
+  for (const auto &connection : sad.connections) {
+    using Kind = profile::EndpointTarget::Kind;
+    if (connection.uses.target.kind != Kind::ComponentInstantiation ||
+        connection.provides.target.kind != Kind::ComponentInstantiation)
+      continue;
+    const auto &uses = connection.uses.target.refid;
+    const auto &provides = connection.provides.target.refid;
+    if (uses.empty() || provides.empty() || uses == provides)
+      continue;
+    request.affinities.push_back({uses, provides, 1.0 + bandwidth[uses]});
+  }
+  request.uses_devices = sad.uses_device_dependencies;
+  request.latency_paths = sad.latency_paths;
+  return request;
+}
+
+} // namespace rsca::allocator

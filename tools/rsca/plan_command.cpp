@@ -1,0 +1,168 @@
+// rsca plan SAD|NAME: admission and placement without launching anything — against the running
+// domain, or offline against node DCDs (--node), so a profile can be checked with no domain up.
+#include <filesystem>
+
+#include <fmt/format.h>
+
+#include "allocator/plan_json.hpp"
+#include "allocator/planner.hpp"
+#include "commands.hpp"
+#include "domain_client.hpp"
+#include "exit_codes.hpp"
+#include "profile/profile_loader.hpp"
+
+namespace rsca::cli {
+namespace {
+
+namespace fs = std::filesystem;
+using control::Json;
+
+struct PlanArgs {
+  std::string what;
+  std::vector<std::string> nodes;
+  std::vector<std::string> assignments;
+  std::string strategy; // empty: the domain's (offline: pack)
+};
+
+std::string milliseconds(const Json &ns) {
+  return fmt::format("{:g} ms", ns.get<double>() / 1e6);
+}
+
+std::string describe_demand(const Json &demand) {
+  std::string out;
+  for (const auto &[name, amount] : demand.items())
+    if (amount.is_number() && amount.get<double>() > 0)
+      out += fmt::format("{}{} {:g}", out.empty() ? "" : ", ", name, amount.get<double>());
+  return out.empty() ? "no declared demand" : out;
+}
+
+void print_plan(const std::string &application, const Json &result) {
+  const bool admitted = result.value("admitted", false);
+  fmt::print("plan for {} (strategy {}): {}\n", application, result.value("strategy", ""),
+             admitted ? "admitted" : "rejected");
+  if (!admitted) {
+    for (const auto &r : result.at("rejections")) {
+      fmt::print("  {}: cannot be placed\n", r.value("component", ""));
+      for (const auto &reason : r.at("reasons"))
+        fmt::print("    {}\n", reason.get<std::string>());
+    }
+    return;
+  }
+  const Json &plan = result.at("plan");
+  for (const auto &p : plan.at("placements")) {
+    fmt::print("  {:<20} -> {:<16} ({})  {}\n", p.value("component", ""), p.value("device", ""),
+               p.value("implementation", ""), describe_demand(p.at("demand")));
+    if (p.contains("schedule")) {
+      const auto &s = p.at("schedule");
+      fmt::print("  {:<20}    cpu {} {}, priority {}, period {}, budget {}, worst response {}\n", "",
+                 s.value("cpu", 0), s.value("policy", ""), s.value("priority", 0),
+                 milliseconds(s.at("period_ns")), milliseconds(s.at("budget_ns")),
+                 milliseconds(s.at("response_time_ns")));
+    }
+    for (const auto &u : p.at("uses_devices"))
+      fmt::print("  {:<20}    uses {} ({})\n", "", u.value("device", ""), u.value("usesdevice", ""));
+  }
+  for (const auto &u : plan.at("uses_devices"))
+    fmt::print("  application uses {} ({})\n", u.value("device", ""), u.value("usesdevice", ""));
+  for (const auto &note : plan.at("notes"))
+    fmt::print("  note: {}\n", note.get<std::string>());
+}
+
+int report(const std::string &application, const Json &result, const GlobalOptions &global) {
+  if (global.json)
+    print_json(result);
+  else
+    print_plan(application, result);
+  return result.value("admitted", false) ? kOk : kRejected;
+}
+
+// Offline: the devices the DCDs declare, valued from their PRFs and the DCDs alone.
+Expected<allocator::DomainState> offline_domain(const std::vector<std::string> &dcds) {
+  allocator::DomainState state;
+  for (const auto &dcd : dcds) {
+    profile::ProfileLoader loader; // each DCD's SDR root is found from where it lies
+    auto node = loader.load_node(dcd);
+    if (!node)
+      return tl::unexpected(node.error());
+    for (auto &device : allocator::devices_of_node(*node)) {
+      const std::string id = device.id;
+      state.emplace(id, allocator::DeviceState{std::move(device), {}});
+    }
+  }
+  return state;
+}
+
+int plan_offline(const PlanArgs &args, const Json &assign, const GlobalOptions &global) {
+  const auto sdrroot =
+      global.sdrroot.empty() ? std::nullopt : std::optional<fs::path>(fs::absolute(global.sdrroot));
+  auto application = profile::ProfileLoader(sdrroot).load_application(args.what);
+  if (!application) {
+    fmt::print(stderr, "rsca plan: {}\n", application.error().to_string());
+    return kInvalidProfile;
+  }
+  auto domain = offline_domain(args.nodes);
+  if (!domain) {
+    fmt::print(stderr, "rsca plan: {}\n", domain.error().to_string());
+    return kInvalidProfile;
+  }
+  std::map<std::string, std::string> assignments;
+  for (const auto &[k, v] : assign.items())
+    assignments[k] = v.get<std::string>();
+  const allocator::PlanOptions options{
+      allocator::parse_strategy(args.strategy).value_or(allocator::Strategy::Pack)};
+  auto plan = allocator::make_plan(*domain, allocator::plan_request_of(*application, assignments),
+                                   options);
+  Json result{{"strategy", to_string(options.strategy)}, {"admitted", plan.has_value()}};
+  if (plan)
+    result["plan"] = allocator::to_json(*plan);
+  else
+    result["rejections"] = allocator::to_json(plan.error());
+  return report(application->sad->name, result, global);
+}
+
+int plan_online(const PlanArgs &args, const Json &assign, const GlobalOptions &global) {
+  int rc = kOk;
+  const std::string application = installed_name_of(args.what, global, rc);
+  if (rc != kOk)
+    return rc;
+  auto client = DomainClient::connect(global);
+  if (!client) {
+    fmt::print(stderr, "rsca plan: {}\n", client.error().to_string());
+    return kFailed;
+  }
+  Json request{{"application", application}, {"assign", assign}};
+  if (!args.strategy.empty())
+    request["strategy"] = args.strategy;
+  auto reply = client->call("app.plan", request, std::chrono::milliseconds(global.timeout_ms));
+  if (!reply)
+    return report_failure(global, "plan", reply.error());
+  return report(application, *reply, global);
+}
+
+} // namespace
+
+void add_plan_command(CLI::App &app, const GlobalOptions &global, int &exit_code) {
+  auto *cmd = app.add_subcommand(
+      "plan", "Admission and placement of an application without launching it: against the "
+              "running domain, or offline against node DCDs (--node)");
+  auto args = std::make_shared<PlanArgs>();
+  cmd->add_option("application", args->what, "SAD file or installed application name")->required();
+  cmd->add_option("--node", args->nodes, "Plan offline against this node's DCD (repeatable)")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--assign", args->assignments,
+                  "Place a component on a device: COMPONENT=DEVICE (repeatable)");
+  cmd->add_option("--strategy", args->strategy,
+                  "Placement: pack or spread (default: the domain's; offline: pack)")
+      ->check(CLI::IsMember({"pack", "spread"}));
+  cmd->callback([args, &global, &exit_code] {
+    auto assign = assignments_json(args->assignments, "plan");
+    if (!assign) {
+      exit_code = kUsage;
+      return;
+    }
+    exit_code = args->nodes.empty() ? plan_online(*args, *assign, global)
+                                    : plan_offline(*args, *assign, global);
+  });
+}
+
+} // namespace rsca::cli
