@@ -60,7 +60,8 @@ std::optional<std::string> override_of(const profile::ComponentInstantiation &ci
   return std::nullopt;
 }
 
-std::vector<const profile::SimpleProperty *> simple_properties(const profile::ResolvedSoftPkg &pkg) {
+std::vector<const profile::SimpleProperty *>
+simple_properties(const profile::ResolvedSoftPkg &pkg) {
   std::vector<const profile::SimpleProperty *> out;
   if (pkg.properties == nullptr)
     return out;
@@ -125,9 +126,8 @@ std::string Device::property_value(std::string_view id_or_name) const {
 bool satisfies(const MatchingProperty &property, const std::string &required) {
   const auto device_number = as_number(property.value);
   const auto required_number = as_number(required);
-  const int order = device_number && required_number
-                        ? compare(*device_number, *required_number)
-                        : compare(property.value, required);
+  const int order = device_number && required_number ? compare(*device_number, *required_number)
+                                                     : compare(property.value, required);
   const bool numeric = device_number && required_number;
   switch (property.action) {
   case profile::Action::Eq:
@@ -212,8 +212,8 @@ std::vector<Device> devices_of_node(const profile::ResolvedNode &node) {
       continue;
     for (const auto &ci : placed.placement->instantiations) {
       const std::string label = ci.usage_name.empty() ? ci.id : ci.usage_name;
-      out.push_back(describe_offline(node.dcd->name, fmt::format("{}:{}", node.dcd->name, label), ci,
-                                     *placed.softpkg));
+      out.push_back(describe_offline(node.dcd->name, fmt::format("{}:{}", node.dcd->name, label),
+                                     ci, *placed.softpkg));
     }
   }
   return out;

@@ -48,7 +48,8 @@ std::optional<std::string> os_processor_mismatch(const Implementation &impl, con
 }
 
 // A requirement (propertyref / simpleref) against the device's matching property of that id.
-std::optional<std::string> requirement_mismatch(const profile::PropertyRef &ref, const Device &device) {
+std::optional<std::string> requirement_mismatch(const profile::PropertyRef &ref,
+                                                const Device &device) {
   const auto *simple = std::get_if<profile::SimpleRef>(&ref);
   if (simple == nullptr)
     return std::nullopt; // structured requirements are capacities of their own kind: not matched
@@ -72,7 +73,8 @@ std::optional<std::string> property_dependency_mismatch(const Implementation &im
   return std::nullopt;
 }
 
-std::optional<std::string> implementation_mismatch(const Implementation &impl, const Device &device) {
+std::optional<std::string> implementation_mismatch(const Implementation &impl,
+                                                   const Device &device) {
   if (auto why = os_processor_mismatch(impl, device))
     return why;
   return property_dependency_mismatch(impl, device);
@@ -86,18 +88,18 @@ std::optional<std::string> dependency_mismatch(const ResolvedImplementation &imp
     return "softpkg dependencies nest too deep";
   for (const auto &dep : impl.dependencies) {
     std::string why = "no implementation";
-    const bool fits = std::any_of(
-        dep.softpkg->implementations.begin(), dep.softpkg->implementations.end(),
-        [&](const ResolvedImplementation &candidate) {
-          if (dep.implref && candidate.implementation->id != *dep.implref)
-            return false;
-          auto m = implementation_mismatch(*candidate.implementation, device);
-          if (!m)
-            m = dependency_mismatch(candidate, device, depth + 1);
-          if (m)
-            why = *m;
-          return !m.has_value();
-        });
+    const bool fits =
+        std::any_of(dep.softpkg->implementations.begin(), dep.softpkg->implementations.end(),
+                    [&](const ResolvedImplementation &candidate) {
+                      if (dep.implref && candidate.implementation->id != *dep.implref)
+                        return false;
+                      auto m = implementation_mismatch(*candidate.implementation, device);
+                      if (!m)
+                        m = dependency_mismatch(candidate, device, depth + 1);
+                      if (m)
+                        why = *m;
+                      return !m.has_value();
+                    });
     if (!fits)
       return fmt::format("dependency {}: {}", dep.softpkg->spd->name, why);
   }
@@ -160,7 +162,8 @@ double load_of(const DeviceState &state) {
   return load;
 }
 
-void add(std::map<std::string, double> &to, const std::map<std::string, double> &amounts, double sign) {
+void add(std::map<std::string, double> &to, const std::map<std::string, double> &amounts,
+         double sign) {
   for (const auto &[name, amount] : amounts) {
     double &v = to[name];
     v = std::max(0.0, v + sign * amount);
@@ -192,7 +195,8 @@ std::map<std::string, double> uses_demand(const profile::UsesDevice &uses, const
   return demand;
 }
 
-std::optional<std::string> uses_mismatch(const profile::UsesDevice &uses, const DeviceState &state) {
+std::optional<std::string> uses_mismatch(const profile::UsesDevice &uses,
+                                         const DeviceState &state) {
   for (const auto &ref : uses.requirements)
     if (auto why = requirement_mismatch(ref, state.device))
       return why;
@@ -208,7 +212,8 @@ admit(const Task &task, const DeviceState &state, Strategy strategy) {
   const unsigned cpus = std::max(1u, state.device.cpus);
   std::vector<std::pair<double, unsigned>> order;
   for (unsigned cpu = 0; cpu < cpus; ++cpu) {
-    const double u = cpu < state.load.cpu_tasks.size() ? utilization(state.load.cpu_tasks[cpu]) : 0.0;
+    const double u =
+        cpu < state.load.cpu_tasks.size() ? utilization(state.load.cpu_tasks[cpu]) : 0.0;
     order.emplace_back(strategy == Strategy::Pack ? -u : u, cpu);
   }
   std::sort(order.begin(), order.end());
@@ -221,7 +226,8 @@ admit(const Task &task, const DeviceState &state, Strategy strategy) {
     if (verdict.schedulable)
       return std::pair{cpu, std::move(verdict)};
     if (first_reason.empty())
-      first_reason = fmt::format("cpu {} ({}): {}", cpu, to_string(state.device.policy), verdict.reason);
+      first_reason =
+          fmt::format("cpu {} ({}): {}", cpu, to_string(state.device.policy), verdict.reason);
   }
   return tl::unexpected(fmt::format("timing admission failed on every CPU; {}", first_reason));
 }
@@ -284,7 +290,8 @@ private:
           if (!why)
             why = requires_mismatch(c, s.device);
           if (why)
-            rejection.reasons.push_back(fmt::format("{} ({}): {}", id, impl.implementation->id, *why));
+            rejection.reasons.push_back(
+                fmt::format("{} ({}): {}", id, impl.implementation->id, *why));
           else
             candidates_[i].push_back({id, &impl});
         }
@@ -360,10 +367,13 @@ private:
     const auto &s = working_.at(candidate.device);
     const auto &impl = *candidate.implementation->implementation;
     if (!c.collocation.empty())
-      if (auto it = group_node_.find(c.collocation); it != group_node_.end() && it->second != s.device.node)
-        return tl::unexpected(fmt::format("hostcollocation {} is on node {}", c.collocation, it->second));
-    Step step{{c.instance, candidate.device, s.device.node, &impl, demand_of(impl, c.timing), {}, {}},
-              task_of(c.instance, impl, c.timing)};
+      if (auto it = group_node_.find(c.collocation);
+          it != group_node_.end() && it->second != s.device.node)
+        return tl::unexpected(
+            fmt::format("hostcollocation {} is on node {}", c.collocation, it->second));
+    Step step{
+        {c.instance, candidate.device, s.device.node, &impl, demand_of(impl, c.timing), {}, {}},
+        task_of(c.instance, impl, c.timing)};
     if (auto why = capacity_shortfall(step.placement.demand, s))
       return tl::unexpected(*why);
     if (step.task) {
@@ -454,7 +464,8 @@ private:
     if (!any_fit && blocked_ == nullptr_index) {
       blocked_ = i;
       blocked_reasons_ = std::move(reasons);
-      blocked_reasons_.insert(blocked_reasons_.end(), first_reasons_[i].begin(), first_reasons_[i].end());
+      blocked_reasons_.insert(blocked_reasons_.end(), first_reasons_[i].begin(),
+                              first_reasons_[i].end());
     }
     return false;
   }
@@ -549,7 +560,7 @@ private:
   std::vector<std::vector<Candidate>> candidates_;
   std::vector<std::vector<std::string>> first_reasons_; // static reasons, per component
   std::vector<std::size_t> order_;
-  std::vector<Step> steps_; // by search position
+  std::vector<Step> steps_;                       // by search position
   std::map<std::string, std::string> node_of_;    // placed instance -> node
   std::map<std::string, std::string> group_node_; // hostcollocation -> node
   std::vector<UsedDevice> application_devices_;
@@ -570,8 +581,9 @@ void apply_plan(DomainState &state, const Plan &plan, double sign) {
       add(s->load.allocated, p.demand, sign);
       if (p.schedule) {
         const Task task{p.instance, p.schedule->period, p.schedule->budget, p.schedule->deadline,
-                        p.schedule->priority == 0 ? std::nullopt
-                                                  : std::optional<std::uint32_t>(p.schedule->priority)};
+                        p.schedule->priority == 0
+                            ? std::nullopt
+                            : std::optional<std::uint32_t>(p.schedule->priority)};
         if (s->load.cpu_tasks.size() <= p.schedule->cpu)
           s->load.cpu_tasks.resize(p.schedule->cpu + 1);
         auto &tasks = s->load.cpu_tasks[p.schedule->cpu];
@@ -634,7 +646,8 @@ std::optional<Task> task_of(const std::string &instance, const Implementation &i
   else if (demand && finite(demand->execution_time))
     c = nanos_of(*demand->execution_time);
   else if (demand && demand->utilization)
-    c = Nanos(static_cast<Nanos::rep>(std::llround(*demand->utilization * static_cast<double>(t.count()))));
+    c = Nanos(static_cast<Nanos::rep>(
+        std::llround(*demand->utilization * static_cast<double>(t.count()))));
   if (c.count() <= 0)
     return std::nullopt;
   const Nanos d = timing && finite(timing->deadline) ? nanos_of(*timing->deadline) : t;
@@ -659,9 +672,8 @@ std::map<std::string, double> demand_of(const Implementation &implementation,
   return demand;
 }
 
-tl::expected<Plan, std::vector<Rejection>> make_plan(const DomainState &state,
-                                                     const PlanRequest &request,
-                                                     const PlanOptions &options) {
+tl::expected<Plan, std::vector<Rejection>>
+make_plan(const DomainState &state, const PlanRequest &request, const PlanOptions &options) {
   return Search(state, request, options).run();
 }
 
@@ -681,14 +693,15 @@ PlanRequest plan_request_of(const profile::ResolvedApplication &application,
   for (const auto &placement : sad.placements) {
     const auto *pkg = application.softpkg_of(placement);
     for (const auto &ci : placement.instantiations) {
-      ComponentRequest c{ci.id, pkg, std::nullopt, placement.host_collocation, ci.device_requires,
-                         ci.timing};
+      ComponentRequest c{
+          ci.id, pkg, std::nullopt, placement.host_collocation, ci.device_requires, ci.timing};
       if (auto it = assignments.find(ci.id); it != assignments.end())
         c.device = it->second;
       double mbps = 0;
       if (pkg != nullptr)
         for (const auto &impl : pkg->implementations)
-          if (impl.implementation->resource_demand && impl.implementation->resource_demand->bandwidth_bps)
+          if (impl.implementation->resource_demand &&
+              impl.implementation->resource_demand->bandwidth_bps)
             mbps = std::max(mbps, *impl.implementation->resource_demand->bandwidth_bps / 1e6);
       bandwidth[ci.id] = mbps;
       request.components.push_back(std::move(c));

@@ -116,12 +116,12 @@ struct PlanOptions {
 std::map<std::string, double> demand_of(const profile::Implementation &implementation,
                                         const std::optional<profile::Timing> &timing = {});
 // The periodic task a component is, when its period and execution time are known.
-std::optional<Task> task_of(const std::string &instance, const profile::Implementation &implementation,
+std::optional<Task> task_of(const std::string &instance,
+                            const profile::Implementation &implementation,
                             const std::optional<profile::Timing> &timing);
 
-tl::expected<Plan, std::vector<Rejection>> make_plan(const DomainState &state,
-                                                     const PlanRequest &request,
-                                                     const PlanOptions &options = {});
+tl::expected<Plan, std::vector<Rejection>>
+make_plan(const DomainState &state, const PlanRequest &request, const PlanOptions &options = {});
 
 // Reserves (commit) or frees (release) what a plan allocates.
 void commit(DomainState &state, const Plan &plan);

@@ -45,6 +45,10 @@ bool process_exists(long pid) {
 class TestDomain {
 public:
   explicit TestDomain(int nodes = 2, int registration_timeout_ms = 3000)
+      : TestDomain(shipped_nodes(nodes), registration_timeout_ms) {}
+
+  // One node daemon per DCD.
+  explicit TestDomain(const std::vector<fs::path> &dcds, int registration_timeout_ms = 3000)
       : run_(fs::temp_directory_path() /
              fmt::format("rsca-it-{}-{}", getpid(), std::random_device{}())) {
     fs::create_directories(run_ / "logs");
@@ -56,14 +60,11 @@ public:
             "--repository", (run_ / "repository").string(), "--registration-timeout-ms",
             std::to_string(registration_timeout_ms)},
         env_);
-    for (int i = 1; i <= nodes; ++i)
+    for (const auto &dcd : dcds)
       nodes_.push_back(std::make_unique<ChildProcess>(
           (kBin / "rsca-noded").string(),
-          std::vector<std::string>{
-              "--dcd",
-              (kSource / fmt::format("profiles/dev/nodes/node{}/DeviceManager.dcd.xml", i))
-                  .string(),
-              "--log-dir", (run_ / "logs").string(), "--exec-path", kBin.string()},
+          std::vector<std::string>{"--dcd", dcd.string(), "--log-dir", (run_ / "logs").string(),
+                                   "--exec-path", kBin.string()},
           env_));
     auto pp = rsca::test::participant();
     auto endpoint = rsca::control::Endpoint::open(pp, fmt::format("rsca/cli/test-{}", getpid()));
@@ -72,8 +73,16 @@ public:
     client_ = std::move(*endpoint);
     REQUIRE(wait_for([&] {
       auto r = call("domain.nodes");
-      return r && r->at("nodes").size() == static_cast<std::size_t>(nodes);
+      return r && r->at("nodes").size() == dcds.size();
     }));
+  }
+
+  // The project's own nodes: profiles/dev/nodes/node1..N.
+  static std::vector<fs::path> shipped_nodes(int nodes) {
+    std::vector<fs::path> dcds;
+    for (int i = 1; i <= nodes; ++i)
+      dcds.push_back(kSource / fmt::format("profiles/dev/nodes/node{}/DeviceManager.dcd.xml", i));
+    return dcds;
   }
 
   ~TestDomain() {
@@ -123,20 +132,24 @@ public:
     CHECK(apps->at("applications").empty());
     auto devices = call("domain.devices");
     REQUIRE(devices.has_value());
-    for (const auto &d : devices->at("devices"))
+    for (const auto &d : devices->at("devices")) {
       for (const auto &[name, c] : d.at("capacity").items()) {
         INFO(d.at("id") << " " << name);
         CHECK(c.at("allocated").get<double>() == Approx(0.0).margin(1e-9));
       }
+      for (const auto &cpu : d.at("cpu_tasks")) {
+        INFO(d.at("id") << " cpu tasks " << cpu.dump());
+        CHECK(cpu.at("tasks").empty());
+      }
+    }
     for (long pid : pids) {
       INFO("component pid " << pid);
       CHECK(wait_for([&] { return !process_exists(pid); }));
     }
-    for (int i = 0; i < static_cast<int>(nodes_.size()); ++i) {
-      if (!nodes_[i])
-        continue;
-      auto status = client_->call_sync(fmt::format("rsca/node/node{}", i + 1), "node.status",
-                                       Json::object(), 5s);
+    auto nodes = call("domain.nodes");
+    REQUIRE(nodes.has_value());
+    for (const auto &node : nodes->at("nodes")) {
+      auto status = client_->call_sync(node.at("address"), "node.status", Json::object(), 5s);
       REQUIRE(status.has_value());
       CHECK(status->at("processes").empty());
     }
@@ -400,4 +413,49 @@ TEST_CASE("a component that crashes after launch is reported to the domain",
   }));
   REQUIRE(domain.call("app.release", Json{{"app", "Healthy"}}).has_value());
   domain.require_clean(pids_of(*app));
+}
+
+TEST_CASE("admission: launches fill the domain, the next is rejected with the reason, a release "
+          "makes room again",
+          "[integration][domain][allocator]") {
+  // Two nodes whose GPPs offer one CPU each; each Greedy takes 60% of one.
+  TestDomain domain({kTestSdr / "dev/nodes/small1/DeviceManager.dcd.xml",
+                     kTestSdr / "dev/nodes/small2/DeviceManager.dcd.xml"});
+  domain.install("Greedy");
+  std::vector<long> pids;
+  for (const char *name : {"g1", "g2"}) {
+    auto app = domain.call("app.create", Json{{"application", "Greedy"}, {"name", name}});
+    INFO((app ? std::string() : app.error().message));
+    REQUIRE(app.has_value());
+    for (long pid : pids_of(*app))
+      pids.push_back(pid);
+  }
+  // Spread over both nodes by necessity: each GPP holds one.
+  auto devices = domain.call("domain.devices");
+  REQUIRE(devices.has_value());
+  for (const auto &d : devices->at("devices"))
+    CHECK(d.at("capacity").at("cpu_capacity").at("allocated").get<double>() == Approx(60.0));
+
+  // The third is rejected before anything runs, and says why on each device.
+  auto [rc, out] = domain.cli({"launch", "Greedy", "--name", "g3"});
+  INFO(out);
+  CHECK(rc == 5);
+  CHECK_THAT(out,
+             Catch::Contains("small1:GPP_1 (cpp): cpu_capacity needs 60.0% CPU, 40.0% CPU free"));
+  CHECK_THAT(out,
+             Catch::Contains("small2:GPP_1 (cpp): cpu_capacity needs 60.0% CPU, 40.0% CPU free"));
+  auto plan = domain.call("app.plan", Json{{"application", "Greedy"}});
+  REQUIRE(plan.has_value());
+  CHECK(plan->at("admitted") == false);
+
+  // Nothing was reserved by the rejection: a release makes room for exactly one more.
+  REQUIRE(domain.call("app.release", Json{{"app", "g1"}}).has_value());
+  auto again = domain.call("app.create", Json{{"application", "Greedy"}, {"name", "g3"}});
+  INFO((again ? std::string() : again.error().message));
+  REQUIRE(again.has_value());
+  for (long pid : pids_of(*again))
+    pids.push_back(pid);
+  REQUIRE(domain.call("app.release", Json{{"app", "g2"}}).has_value());
+  REQUIRE(domain.call("app.release", Json{{"app", "g3"}}).has_value());
+  domain.require_clean(pids);
 }

@@ -54,13 +54,14 @@ void print_plan(const std::string &application, const Json &result) {
                p.value("implementation", ""), describe_demand(p.at("demand")));
     if (p.contains("schedule")) {
       const auto &s = p.at("schedule");
-      fmt::print("  {:<20}    cpu {} {}, priority {}, period {}, budget {}, worst response {}\n", "",
-                 s.value("cpu", 0), s.value("policy", ""), s.value("priority", 0),
+      fmt::print("  {:<20}    cpu {} {}, priority {}, period {}, budget {}, worst response {}\n",
+                 "", s.value("cpu", 0), s.value("policy", ""), s.value("priority", 0),
                  milliseconds(s.at("period_ns")), milliseconds(s.at("budget_ns")),
                  milliseconds(s.at("response_time_ns")));
     }
     for (const auto &u : p.at("uses_devices"))
-      fmt::print("  {:<20}    uses {} ({})\n", "", u.value("device", ""), u.value("usesdevice", ""));
+      fmt::print("  {:<20}    uses {} ({})\n", "", u.value("device", ""),
+                 u.value("usesdevice", ""));
   }
   for (const auto &u : plan.at("uses_devices"))
     fmt::print("  application uses {} ({})\n", u.value("device", ""), u.value("usesdevice", ""));
@@ -110,8 +111,8 @@ int plan_offline(const PlanArgs &args, const Json &assign, const GlobalOptions &
     assignments[k] = v.get<std::string>();
   const allocator::PlanOptions options{
       allocator::parse_strategy(args.strategy).value_or(allocator::Strategy::Pack)};
-  auto plan = allocator::make_plan(*domain, allocator::plan_request_of(*application, assignments),
-                                   options);
+  auto plan =
+      allocator::make_plan(*domain, allocator::plan_request_of(*application, assignments), options);
   Json result{{"strategy", to_string(options.strategy)}, {"admitted", plan.has_value()}};
   if (plan)
     result["plan"] = allocator::to_json(*plan);
