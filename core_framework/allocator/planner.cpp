@@ -247,6 +247,7 @@ Schedule schedule_of(const Task &task, unsigned cpu, const Schedulability &verdi
 
 struct Candidate {
   std::string device;
+  DeviceState *state = nullptr; // in the search's working copy, whose nodes never move
   const ResolvedImplementation *implementation = nullptr;
 };
 
@@ -265,6 +266,7 @@ public:
     if (auto unplaceable = find_candidates(); !unplaceable.empty())
       return tl::unexpected(std::move(unplaceable));
     order_components();
+    index_affinities();
     steps_.resize(order_.size());
     if (place(0))
       return finish();
@@ -281,7 +283,7 @@ private:
       const auto &c = request_.components[i];
       Rejection rejection{c.instance, {}};
       for (const auto &impl : c.softpkg->implementations)
-        for (const auto &[id, s] : state_) {
+        for (auto &[id, s] : working_) {
           if (s.device.kind != "gpp" || (c.device && *c.device != id))
             continue;
           auto why = implementation_mismatch(*impl.implementation, s.device);
@@ -293,7 +295,7 @@ private:
             rejection.reasons.push_back(
                 fmt::format("{} ({}): {}", id, impl.implementation->id, *why));
           else
-            candidates_[i].push_back({id, &impl});
+            candidates_[i].push_back({id, &s, &impl});
         }
       first_reasons_[i] = rejection.reasons;
       if (!candidates_[i].empty())
@@ -309,36 +311,49 @@ private:
 
   // Fewest candidates first; a collocation group's members next to each other.
   void order_components() {
-    std::vector<std::size_t> order(request_.components.size());
-    for (std::size_t i = 0; i < order.size(); ++i)
-      order[i] = i;
-    auto key = [&](std::size_t i) {
-      const auto &c = request_.components[i];
-      // A group sorts by its most constrained member, so that its members stay together.
-      std::size_t n = candidates_[i].size();
-      if (!c.collocation.empty())
-        for (std::size_t j = 0; j < order.size(); ++j)
-          if (request_.components[j].collocation == c.collocation)
-            n = std::min(n, candidates_[j].size());
-      return std::tuple(n, c.collocation, i);
-    };
-    std::stable_sort(order.begin(), order.end(), [&](auto a, auto b) { return key(a) < key(b); });
-    order_ = std::move(order);
+    // A group sorts by its most constrained member, so that its members stay together.
+    std::map<std::string, std::size_t> group_candidates;
+    for (std::size_t i = 0; i < request_.components.size(); ++i) {
+      const auto &group = request_.components[i].collocation;
+      if (group.empty())
+        continue;
+      auto [it, fresh] = group_candidates.emplace(group, candidates_[i].size());
+      if (!fresh)
+        it->second = std::min(it->second, candidates_[i].size());
+    }
+    std::vector<std::tuple<std::size_t, std::string, std::size_t>> keyed;
+    for (std::size_t i = 0; i < request_.components.size(); ++i) {
+      const auto &group = request_.components[i].collocation;
+      keyed.emplace_back(group.empty() ? candidates_[i].size() : group_candidates[group], group, i);
+    }
+    std::sort(keyed.begin(), keyed.end());
+    order_.clear();
+    for (const auto &[n, group, i] : keyed)
+      order_.push_back(i);
   }
 
-  double affinity_on(const std::string &instance, const std::string &node, bool heavy_only) const {
-    double sum = 0;
+  // Each component's partners (affinities both ways), so that ranking costs its degree only.
+  void index_affinities() {
     for (const auto &a : request_.affinities) {
-      if (heavy_only && a.weight < kHeavyAffinity)
-        continue;
-      const std::string *other = a.a == instance ? &a.b : (a.b == instance ? &a.a : nullptr);
-      if (other == nullptr)
-        continue;
-      auto it = node_of_.find(*other);
-      if (it != node_of_.end() && it->second == node)
-        sum += a.weight;
+      partners_[a.a].emplace_back(a.b, a.weight);
+      partners_[a.b].emplace_back(a.a, a.weight);
     }
-    return sum;
+  }
+
+  // The weight of `instance`'s placed partners per node they are on.
+  std::map<std::string, double> affinity_by_node(const std::string &instance,
+                                                 bool heavy_only) const {
+    std::map<std::string, double> out;
+    auto partners = partners_.find(instance);
+    if (partners == partners_.end())
+      return out;
+    for (const auto &[other, weight] : partners->second) {
+      if (heavy_only && weight < kHeavyAffinity)
+        continue;
+      if (auto it = node_of_.find(other); it != node_of_.end())
+        out[it->second] += weight;
+    }
+    return out;
   }
 
   // The candidates of component `i` in the order the strategy prefers them.
@@ -347,11 +362,12 @@ private:
     const bool pack = options_.strategy == Strategy::Pack;
     std::vector<std::tuple<double, double, std::size_t>> keyed;
     const auto &list = candidates_[i];
+    const auto affinity = affinity_by_node(c.instance, !pack);
     for (std::size_t k = 0; k < list.size(); ++k) {
-      const auto &s = working_.at(list[k].device);
-      const double affinity = affinity_on(c.instance, s.device.node, !pack);
+      const auto &s = *list[k].state;
+      auto a = affinity.empty() ? affinity.end() : affinity.find(s.device.node);
       const double load = load_of(s);
-      keyed.emplace_back(-affinity, pack ? -load : load, k);
+      keyed.emplace_back(a == affinity.end() ? 0.0 : -a->second, pack ? -load : load, k);
     }
     std::stable_sort(keyed.begin(), keyed.end());
     std::vector<Candidate> out;
@@ -364,7 +380,7 @@ private:
   // The step that places component `i` on the candidate, or why it does not fit now.
   tl::expected<Step, std::string> try_candidate(std::size_t i, const Candidate &candidate) const {
     const auto &c = request_.components[i];
-    const auto &s = working_.at(candidate.device);
+    const auto &s = *candidate.state;
     const auto &impl = *candidate.implementation->implementation;
     if (!c.collocation.empty())
       if (auto it = group_node_.find(c.collocation);
@@ -560,7 +576,8 @@ private:
   std::vector<std::vector<Candidate>> candidates_;
   std::vector<std::vector<std::string>> first_reasons_; // static reasons, per component
   std::vector<std::size_t> order_;
-  std::vector<Step> steps_;                       // by search position
+  std::vector<Step> steps_; // by search position
+  std::map<std::string, std::vector<std::pair<std::string, double>>> partners_;
   std::map<std::string, std::string> node_of_;    // placed instance -> node
   std::map<std::string, std::string> group_node_; // hostcollocation -> node
   std::vector<UsedDevice> application_devices_;
