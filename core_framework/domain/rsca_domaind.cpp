@@ -24,6 +24,11 @@ int main(int argc, char **argv) {
                  "How long a launch waits for its components to register")
       ->capture_default_str();
   app.add_option("--log-level", level, "trace, debug, info, warn, error")->capture_default_str();
+  std::string strategy = "pack";
+  app.add_option("--strategy", strategy,
+                 "Placement: pack (fewest devices) or spread (balance load)")
+      ->check(CLI::IsMember({"pack", "spread"}))
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   spdlog::set_level(spdlog::level::from_str(level));
   spdlog::set_pattern("%Y-%m-%dT%H:%M:%S.%e %^%l%$ domaind: %v");
@@ -31,6 +36,7 @@ int main(int argc, char **argv) {
   rsca::domain::DomainOptions options;
   options.repository = repository;
   options.registration_timeout = std::chrono::milliseconds(registration_ms);
+  options.strategy = *rsca::allocator::parse_strategy(strategy);
   if (!dmd.empty()) {
     rsca::profile::ProfileLoader loader;
     auto domain = loader.load_domain(dmd);
