@@ -254,8 +254,10 @@ struct Candidate {
 // One way to place a component, with what it changes in the state.
 struct Step {
   Placement placement;
-  std::optional<Task> task;
+  std::size_t task_index = 0; // where its task stands in its CPU's task set
 };
+
+using Reservations = std::map<std::string, std::map<std::string, double>>; // device -> demand
 
 class Search {
 public:
@@ -387,35 +389,51 @@ private:
           it != group_node_.end() && it->second != s.device.node)
         return tl::unexpected(
             fmt::format("hostcollocation {} is on node {}", c.collocation, it->second));
-    Step step{
-        {c.instance, candidate.device, s.device.node, &impl, demand_of(impl, c.timing), {}, {}},
-        task_of(c.instance, impl, c.timing)};
+    Step step{{c.instance,
+               candidate.device,
+               s.device.node,
+               &impl,
+               demand_of(impl, c.timing),
+               task_of(c.instance, impl, c.timing),
+               std::nullopt,
+               {}}};
     if (auto why = capacity_shortfall(step.placement.demand, s))
       return tl::unexpected(*why);
-    if (step.task) {
-      auto admitted = admit(*step.task, s, options_.strategy);
+    if (const auto &task = step.placement.task) {
+      auto admitted = admit(*task, s, options_.strategy);
       if (!admitted)
         return tl::unexpected(admitted.error());
       step.placement.schedule =
-          schedule_of(*step.task, admitted->first, admitted->second, s.device.policy);
+          schedule_of(*task, admitted->first, admitted->second, s.device.policy);
     }
+    // What this step reserves so far: its own usesdevice entries must not count a device twice.
+    Reservations pending{{candidate.device, step.placement.demand}};
     for (const auto &uses : impl.uses_devices) {
-      auto used = find_used_device(uses, s.device.node);
+      auto used = find_used_device(uses, s.device.node, pending);
       if (!used)
         return tl::unexpected(used.error());
+      add(pending[used->device], used->demand, +1);
       step.placement.used_devices.push_back(std::move(*used));
     }
     return step;
   }
 
   // A device on `node` (any node when empty) that satisfies `uses`, with its demand.
+  // `pending`: reserved by the caller but not yet applied to the working state.
   tl::expected<UsedDevice, std::string> find_used_device(const profile::UsesDevice &uses,
-                                                         const std::string &node) const {
+                                                         const std::string &node,
+                                                         const Reservations &pending) const {
     std::string first_reason;
     for (const auto &[id, s] : working_) {
       if (!node.empty() && s.device.node != node)
         continue;
-      auto why = uses_mismatch(uses, s);
+      auto reserved = pending.find(id);
+      std::optional<DeviceState> with_pending;
+      if (reserved != pending.end()) {
+        with_pending = s;
+        add(with_pending->load.allocated, reserved->second, +1);
+      }
+      auto why = uses_mismatch(uses, with_pending ? *with_pending : s);
       if (!why)
         return UsedDevice{uses.id, id, uses_demand(uses, s.device)};
       if (first_reason.empty())
@@ -426,20 +444,22 @@ private:
                                       first_reason.empty() ? "" : " (" + first_reason + ")"));
   }
 
-  void apply(const Step &step, double sign) {
+  void apply(Step &step, double sign) {
     auto &s = working_.at(step.placement.device);
     add(s.load.allocated, step.placement.demand, sign);
     for (const auto &used : step.placement.used_devices)
       add(working_.at(used.device).load.allocated, used.demand, sign);
-    if (step.task && step.placement.schedule) {
+    if (step.placement.task && step.placement.schedule) {
       const unsigned cpu = step.placement.schedule->cpu;
       if (s.load.cpu_tasks.size() <= cpu)
         s.load.cpu_tasks.resize(cpu + 1);
       auto &tasks = s.load.cpu_tasks[cpu];
-      if (sign > 0)
-        tasks.push_back(*step.task);
-      else
+      if (sign > 0) {
+        step.task_index = tasks.size();
+        tasks.push_back(*step.placement.task);
+      } else {
         tasks.pop_back(); // steps are undone in reverse order
+      }
     }
   }
 
@@ -488,23 +508,42 @@ private:
 
   // Every component is placed: the SAD's own usesdevice and the latency bounds decide.
   bool complete() {
-    application_devices_.clear();
+    Reservations pending;
+    std::vector<UsedDevice> used_devices;
     for (const auto &uses : request_.uses_devices) {
-      auto used = find_used_device(uses, "");
+      auto used = find_used_device(uses, "", pending);
       if (!used) {
         leaf_failure_ = used.error();
         return false;
       }
-      add(working_.at(used->device).load.allocated, used->demand, +1);
-      application_devices_.push_back(std::move(*used));
+      add(pending[used->device], used->demand, +1);
+      used_devices.push_back(std::move(*used));
     }
+    refresh_schedules();
     if (auto why = latency_violation()) {
-      for (const auto &used : application_devices_)
-        add(working_.at(used.device).load.allocated, used.demand, -1);
       leaf_failure_ = *why;
       return false;
     }
+    application_devices_ = std::move(used_devices);
     return true;
+  }
+
+  // A task placed later can change the priority (deadline monotonic) and the response time of
+  // the tasks already on its CPU: every schedule of this plan is read off its CPU's final set.
+  void refresh_schedules() {
+    std::map<std::pair<const DeviceState *, unsigned>, Schedulability> verdicts;
+    for (auto &step : steps_) {
+      auto &schedule = step.placement.schedule;
+      if (!schedule)
+        continue;
+      const auto &s = working_.at(step.placement.device);
+      auto [it, fresh] = verdicts.try_emplace({&s, schedule->cpu});
+      if (fresh)
+        it->second = analyse(s.load.cpu_tasks[schedule->cpu], s.device.policy);
+      const auto &verdict = it->second.tasks[step.task_index];
+      schedule->priority = verdict.priority;
+      schedule->response_time = verdict.response_time;
+    }
   }
 
   // A latency path whose worst case exceeds its bound: the first component's response time,
@@ -596,19 +635,17 @@ void apply_plan(DomainState &state, const Plan &plan, double sign) {
   for (const auto &p : plan.placements) {
     if (auto *s = device(p.device)) {
       add(s->load.allocated, p.demand, sign);
-      if (p.schedule) {
-        const Task task{p.instance, p.schedule->period, p.schedule->budget, p.schedule->deadline,
-                        p.schedule->priority == 0
-                            ? std::nullopt
-                            : std::optional<std::uint32_t>(p.schedule->priority)};
+      if (p.task && p.schedule) {
         if (s->load.cpu_tasks.size() <= p.schedule->cpu)
           s->load.cpu_tasks.resize(p.schedule->cpu + 1);
         auto &tasks = s->load.cpu_tasks[p.schedule->cpu];
         if (sign > 0) {
-          tasks.push_back(task);
+          tasks.push_back(*p.task);
         } else {
+          // Equal tasks are interchangeable for the analysis: remove any one of them.
           auto it = std::find_if(tasks.begin(), tasks.end(), [&](const Task &t) {
-            return t.id == task.id && t.period == task.period && t.execution == task.execution;
+            return t.id == p.task->id && t.period == p.task->period &&
+                   t.execution == p.task->execution && t.deadline == p.task->deadline;
           });
           if (it != tasks.end())
             tasks.erase(it);

@@ -90,7 +90,8 @@ struct Placement {
   std::string node;
   const profile::Implementation *implementation = nullptr;
   std::map<std::string, double> demand; // reserved on the device
-  std::optional<Schedule> schedule;     // periodic components only
+  std::optional<Task> task;             // periodic components: the task as the profiles give it
+  std::optional<Schedule> schedule;     // and what admission decided for it
   std::vector<UsedDevice> used_devices;
 };
 
