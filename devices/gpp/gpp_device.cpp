@@ -36,7 +36,9 @@ GppDevice::GppDevice(node::DeviceContext context)
   properties_ = {
       {"os_name", override_of(context_, "os_name").value_or(host.os_name)},
       {"processor_name", override_of(context_, "processor_name").value_or(host.processor_name)},
-      {"hostname", host.hostname}};
+      {"hostname", host.hostname},
+      {"scheduling_policy",
+       override_of(context_, "scheduling_policy").value_or(Json("fixed-priority"))}};
   capacity_ = {{"cpu_capacity",
                 override_of(context_, "cpu_capacity").value_or(Json(host.cpu_cores * 100.0))},
                {"mem_capacity", override_of(context_, "mem_capacity")

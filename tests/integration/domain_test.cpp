@@ -244,6 +244,23 @@ TEST_CASE("ProducerConsumer: install, launch, data flows, configure, query, stop
   for (long pid : pids)
     CHECK(process_exists(pid));
 
+  // Producer_1 is periodic (20 ms): admission gave it a CPU and a priority, and its process runs
+  // on that CPU only.
+  for (const auto &c : app->at("components")) {
+    if (c.at("id") != "Producer_1")
+      continue;
+    REQUIRE(c.contains("schedule"));
+    const auto &schedule = c.at("schedule");
+    CHECK(schedule.at("period_ns") == 20000000);
+    CHECK(schedule.at("priority") == 10); // as the SAD gives it
+    std::ifstream status(fmt::format("/proc/{}/status", c.at("pid").get<long>()));
+    std::string line, allowed;
+    while (std::getline(status, line))
+      if (line.rfind("Cpus_allowed_list:", 0) == 0)
+        allowed = line.substr(line.find_first_not_of(" \t", 18));
+    CHECK(allowed == std::to_string(schedule.at("cpu").get<int>()));
+  }
+
   // Data flows across the connection: the consumer's count grows.
   CHECK(TestDomain::wait_for([&] { return received(domain, "ProducerConsumer") > 20; }));
 

@@ -247,6 +247,47 @@ TEST_CASE("exec parameters come in pairs and name the component", "[component]")
   CHECK(parse_exec_params(5, argv).error() == "the exec parameter CONTROL_ADDRESS is missing");
 }
 
+TEST_CASE("the schedule admission decided arrives as exec parameters", "[component]") {
+  const char *argv[] = {"rsca-producer",
+                        "COMPONENT_IDENTIFIER",
+                        "P_1",
+                        "PROFILE_NAME",
+                        "/sdr/P.spd.xml",
+                        "CONTROL_ADDRESS",
+                        "rsca/c/P_1",
+                        "RSCA_CPU",
+                        "1",
+                        "RSCA_PRIORITY",
+                        "7",
+                        "RSCA_PERIOD_NS",
+                        "20000000",
+                        "RSCA_BUDGET_NS",
+                        "1000000",
+                        "RSCA_DEADLINE_NS",
+                        "15000000",
+                        "rate_hz",
+                        "20"};
+  auto params = parse_exec_params(19, argv);
+  REQUIRE(params.has_value());
+  REQUIRE(params->schedule.has_value());
+  CHECK(params->schedule->cpu == 1);
+  CHECK(params->schedule->priority == 7);
+  CHECK(params->schedule->period == std::chrono::milliseconds(20));
+  CHECK(params->schedule->budget == std::chrono::milliseconds(1));
+  CHECK(params->schedule->deadline == std::chrono::milliseconds(15));
+  // The schedule's parameters are not properties.
+  CHECK(params->others == std::vector<std::pair<std::string, std::string>>{{"rate_hz", "20"}});
+
+  const char *bad[] = {"c",    "COMPONENT_IDENTIFIER", "P_1", "PROFILE_NAME",
+                       "/p",   "CONTROL_ADDRESS",      "a",   "RSCA_CPU",
+                       "first"};
+  CHECK(parse_exec_params(9, bad).error() ==
+        "the exec parameter RSCA_CPU is not a number: \"first\"");
+  const char *none[] = {"c",  "COMPONENT_IDENTIFIER", "P_1", "PROFILE_NAME",
+                        "/p", "CONTROL_ADDRESS",      "a"};
+  CHECK_FALSE(parse_exec_params(7, none)->schedule.has_value());
+}
+
 TEST_CASE("repids map to the port types of ports.idl", "[component]") {
   CHECK(port::port_type_for_repid("IDL:rsca/SampleSeq:1.0") == port::PortType::Samples);
   CHECK(port::port_type_for_repid("IDL:BULKIO/dataFloat:1.0") == port::PortType::Samples);
