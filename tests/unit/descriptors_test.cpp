@@ -431,7 +431,7 @@ TEST_CASE("PRF: Consumer counters and GPP allocation properties", "[descriptors]
   CHECK(definition<SimpleProperty>(consumer, "log_every").type.type == SimpleType::ULong);
 
   const auto gpp = read<Properties>(kGpp / "GPP.prf.xml");
-  REQUIRE(gpp.properties.size() == 7);
+  REQUIRE(gpp.properties.size() == 8);
   const auto &os = definition<SimpleProperty>(gpp, "DCE:4a23ad60-0b25-4121-a630-68803a498f75");
   CHECK(os.name == "os_name");
   CHECK(os.label() == "os_name");
@@ -451,6 +451,9 @@ TEST_CASE("PRF: Consumer counters and GPP allocation properties", "[descriptors]
   CHECK(cores.type.type == SimpleType::UShort);
   CHECK(cores.kinds == std::vector<PropertyKind>{PropertyKind::Property});
   CHECK_FALSE(cores.action.has_value());
+  const auto &policy = definition<SimpleProperty>(gpp, "scheduling_policy");
+  CHECK(as<std::string>(policy.value) == "fixed-priority");
+  CHECK(policy.enumerations.size() == 2);
 }
 
 TEST_CASE("DCD: node1 and node2", "[descriptors][dcd]") {
