@@ -51,7 +51,7 @@ TEST_CASE("a device from a node's announcement keeps the PRF's ids and actions",
   CHECK(device.property_value("hostname") == "robot");
   CHECK(device.capacity.at("cpu_capacity") == 200.0);
   CHECK(device.find_property("cpu_capacity") == nullptr); // a capacity, not a matching property
-  CHECK(device.cpus == 2);                                 // 200% of a core
+  CHECK(device.cpus == 2);                                // 200% of a core
   CHECK(device.policy == allocator::SchedulingPolicy::Edf);
   CHECK(device.deployer_requires == std::map<std::string, std::string>{{"site", "front"}});
 }
