@@ -1,6 +1,6 @@
 // rsca-consumer: counts the sample sequences arriving on samples_in since start (received),
 // measures the latency of each from its timestamp (last_latency_us) and logs one line every
-// log_every sequences.
+// log_every sequences; counts the events arriving on events_in (events_received).
 #include <atomic>
 
 #include "component/runtime.hpp"
@@ -18,6 +18,9 @@ public:
     property("received", received_);
     property("last_latency_us", last_latency_us_);
     property("log_every", log_every_);
+    property("events_received", events_received_);
+    provides_port<rsca::port::PropertyEvent>(
+        "events_in", [this](const rsca::port::PropertyEvent &) { ++events_received_; });
     provides_port<rsca::port::Samples>(
         "samples_in", [this](const rsca::port::Samples &samples) { on_samples(samples); });
   }
@@ -25,6 +28,7 @@ public:
 private:
   Result start() override {
     received_ = 0;
+    events_received_ = 0;
     return {};
   }
 
@@ -42,6 +46,7 @@ private:
   std::atomic<std::uint64_t> received_{0};
   std::atomic<double> last_latency_us_{0.0};
   std::atomic<std::uint32_t> log_every_{0};
+  std::atomic<std::uint64_t> events_received_{0};
 };
 
 } // namespace

@@ -1,7 +1,10 @@
 // rsca-producer: publishes sample sequences on samples_out at rate_hz, each of payload_size
-// samples of a 10 Hz sine at the stream's sample_rate, stamped with the time of publication.
+// samples of a 10 Hz sine at the stream's sample_rate, stamped with the time of publication; and
+// with each one an event "tick" {"sequence": n} on events_out (for event channels).
 #include <cmath>
 #include <numbers>
+
+#include <fmt/format.h>
 
 #include "component/runtime.hpp"
 
@@ -20,7 +23,8 @@ struct Stream {
 class Producer final : public Component {
 public:
   explicit Producer(const Context &context)
-      : Component(context), out_(uses_port<rsca::port::Samples>("samples_out")) {
+      : Component(context), out_(uses_port<rsca::port::Samples>("samples_out")),
+        events_(uses_port<rsca::port::PropertyEvent>("events_out")) {
     property("rate_hz", rate_hz_);
     property("payload_size", payload_size_);
     property("message", message_);
@@ -41,6 +45,10 @@ private:
     fill();
     if (auto written = out_.write(samples_); !written && failures_++ % 100 == 0)
       log().warn("{} (failures so far: {})", written.error(), failures_);
+    tick_.timestamp_ns = samples_.timestamp_ns;
+    tick_.value = fmt::format(R"({{"sequence": {}}})", samples_.sequence);
+    if (auto written = events_.write(tick_); !written && failures_++ % 100 == 0)
+      log().warn("{} (failures so far: {})", written.error(), failures_);
     ++samples_.sequence;
     return std::chrono::duration_cast<Clock::duration>(
         std::chrono::duration<double>(1.0 / rate_hz_));
@@ -60,6 +68,8 @@ private:
   }
 
   rsca::component::UsesPort<rsca::port::Samples> &out_;
+  rsca::component::UsesPort<rsca::port::PropertyEvent> &events_;
+  rsca::port::PropertyEvent tick_{0, context().name, "tick", ""};
   double rate_hz_ = 100.0;
   std::uint32_t payload_size_ = 64;
   std::string message_;

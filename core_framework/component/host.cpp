@@ -356,13 +356,27 @@ CallResult<Json> Host::op_connect(const Json &body) {
   auto qos = dds::qos_from_json(body.contains("qos") ? body.at("qos") : Json::object());
   if (!qos)
     return control::call_error(Status::BadRequest, first_message(qos.error()));
+  const std::string filter_text = body.value("filter", "");
+  std::optional<ContentFilter> filter;
+  if (!filter_text.empty()) {
+    if (port->direction() != profile::PortDirection::Provides)
+      return control::call_error(Status::BadRequest,
+                                 "only a provides port filters what it receives");
+    auto parsed = ContentFilter::parse(filter_text);
+    if (!parsed)
+      return control::call_error(Status::BadRequest,
+                                 fmt::format("filter \"{}\": {}", filter_text, parsed.error()));
+    filter = std::move(*parsed);
+  }
   std::lock_guard lock(lifecycle_);
   if (c().state() == State::Released)
     return control::call_error(Status::Unavailable, "the component is released");
-  if (auto ok = port->connect(participant_->get(), loop_.get(), *connection, *topic, qos->get());
+  if (auto ok = port->connect(participant_->get(), loop_.get(), *connection, *topic, qos->get(),
+                              std::move(filter));
       !ok)
     return control::call_error(Status::Failed, first_message(ok.error()));
-  log().info("port {}: connection {} on topic \"{}\"", *port_name, *connection, *topic);
+  log().info("port {}: connection {} on topic \"{}\"{}", *port_name, *connection, *topic,
+             filter_text.empty() ? "" : fmt::format(" with filter \"{}\"", filter_text));
   return Json::object();
 }
 
@@ -440,7 +454,8 @@ CallResult<Json> Host::op_status(const Json &) {
       connections.push_back({{"connection", s.connection},
                              {"topic", s.topic},
                              {"matched", s.matched},
-                             {"samples", s.samples}});
+                             {"samples", s.samples},
+                             {"filtered", s.filtered}});
     ports.push_back({{"name", port->name()},
                      {"direction", direction_name(port->direction())},
                      {"connections", std::move(connections)}});

@@ -6,6 +6,8 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <nlohmann/json.hpp>
+
 #include "component/port_wire.hpp"
 #include "component/receive_loop.hpp"
 
@@ -22,6 +24,8 @@ struct DataConnection {
   dds::Entity read_condition; // provides only: attached to the receive loop
   ReceiveLoop *loop = nullptr;
   std::atomic<std::uint64_t> samples{0};
+  std::optional<ContentFilter> filter; // provides only: what is delivered
+  std::atomic<std::uint64_t> filtered{0};
 
   ~DataConnection() {
     if (loop != nullptr && read_condition)
@@ -36,6 +40,77 @@ namespace {
 using detail::DataConnection;
 
 constexpr std::uint32_t kTakeBatch = 32;
+
+// ---- the fields a content filter sees, per port type ------------------------------------------
+
+std::optional<FilterValue> json_field(const nlohmann::json &value) {
+  if (value.is_number())
+    return value.get<double>();
+  if (value.is_string())
+    return value.get<std::string>();
+  if (value.is_boolean())
+    return value.get<bool>();
+  return std::nullopt;
+}
+
+// A member path ("a.b") inside a JSON value.
+std::optional<FilterValue> json_path(const nlohmann::json &value, std::string_view path) {
+  const nlohmann::json *at = &value;
+  while (!path.empty()) {
+    const auto dot = path.find('.');
+    const std::string name(path.substr(0, dot));
+    if (!at->is_object() || !at->contains(name))
+      return std::nullopt;
+    at = &at->at(name);
+    path = dot == std::string_view::npos ? std::string_view() : path.substr(dot + 1);
+  }
+  return json_field(*at);
+}
+
+// id, source, timestamp_ns, value (and value.member); any other name is the event's value when
+// the event bears that id ("range < 10" on an event {id: range, value: 5}), else a member of it.
+std::optional<FilterValue> field_of(const port::PropertyEvent &e, std::string_view field) {
+  if (field == "id")
+    return e.id;
+  if (field == "source")
+    return e.source;
+  if (field == "timestamp_ns")
+    return static_cast<double>(e.timestamp_ns);
+  const auto value = nlohmann::json::parse(e.value, nullptr, false);
+  if (value.is_discarded())
+    return std::nullopt;
+  if (field == "value" || field == e.id)
+    return json_field(value);
+  if (field.starts_with("value."))
+    return json_path(value, field.substr(6));
+  return json_path(value, field);
+}
+
+std::optional<FilterValue> field_of(const port::Command &c, std::string_view field) {
+  if (field == "name")
+    return c.name;
+  if (field == "source")
+    return c.source;
+  if (field == "text")
+    return c.text;
+  if (field == "timestamp_ns")
+    return static_cast<double>(c.timestamp_ns);
+  return std::nullopt;
+}
+
+std::optional<FilterValue> field_of(const port::Samples &s, std::string_view field) {
+  if (field == "stream_id")
+    return s.stream_id;
+  if (field == "sample_rate")
+    return s.sample_rate;
+  if (field == "complex")
+    return s.complex;
+  if (field == "end_of_stream")
+    return s.end_of_stream;
+  if (field == "timestamp_ns")
+    return static_cast<double>(s.timestamp_ns);
+  return std::nullopt;
+}
 
 Expected<std::unique_ptr<DataConnection>>
 open_writer(dds_entity_t participant, std::unique_ptr<DataConnection> c, const dds_qos_t *qos) {
@@ -98,9 +173,10 @@ std::size_t PortBase::connection_count() const {
 
 Expected<void> PortBase::connect(dds_entity_t participant, detail::ReceiveLoop *loop,
                                  const std::string &connection, const std::string &topic,
-                                 const dds_qos_t *qos) {
+                                 const dds_qos_t *qos, std::optional<ContentFilter> filter) {
   auto c = std::make_unique<DataConnection>();
   c->topic_name = topic;
+  c->filter = std::move(filter);
   auto created = dds::checked(
       dds_create_topic(participant, port::wire::descriptor(type_), topic.c_str(), nullptr, nullptr),
       fmt::format("creating topic \"{}\"", topic));
@@ -132,8 +208,8 @@ std::vector<ConnectionStatus> PortBase::status() const {
   std::vector<ConnectionStatus> out;
   out.reserve(connections_.size());
   for (const auto &[id, c] : connections_)
-    out.push_back(
-        {id, c->topic_name, matched_count(c->entity.get(), direction_), c->samples.load()});
+    out.push_back({id, c->topic_name, matched_count(c->entity.get(), direction_), c->samples.load(),
+                   c->filtered.load()});
   return out;
 }
 
@@ -187,6 +263,11 @@ void ProvidesPort<T>::take_all(bool deliver) {
         if (!deliver || !callback_)
           continue;
         port::wire::from_wire(*static_cast<const Wire *>(samples[i]), scratch_);
+        if (c->filter &&
+            !c->filter->matches([this](std::string_view f) { return field_of(scratch_, f); })) {
+          c->filtered.fetch_add(1, std::memory_order_relaxed);
+          continue;
+        }
         try {
           callback_(scratch_);
         } catch (const std::exception &e) {

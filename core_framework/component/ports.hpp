@@ -15,6 +15,7 @@
 
 #include <tl/expected.hpp>
 
+#include "common/content_filter.hpp"
 #include "common/diagnostic.hpp"
 #include "component/port_types.hpp"
 #include "dds/entity.hpp"
@@ -30,8 +31,9 @@ class ReceiveLoop;
 struct ConnectionStatus {
   std::string connection;
   std::string topic;
-  std::int32_t matched = 0;  // readers (uses) or writers (provides) matched on the topic
-  std::uint64_t samples = 0; // written (uses) or received (provides)
+  std::int32_t matched = 0;   // readers (uses) or writers (provides) matched on the topic
+  std::uint64_t samples = 0;  // written (uses) or received (provides)
+  std::uint64_t filtered = 0; // provides: received but not delivered (the content filter)
 };
 
 // How many connections a write reached, or why one failed (the others were still written).
@@ -53,7 +55,7 @@ public:
   // is attached to `loop`, which must outlive the connection.
   Expected<void> connect(dds_entity_t participant, detail::ReceiveLoop *loop,
                          const std::string &connection, const std::string &topic,
-                         const dds_qos_t *qos);
+                         const dds_qos_t *qos, std::optional<ContentFilter> filter = std::nullopt);
   bool disconnect(const std::string &connection);
   void disconnect_all();
   std::vector<ConnectionStatus> status() const;

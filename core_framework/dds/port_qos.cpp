@@ -46,6 +46,17 @@ ConnectionQos with_defaults(ConnectionQos qos) {
   return qos;
 }
 
+// Durations ordered with infinite as the longest.
+bool longer(const Duration &a, const Duration &b) {
+  if (a.infinite())
+    return !b.infinite();
+  return !b.infinite() && *a.value > *b.value;
+}
+
+std::string duration_text(const Duration &d) {
+  return d.infinite() ? std::string(kInfinite) : format_duration(d);
+}
+
 Json duration_json(const Duration &duration) {
   if (duration.infinite())
     return kInfinite;
@@ -235,6 +246,35 @@ Expected<profile::ConnectionQos> connection_qos_from_json(const nlohmann::json &
 
 Expected<Qos> qos_from_json(const nlohmann::json &json) {
   return parse(json).map(make_dds_qos);
+}
+
+std::optional<std::string> qos_incompatibility(const ConnectionQos &offered_qos,
+                                               const ConnectionQos &requested_qos) {
+  const ConnectionQos o = with_defaults(offered_qos), r = with_defaults(requested_qos);
+  auto mismatch = [](const char *policy, auto offered, auto requested) {
+    return fmt::format("{}: the writer offers {}, the reader requests {}", policy, offered,
+                       requested);
+  };
+  if (*o.reliability < *r.reliability)
+    return mismatch("reliability", profile::to_string(*o.reliability),
+                    profile::to_string(*r.reliability));
+  if (*o.durability < *r.durability)
+    return mismatch("durability", profile::to_string(*o.durability),
+                    profile::to_string(*r.durability));
+  if (longer(*o.deadline, *r.deadline))
+    return mismatch("deadline", duration_text(*o.deadline), duration_text(*r.deadline));
+  if (longer(*o.latency_budget, *r.latency_budget))
+    return mismatch("latency budget", duration_text(*o.latency_budget),
+                    duration_text(*r.latency_budget));
+  if (*o.liveliness < *r.liveliness)
+    return mismatch("liveliness", profile::to_string(*o.liveliness),
+                    profile::to_string(*r.liveliness));
+  if (longer(*o.lease, *r.lease))
+    return mismatch("liveliness lease", duration_text(*o.lease), duration_text(*r.lease));
+  if (*o.ownership != *r.ownership)
+    return mismatch("ownership", profile::to_string(*o.ownership),
+                    profile::to_string(*r.ownership));
+  return std::nullopt;
 }
 
 } // namespace rsca::dds

@@ -10,6 +10,9 @@
 // only.
 #pragma once
 
+#include <optional>
+#include <string>
+
 #include <nlohmann/json.hpp>
 
 #include "common/diagnostic.hpp"
@@ -25,6 +28,12 @@ nlohmann::json qos_to_json(const profile::ConnectionQos &qos);
 
 // The connection QoS `json` describes, every field set (absent keys take the defaults).
 Expected<profile::ConnectionQos> connection_qos_from_json(const nlohmann::json &json);
+
+// Why a writer with QoS `offered` and a reader with QoS `requested` would never match under
+// DDS's requested/offered rules (reliability, durability, deadline, latency budget, liveliness,
+// ownership), or nothing when they match. Absent fields take the defaults.
+std::optional<std::string> qos_incompatibility(const profile::ConnectionQos &offered,
+                                               const profile::ConnectionQos &requested);
 
 // A QoS for a port's writer or reader. Absent keys take the defaults; unknown keys, values of the
 // wrong type and values out of range are errors naming the key.

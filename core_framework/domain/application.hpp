@@ -42,6 +42,7 @@ struct ConnectionInstance {
   std::string repid;
   std::string topic;
   nlohmann::json qos;
+  std::string filter; // a channel subscriber's content filter
 };
 
 struct Application {

@@ -116,16 +116,51 @@ public:
 
 private:
   // Wiring problems found while loading (unknown ports, mismatched port types) stop a launch.
+  // Wiring problems found while loading (unknown ports, mismatched port types) and event-channel
+  // members that could never match the channel's others stop a launch before anything runs.
   CallResult<void> check() {
-    if (request_.profile->warnings.empty()) {
-      detail_ = fmt::format("{} components, {} connections", count_instances(),
-                            request_.profile->sad->connections.size());
-      return {};
+    if (!request_.profile->warnings.empty()) {
+      std::vector<std::string> problems;
+      for (const auto &w : request_.profile->warnings)
+        problems.push_back(to_string(w));
+      return control::call_error(Status::BadRequest, fmt::format("{}", fmt::join(problems, "\n")));
     }
-    std::vector<std::string> problems;
-    for (const auto &w : request_.profile->warnings)
-      problems.push_back(to_string(w));
-    return control::call_error(Status::BadRequest, fmt::format("{}", fmt::join(problems, "\n")));
+    if (auto joined = s_.channels->join(channel_members()); !joined)
+      return joined;
+    joined_channels_ = true;
+    detail_ = fmt::format("{} components, {} connections", count_instances(),
+                          request_.profile->sad->connections.size());
+    return {};
+  }
+
+  // This application's publishers and subscribers of event channels, by channel name.
+  std::vector<std::pair<std::string, ChannelMember>> channel_members() const {
+    std::vector<std::pair<std::string, ChannelMember>> members;
+    const auto &sad = *request_.profile->sad;
+    for (std::size_t i = 0; i < sad.connections.size(); ++i) {
+      const auto &c = sad.connections[i];
+      if (!c.publishes_to_channel() && !c.subscribes_to_channel())
+        continue;
+      const bool publishes = c.publishes_to_channel();
+      ChannelMember m{publishes ? ChannelMember::Role::Publisher : ChannelMember::Role::Subscriber,
+                      app_->name,
+                      connection_id(c, i),
+                      publishes ? c.uses.target.refid : c.provides.target.refid,
+                      publishes ? c.uses.port : c.provides.port,
+                      repid_of(c),
+                      c.qos.value_or(profile::ConnectionQos{}),
+                      c.filter.value_or("")};
+      members.emplace_back(channel_name(c), std::move(m));
+    }
+    return members;
+  }
+
+  static std::string connection_id(const profile::Connection &c, std::size_t index) {
+    return c.id.empty() ? fmt::format("connection_{}", index + 1) : c.id;
+  }
+
+  static const std::string &channel_name(const profile::Connection &c) {
+    return c.publishes_to_channel() ? c.provides.target.findby.name : c.uses.target.findby.name;
   }
 
   CallResult<void> allocate() {
@@ -223,13 +258,14 @@ private:
     std::vector<Call> provides_side, uses_side;
     for (std::size_t i = 0; i < sad.connections.size(); ++i) {
       const auto &c = sad.connections[i];
-      const std::string id = c.id.empty() ? fmt::format("connection_{}", i + 1) : c.id;
+      const std::string id = connection_id(c, i);
       ConnectionInstance ci;
       ci.id = id;
       ci.qos = dds::qos_to_json(c.qos.value_or(profile::ConnectionQos{}));
       ci.topic = c.publishes_to_channel() || c.subscribes_to_channel()
-                     ? channel_topic(c)
+                     ? s_.channels->topic_of(channel_name(c))
                      : topic_name(s_.domain_name, fmt::format("{}_{}", app_->name, launch_), id);
+      ci.filter = c.filter.value_or("");
       ci.repid = repid_of(c);
       if (c.uses.target.kind == profile::EndpointTarget::Kind::ComponentInstantiation) {
         ci.uses = {c.uses.target.refid, c.uses.port};
@@ -276,13 +312,9 @@ private:
                  {"direction", direction},
                  {"topic", ci.topic},
                  {"repid", ci.repid},
-                 {"qos", ci.qos}},
+                 {"qos", ci.qos},
+                 {"filter", std::string_view(direction) == "provides" ? ci.filter : ""}},
             fmt::format("{} ({}.{})", ci.id, end.component, end.port)};
-  }
-
-  std::string channel_topic(const profile::Connection &c) const {
-    const auto &findby = c.publishes_to_channel() ? c.provides.target.findby : c.uses.target.findby;
-    return fmt::format("rsca_{}_channel_{}", sanitize(s_.domain_name), sanitize(findby.name));
   }
 
   std::string repid_of(const profile::Connection &c) const {
@@ -417,6 +449,12 @@ private:
     ApplicationFactory factory(s_);
     const std::size_t started = std::count_if(app_->components.begin(), app_->components.end(),
                                               [](const auto &c) { return c.pid != 0; });
+    if (joined_channels_) {
+      const auto destroyed = s_.channels->leave(app_->name);
+      undone.push_back(destroyed.empty() ? "event channel memberships withdrawn"
+                                         : fmt::format("event channels {} destroyed",
+                                                       fmt::join(destroyed, ", ")));
+    }
     if (started > 0) {
       factory.release(*app_);
       undone.push_back(fmt::format("{} process{} terminated", started, started == 1 ? "" : "es"));
@@ -426,6 +464,7 @@ private:
     if (allocated_) {
       undone.push_back(fmt::format("allocations on {} released", fmt::join(devices, ", ")));
     }
+
     return fmt::format("{}", fmt::join(undone, "; "));
   }
 
@@ -434,6 +473,7 @@ private:
   const ProgressSink &progress_;
   std::shared_ptr<Application> app_;
   bool allocated_ = false;
+  bool joined_channels_ = false;
   std::uint64_t launch_ = 0;
   std::string detail_;
 };
@@ -508,6 +548,7 @@ CallResult<std::vector<std::string>> ApplicationFactory::release(Application &ap
   }
   services_.allocator->release(app.plan);
   app.plan = {};
+  services_.channels->leave(app.name);
   // A component whose node is gone cannot be terminated by it, and is gone with it.
   for (std::size_t i = 0; i < terminated.size(); ++i)
     if (!terminated[i] && terminated[i].error().status != Status::Unavailable &&

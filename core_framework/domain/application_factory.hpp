@@ -15,6 +15,7 @@
 #include "control/endpoint.hpp"
 #include "domain/application.hpp"
 #include "domain/component_registry.hpp"
+#include "domain/event_channel_manager.hpp"
 
 namespace rsca::domain {
 
@@ -40,6 +41,7 @@ struct DomainServices {
   control::Endpoint *endpoint = nullptr;
   allocator::ResourceAllocator *allocator = nullptr;
   ComponentRegistry *components = nullptr;
+  EventChannelManager *channels = nullptr;
   std::function<std::optional<std::string>(const std::string &node)> node_address;
   // A number unique to each launch in this domain: component addresses and topics carry it, so
   // an application re-launched under the same name never meets its predecessor's leftovers.

@@ -3,6 +3,7 @@
 #include <atomic>
 #include <chrono>
 #include <fstream>
+#include <future>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -66,6 +67,41 @@ std::optional<fs::path> safe_relative(const std::string &path) {
   return p;
 }
 
+// One end's live state from its component's status: {"matched", "samples"}, or null.
+Json end_state(const std::map<std::string, Json> &status_of, const ConnectionEnd &end,
+               const std::string &connection) {
+  auto it = status_of.find(end.component);
+  if (end.component.empty() || it == status_of.end())
+    return nullptr;
+  for (const auto &port : it->second.value("ports", Json::array())) {
+    if (port.value("name", "") != end.port)
+      continue;
+    for (const auto &c : port.value("connections", Json::array()))
+      if (c.value("connection", "") == connection)
+        return Json{{"matched", c.value("matched", 0)},
+                    {"samples", c.value("samples", 0)},
+                    {"filtered", c.value("filtered", 0)}};
+  }
+  return nullptr;
+}
+
+Json connection_json(const Application &app, const ConnectionInstance &c,
+                     const std::map<std::string, Json> &status_of) {
+  auto end = [](const ConnectionEnd &e) {
+    return e.component.empty() ? std::string() : e.component + "." + e.port;
+  };
+  return {{"application", app.name},
+          {"id", c.id},
+          {"uses", end(c.uses)},
+          {"provides", end(c.provides)},
+          {"topic", c.topic},
+          {"repid", c.repid},
+          {"qos", c.qos},
+          {"filter", c.filter},
+          {"uses_state", end_state(status_of, c.uses, c.id)},
+          {"provides_state", end_state(status_of, c.provides, c.id)}};
+}
+
 std::vector<allocator::Device> devices_of(const std::string &node, const Json &body) {
   std::vector<allocator::Device> devices;
   for (const auto &d : body.value("devices", Json::array()))
@@ -99,6 +135,7 @@ struct DomainManager::Impl {
   std::unique_ptr<control::Endpoint> endpoint;
   allocator::ResourceAllocator allocator;
   ComponentRegistry components;
+  std::optional<EventChannelManager> channels; // made when the domain's name is known
   std::optional<DomainStore> store;
 
   std::mutex mutex; // guards everything below
@@ -114,6 +151,7 @@ struct DomainManager::Impl {
     s.endpoint = endpoint.get();
     s.allocator = &allocator;
     s.components = &components;
+    s.channels = &*channels;
     s.node_address = [this](const std::string &node) -> std::optional<std::string> {
       std::lock_guard lock(mutex);
       auto it = nodes.find(node);
@@ -143,6 +181,10 @@ struct DomainManager::Impl {
   CallResult<Json> list_nodes();
   CallResult<Json> list_devices();
   CallResult<Json> plan_application(const Json &body);
+  CallResult<Json> list_channels();
+  CallResult<Json> create_channel(const Json &body);
+  CallResult<Json> destroy_channel(const Json &body);
+  CallResult<Json> list_connections(const Json &body);
   CallResult<Json> component_exited(const Json &body);
   std::string unique_name(const std::string &wanted) const;
   CallResult<std::string> target_of(const Application &app, const Json &body) const;
@@ -441,6 +483,61 @@ CallResult<Json> DomainManager::Impl::list_devices() {
   return Json{{"devices", allocator::to_json(allocator.snapshot())}};
 }
 
+CallResult<Json> DomainManager::Impl::list_channels() {
+  Json list = Json::array();
+  for (const auto &c : channels->list())
+    list.push_back(to_json(c));
+  return Json{{"channels", list}};
+}
+
+CallResult<Json> DomainManager::Impl::create_channel(const Json &body) {
+  auto name = required<std::string>(body, "name");
+  if (!name)
+    return tl::unexpected(name.error());
+  auto channel = channels->create(*name);
+  if (!channel)
+    return tl::unexpected(channel.error());
+  return to_json(*channel);
+}
+
+CallResult<Json> DomainManager::Impl::destroy_channel(const Json &body) {
+  auto name = required<std::string>(body, "name");
+  if (!name)
+    return tl::unexpected(name.error());
+  if (auto ok = channels->destroy(*name); !ok)
+    return tl::unexpected(ok.error());
+  return Json{{"name", *name}};
+}
+
+// Every connection of the running applications (or of one), with its live state as its
+// components report it: matched or not, samples through it.
+CallResult<Json> DomainManager::Impl::list_connections(const Json &body) {
+  const std::string only = body.value("app", "");
+  std::vector<std::shared_ptr<Application>> apps;
+  {
+    std::lock_guard lock(mutex);
+    for (const auto &[name, app] : applications)
+      if (app && (only.empty() || name == only))
+        apps.push_back(app);
+  }
+  if (!only.empty() && apps.empty())
+    return control::call_error(Status::NotFound, fmt::format("no application {} runs", only));
+  Json list = Json::array();
+  for (const auto &app : apps) {
+    std::map<std::string, std::future<CallResult<Json>>> statuses;
+    for (const auto &c : app->components)
+      statuses.emplace(c.id, endpoint->call(c.address, "component.status", Json::object(),
+                                            options.call_timeout));
+    std::map<std::string, Json> status_of;
+    for (auto &[id, f] : statuses)
+      if (auto s = f.get())
+        status_of[id] = *s;
+    for (const auto &c : app->connections)
+      list.push_back(connection_json(*app, c, status_of));
+  }
+  return Json{{"connections", list}};
+}
+
 // Admission and placement of an installed application on the domain as it is, reserving nothing.
 CallResult<Json> DomainManager::Impl::plan_application(const Json &body) {
   auto name = required<std::string>(body, "application");
@@ -535,6 +632,10 @@ void DomainManager::Impl::serve() {
   bind("domain.component_exited", &Impl::component_exited);
   bind("app.create", &Impl::create_application);
   bind("app.plan", &Impl::plan_application);
+  bind0("channel.list", &Impl::list_channels);
+  bind("channel.create", &Impl::create_channel);
+  bind("channel.destroy", &Impl::destroy_channel);
+  bind("connection.list", &Impl::list_connections);
   bind("app.progress", &Impl::progress);
   bind("app.release", &Impl::release);
   bind("app.configure", &Impl::configure);
@@ -587,6 +688,7 @@ DomainManager::create(std::shared_ptr<dds::Participant> participant, DomainOptio
   auto impl = std::make_unique<Impl>();
   impl->options = std::move(options);
   impl->participant = participant;
+  impl->channels.emplace(impl->options.name);
   std::error_code ec;
   fs::create_directories(impl->options.repository, ec);
   if (ec)

@@ -4,6 +4,7 @@
 
 #include <fmt/ranges.h>
 
+#include "common/content_filter.hpp"
 #include "profile/read_context.hpp"
 
 namespace rsca::profile::detail {
@@ -290,6 +291,10 @@ std::vector<Connection> read_connections(ReadContext &ctx, const XmlElement *hol
                    fmt::format("{} has a filter but does not subscribe to an event channel "
                                "(usesport/findby/domainfinder type=\"eventchannel\")",
                                connection_label(c)));
+        else if (auto parsed = ContentFilter::parse(*c.filter); !parsed)
+          ctx.fail(part, "filter",
+                   fmt::format("{}: the filter \"{}\" is not valid: {}", connection_label(c),
+                               *c.filter, parsed.error()));
       }
     }
     connections.push_back(std::move(c));

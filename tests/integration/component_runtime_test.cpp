@@ -216,8 +216,10 @@ TEST_CASE("a component registers by announcing its id, pid, state and ports", "[
   CHECK(body.at("application") == h.application());
   CHECK(body.at("pid") == producer.process->pid());
   CHECK(body.at("state") == "loaded");
-  const Json port = {{"name", "samples_out"}, {"direction", "uses"}, {"repid", kSampleSeq}};
-  CHECK(body.at("ports") == Json::array({port}));
+  const Json samples = {{"name", "samples_out"}, {"direction", "uses"}, {"repid", kSampleSeq}};
+  const Json events = {
+      {"name", "events_out"}, {"direction", "uses"}, {"repid", "IDL:rsca/PropertyEvent:1.0"}};
+  CHECK(body.at("ports") == Json::array({samples, events}));
 }
 
 TEST_CASE("configure checks every value against the PRF and applies all or nothing",

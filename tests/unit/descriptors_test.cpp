@@ -316,7 +316,7 @@ TEST_CASE("SCD: ports, repids and directions", "[descriptors][scd]") {
   CHECK(producer.component_repid == "IDL:CF/Resource:1.0");
   CHECK(producer.component_type == "resource");
   CHECK(producer.supported_interfaces.size() == 5);
-  REQUIRE(producer.ports.size() == 1);
+  REQUIRE(producer.ports.size() == 2);
   const PortDefinition &out = producer.ports.front();
   CHECK(out.name == "samples_out");
   CHECK(out.repid == "IDL:rsca/SampleSeq:1.0");
@@ -326,13 +326,19 @@ TEST_CASE("SCD: ports, repids and directions", "[descriptors][scd]") {
   CHECK(out.where.line == 14);
   CHECK(producer.find_port("samples_out", PortDirection::Uses) == &out);
   CHECK(producer.find_port("samples_out", PortDirection::Provides) == nullptr);
-  CHECK(producer.interfaces.size() == 6);
+  const PortDefinition &events = producer.ports.back();
+  CHECK(events.name == "events_out");
+  CHECK(events.repid == "IDL:rsca/PropertyEvent:1.0");
+  CHECK(events.direction == PortDirection::Uses);
+  CHECK(producer.interfaces.size() == 7);
   CHECK(producer.supports("IDL:CF/LifeCycle:1.0"));
   CHECK_FALSE(producer.supports("IDL:CF/Device:1.0"));
 
   const auto consumer = read<SoftwareComponent>(kConsumer / "Consumer.scd.xml");
-  REQUIRE(consumer.ports.size() == 1);
+  REQUIRE(consumer.ports.size() == 2);
   CHECK(consumer.ports[0].name == "samples_in");
+  CHECK(consumer.ports[1].name == "events_in");
+  CHECK(consumer.ports[1].direction == PortDirection::Provides);
   CHECK(consumer.ports[0].repid == "IDL:rsca/SampleSeq:1.0");
   CHECK(consumer.ports[0].direction == PortDirection::Provides);
   CHECK(consumer.find_port("samples_in", PortDirection::Provides) != nullptr);

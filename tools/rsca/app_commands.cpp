@@ -297,6 +297,23 @@ void add_application_commands(CLI::App &app, const GlobalOptions &global, int &e
     exit_code = launch(*what, *instance, *no_start, *assign, *strategy, global);
   });
 
+  auto *channel_cmd = app.add_subcommand(
+      "channel", "Create or destroy an operator's event channel (it lives until destroyed)");
+  channel_cmd->require_subcommand(1);
+  for (const auto &[verb, op] :
+       {std::pair{"create", "channel.create"}, std::pair{"destroy", "channel.destroy"}}) {
+    auto *cmd = channel_cmd->add_subcommand(verb, std::string(verb) + " an event channel");
+    auto channel = std::make_shared<std::string>();
+    cmd->add_option("name", *channel, "The channel's name")->required();
+    cmd->callback([=, verb = std::string(verb), op = std::string(op), &global, &exit_code] {
+      exit_code = simple_call(
+          ("channel " + verb).c_str(), op, Json{{"name", *channel}}, global, [verb](const Json &r) {
+            fmt::print("channel {}: {}\n", verb == "create" ? "created" : "destroyed",
+                       r.value("name", ""));
+          });
+    });
+  }
+
   for (const auto &[verb, op, help] :
        {std::tuple{"start", "app.start", "Start a created or stopped application"},
         std::tuple{"stop", "app.stop", "Stop a running application"},

@@ -48,31 +48,74 @@ void print_devices(const Json &r) {
   }
 }
 
+void print_channels(const Json &r) {
+  fmt::print("{:<20} {:<10} {:>10} {:>11}  {}\n", "CHANNEL", "OWNER", "PUBLISHERS", "SUBSCRIBERS",
+             "TOPIC");
+  for (const auto &c : r.at("channels")) {
+    fmt::print("{:<20} {:<10} {:>10} {:>11}  {}\n", c.value("name", ""),
+               c.value("operator", false) ? "operator" : "apps", c.value("publishers", 0),
+               c.value("subscribers", 0), c.value("topic", ""));
+    for (const auto &m : c.at("members"))
+      fmt::print("  {:<10} {}/{}.{}{}\n", m.value("role", ""), m.value("application", ""),
+                 m.value("component", ""), m.value("port", ""),
+                 m.value("filter", "").empty() ? "" : "  filter: " + m.value("filter", ""));
+  }
+}
+
+std::string end_state(const Json &state) {
+  if (state.is_null())
+    return "-";
+  return fmt::format("{} matched, {} samples", state.value("matched", 0),
+                     state.value("samples", 0));
+}
+
+void print_connections(const Json &r) {
+  for (const auto &c : r.at("connections")) {
+    const std::string uses = c.value("uses", ""), provides = c.value("provides", "");
+    fmt::print("{}/{}: {} -> {}  [{}]\n", c.value("application", ""), c.value("id", ""),
+               uses.empty() ? "(channel)" : uses, provides.empty() ? "(channel)" : provides,
+               c.value("topic", ""));
+    const auto &q = c.at("qos");
+    fmt::print("  qos {} {} {}{}\n", q.value("reliability", ""), q.value("durability", ""),
+               q.value("history", ""),
+               q.contains("depth") ? fmt::format(" depth {}", q.at("depth").dump()) : "");
+    fmt::print("  uses: {}   provides: {}\n", end_state(c.at("uses_state")),
+               end_state(c.at("provides_state")));
+  }
+}
+
 } // namespace
 
 void add_ls_command(CLI::App &app, const GlobalOptions &global, int &exit_code) {
   auto *cmd =
-      app.add_subcommand("ls", "List what the domain holds: apps, nodes, devices or installed");
+      app.add_subcommand("ls", "List what the domain holds: apps, nodes, devices, installed, "
+                               "channels or connections [APP]");
   auto what = std::make_shared<std::string>("apps");
-  cmd->add_option("what", *what, "apps, nodes, devices or installed")
-      ->check(CLI::IsMember({"apps", "nodes", "devices", "installed"}));
-  cmd->callback([what, &global, &exit_code] {
+  auto of_app = std::make_shared<std::string>();
+  cmd->add_option("what", *what, "apps, nodes, devices, installed, channels or connections")
+      ->check(CLI::IsMember({"apps", "nodes", "devices", "installed", "channels", "connections"}));
+  cmd->add_option("app", *of_app, "connections: only this application's");
+  cmd->callback([what, of_app, &global, &exit_code] {
     struct View {
       const char *operation;
       void (*print)(const Json &);
     };
-    const View view = *what == "nodes"       ? View{"domain.nodes", print_nodes}
-                      : *what == "devices"   ? View{"domain.devices", print_devices}
-                      : *what == "installed" ? View{"domain.installed", print_installed}
-                                             : View{"app.list", print_apps};
+    const View view = *what == "nodes"         ? View{"domain.nodes", print_nodes}
+                      : *what == "devices"     ? View{"domain.devices", print_devices}
+                      : *what == "installed"   ? View{"domain.installed", print_installed}
+                      : *what == "channels"    ? View{"channel.list", print_channels}
+                      : *what == "connections" ? View{"connection.list", print_connections}
+                                               : View{"app.list", print_apps};
     auto client = DomainClient::connect(global);
     if (!client) {
       fmt::print(stderr, "rsca ls: {}\n", client.error().to_string());
       exit_code = kFailed;
       return;
     }
-    auto reply =
-        client->call(view.operation, Json::object(), std::chrono::milliseconds(global.timeout_ms));
+    Json body = Json::object();
+    if (!of_app->empty())
+      body["app"] = *of_app;
+    auto reply = client->call(view.operation, body, std::chrono::milliseconds(global.timeout_ms));
     if (!reply) {
       exit_code = report_failure(global, "ls", reply.error());
       return;

@@ -1,0 +1,200 @@
+// Event channels with real daemons and components: created on first use, shared across
+// applications, destroyed with their last member (down to the DDS entities), filtered per
+// subscriber, and refused before anything runs when their members could never match.
+#include <dds/dds.h>
+
+#include <catch2/catch.hpp>
+#include <fmt/format.h>
+
+#include "domain_fixture.hpp"
+
+using namespace rsca::test;
+using namespace std::chrono_literals;
+using rsca::control::Json;
+
+namespace {
+
+const std::string kTicksTopic = "rsca_rsca_channel_Ticks";
+
+// Counts the live DDS writers and readers on `topic` in the test's DDS domain, from the
+// built-in discovery topics: what a channel's members really left behind.
+class DdsEndpoints {
+public:
+  DdsEndpoints() : participant_(participant()) {
+    writers_ =
+        dds_create_reader(participant_->get(), DDS_BUILTIN_TOPIC_DCPSPUBLICATION, nullptr, nullptr);
+    readers_ = dds_create_reader(participant_->get(), DDS_BUILTIN_TOPIC_DCPSSUBSCRIPTION, nullptr,
+                                 nullptr);
+    REQUIRE(writers_ > 0);
+    REQUIRE(readers_ > 0);
+  }
+  ~DdsEndpoints() {
+    dds_delete(writers_);
+    dds_delete(readers_);
+  }
+
+  std::size_t on(const std::string &topic) const {
+    return count(writers_, topic) + count(readers_, topic);
+  }
+
+private:
+  static std::size_t count(dds_entity_t reader, const std::string &topic) {
+    constexpr std::size_t kMax = 256;
+    void *samples[kMax] = {nullptr};
+    dds_sample_info_t infos[kMax];
+    const dds_return_t n =
+        dds_read_mask(reader, samples, infos, kMax, kMax,
+                      DDS_ANY_SAMPLE_STATE | DDS_ANY_VIEW_STATE | DDS_ALIVE_INSTANCE_STATE);
+    std::size_t found = 0;
+    for (dds_return_t i = 0; i < n; ++i) {
+      const auto *e = static_cast<const dds_builtintopic_endpoint_t *>(samples[i]);
+      if (infos[i].valid_data && e->topic_name != nullptr && topic == e->topic_name)
+        ++found;
+    }
+    if (n > 0)
+      dds_return_loan(reader, samples, n);
+    return found;
+  }
+
+  std::shared_ptr<rsca::dds::Participant> participant_;
+  dds_entity_t writers_ = 0;
+  dds_entity_t readers_ = 0;
+};
+
+long property(TestDomain &domain, const std::string &target, const std::string &id) {
+  const auto slash = target.find('/');
+  auto q = domain.call("app.query", Json{{"app", target.substr(0, slash)},
+                                         {"component", target.substr(slash + 1)},
+                                         {"ids", {id}}});
+  return q ? q->at("properties").at(id).get<long>() : -1;
+}
+
+Json channel(TestDomain &domain, const std::string &name) {
+  auto list = domain.call("channel.list");
+  REQUIRE(list.has_value());
+  for (const auto &c : list->at("channels"))
+    if (c.at("name") == name)
+      return c;
+  return nullptr;
+}
+
+} // namespace
+
+TEST_CASE("an event channel carries events to every subscriber, and a filtered one gets only what "
+          "matches",
+          "[integration][channels]") {
+  TestDomain domain;
+  domain.install("Events");
+  auto app = domain.call("app.create", Json{{"application", "Events"}});
+  INFO((app ? std::string() : app.error().message));
+  REQUIRE(app.has_value());
+  const auto pids = pids_of(*app);
+
+  // Consumer_1 takes every tick; Consumer_2's filter "sequence < 5" lets the first five through.
+  CHECK(TestDomain::wait_for(
+      [&] { return property(domain, "Events/Consumer_1", "events_received") > 20; }));
+  CHECK(property(domain, "Events/Consumer_2", "events_received") == 5);
+  auto connections = domain.call("connection.list", Json{{"app", "Events"}});
+  REQUIRE(connections.has_value());
+  for (const auto &c : connections->at("connections")) {
+    if (c.at("id") != "first_five")
+      continue;
+    CHECK(c.at("filter") == "sequence < 5");
+    CHECK(c.at("provides_state").at("matched") == 1);
+    CHECK(c.at("provides_state").at("filtered").get<long>() > 15);
+  }
+  const Json ticks = channel(domain, "Ticks");
+  REQUIRE_FALSE(ticks.is_null());
+  CHECK(ticks.at("publishers") == 1);
+  CHECK(ticks.at("subscribers") == 2);
+  CHECK(ticks.at("topic") == kTicksTopic);
+
+  REQUIRE(domain.call("app.release", Json{{"app", "Events"}}).has_value());
+  CHECK(channel(domain, "Ticks").is_null());
+  domain.require_clean(pids);
+}
+
+TEST_CASE("a channel shared by two applications outlives the first and goes with the second, DDS "
+          "entities and all",
+          "[integration][channels]") {
+  TestDomain domain;
+  DdsEndpoints dds;
+  domain.install("Events");
+  domain.install("TickListener");
+  auto events = domain.call("app.create", Json{{"application", "Events"}});
+  REQUIRE(events.has_value());
+  auto listener = domain.call("app.create", Json{{"application", "TickListener"}});
+  REQUIRE(listener.has_value());
+  auto pids = pids_of(*events);
+  for (long pid : pids_of(*listener))
+    pids.push_back(pid);
+  CHECK(channel(domain, "Ticks").at("subscribers") == 3);
+  CHECK(TestDomain::wait_for(
+      [&] { return property(domain, "TickListener/Listener_1", "events_received") > 5; }));
+  // 1 writer, 3 readers.
+  CHECK(TestDomain::wait_for([&] { return dds.on(kTicksTopic) == 4; }));
+
+  REQUIRE(domain.call("app.release", Json{{"app", "Events"}}).has_value());
+  const Json ticks = channel(domain, "Ticks");
+  REQUIRE_FALSE(ticks.is_null());
+  CHECK(ticks.at("publishers") == 0);
+  CHECK(ticks.at("subscribers") == 1);
+  CHECK(TestDomain::wait_for([&] { return dds.on(kTicksTopic) == 1; }));
+
+  REQUIRE(domain.call("app.release", Json{{"app", "TickListener"}}).has_value());
+  CHECK(channel(domain, "Ticks").is_null());
+  CHECK(TestDomain::wait_for([&] { return dds.on(kTicksTopic) == 0; }));
+  domain.require_clean(pids);
+}
+
+TEST_CASE("channel members that could never match are refused before anything runs",
+          "[integration][channels][failure]") {
+  TestDomain domain;
+  domain.install("QosMismatch");
+  domain.install("MixedChannel");
+  auto [qrc, qout] = domain.cli({"launch", "QosMismatch"});
+  INFO(qout);
+  CHECK(qrc == 1);
+  CHECK_THAT(qout, Catch::Contains("failed at step 'check'"));
+  CHECK_THAT(qout,
+             Catch::Contains("publisher QosMismatch/Producer_1.events_out (connection publish)"));
+  CHECK_THAT(qout,
+             Catch::Contains("subscriber QosMismatch/Consumer_1.events_in (connection subscribe)"));
+  CHECK_THAT(qout, Catch::Contains(
+                       "reliability: the writer offers besteffort, the reader requests reliable"));
+  auto [mrc, mout] = domain.cli({"launch", "MixedChannel"});
+  INFO(mout);
+  CHECK(mrc == 1);
+  CHECK_THAT(mout, Catch::Contains(
+                       "port type: MixedChannel/Producer_1.events_out is "
+                       "IDL:rsca/PropertyEvent:1.0, channel Mixed carries IDL:rsca/SampleSeq:1.0"));
+  // Nothing ran, and neither channel stayed.
+  auto list = domain.call("channel.list");
+  REQUIRE(list.has_value());
+  CHECK(list->at("channels").empty());
+  domain.require_clean({});
+}
+
+TEST_CASE("an operator's channel lives until the operator destroys it", "[integration][channels]") {
+  TestDomain domain;
+  auto [crc, cout_text] = domain.cli({"channel", "create", "Ticks"});
+  INFO(cout_text);
+  REQUIRE(crc == 0);
+  CHECK(channel(domain, "Ticks").at("operator") == true);
+  domain.install("Events");
+  auto app = domain.call("app.create", Json{{"application", "Events"}});
+  REQUIRE(app.has_value());
+  // In use: not destroyed under the application.
+  auto [drc, dout] = domain.cli({"channel", "destroy", "Ticks"});
+  CHECK(drc == 5);
+  CHECK_THAT(dout, Catch::Contains("event channel Ticks is in use by Events"));
+  REQUIRE(domain.call("app.release", Json{{"app", "Events"}}).has_value());
+  CHECK_FALSE(channel(domain, "Ticks").is_null()); // the release leaves the operator's channel
+  auto [rrc, rout] = domain.cli({"channel", "destroy", "Ticks"});
+  INFO(rout);
+  CHECK(rrc == 0);
+  CHECK(channel(domain, "Ticks").is_null());
+  auto [nrc, nout] = domain.cli({"channel", "destroy", "Ticks"});
+  CHECK(nrc == 3);
+  domain.require_clean(pids_of(*app));
+}

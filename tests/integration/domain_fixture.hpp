@@ -1,0 +1,229 @@
+// The whole product with real processes, for integration tests: rsca-domaind and node daemons
+// on loopback, on a DDS domain of their own, driven through the CLI and the control plane. A test
+// checks that what it launched leaves nothing behind (require_clean).
+#pragma once
+#include <signal.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <thread>
+
+#include <catch2/catch.hpp>
+#include <fmt/format.h>
+#include <future>
+
+#include "../unit/test_domain.hpp"
+#include "child_process.hpp"
+#include "control/endpoint.hpp"
+
+namespace rsca::test {
+
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+using rsca::control::Json;
+using rsca::control::Status;
+
+inline const fs::path kBin = RSCA_BIN_DIR;
+inline const fs::path kSource = RSCA_SOURCE_DIR;
+inline const fs::path kTestSdr = kSource / "tests/data/integration";
+
+inline bool process_exists(long pid) {
+  if (pid <= 0)
+    return false;
+  std::ifstream stat(fmt::format("/proc/{}/stat", pid));
+  std::string state;
+  if (!stat)
+    return false;
+  std::string skip;
+  stat >> skip >> skip >> state;
+  return state != "Z"; // a zombie has exited; its parent has not reaped it yet
+}
+
+// A domain daemon and `nodes` node daemons, stopped (nodes first, gracefully) when it goes.
+class TestDomain {
+public:
+  explicit TestDomain(int nodes = 2, int registration_timeout_ms = 3000)
+      : TestDomain(shipped_nodes(nodes), registration_timeout_ms) {}
+
+  // One node daemon per DCD.
+  explicit TestDomain(const std::vector<fs::path> &dcds, int registration_timeout_ms = 3000)
+      : run_(fs::temp_directory_path() /
+             fmt::format("rsca-it-{}-{}", getpid(), std::random_device{}())) {
+    fs::create_directories(run_ / "logs");
+    env_ = {{"RSCA_DDS_DOMAIN", std::to_string(rsca::test::isolated_domain_id())}};
+    domaind_ = std::make_unique<ChildProcess>(
+        (kBin / "rsca-domaind").string(),
+        std::vector<std::string>{
+            "--dmd", (kSource / "profiles/dom/domain/DomainManager.dmd.xml").string(),
+            "--repository", (run_ / "repository").string(), "--registration-timeout-ms",
+            std::to_string(registration_timeout_ms)},
+        env_);
+    for (const auto &dcd : dcds)
+      nodes_.push_back(std::make_unique<ChildProcess>(
+          (kBin / "rsca-noded").string(),
+          std::vector<std::string>{"--dcd", dcd.string(), "--log-dir", (run_ / "logs").string(),
+                                   "--exec-path", kBin.string()},
+          env_));
+    auto pp = rsca::test::participant();
+    auto endpoint = rsca::control::Endpoint::open(pp, fmt::format("rsca/cli/test-{}", getpid()));
+    REQUIRE(endpoint.has_value());
+    participant_ = pp;
+    client_ = std::move(*endpoint);
+    REQUIRE(wait_for([&] {
+      auto r = call("domain.nodes");
+      return r && r->at("nodes").size() == dcds.size();
+    }));
+  }
+
+  // The project's own nodes: profiles/dev/nodes/node1..N.
+  static std::vector<fs::path> shipped_nodes(int nodes) {
+    std::vector<fs::path> dcds;
+    for (int i = 1; i <= nodes; ++i)
+      dcds.push_back(kSource / fmt::format("profiles/dev/nodes/node{}/DeviceManager.dcd.xml", i));
+    return dcds;
+  }
+
+  ~TestDomain() {
+    for (auto &n : nodes_)
+      if (n) {
+        n->signal(SIGTERM);
+        n->wait_exit(5s);
+      }
+    if (domaind_) {
+      domaind_->signal(SIGTERM);
+      domaind_->wait_exit(5s);
+    }
+    std::error_code ec;
+    fs::remove_all(run_, ec);
+  }
+
+  rsca::control::CallResult<Json> call(const std::string &op, Json body = Json::object(),
+                                       std::chrono::milliseconds timeout = 10s) {
+    return client_->call_sync("rsca/domain", op, std::move(body), timeout);
+  }
+
+  // Runs the CLI against this domain; returns its exit code and output.
+  std::pair<int, std::string> cli(const std::vector<std::string> &args) {
+    const fs::path out = run_ / "cli.out";
+    std::vector<std::string> sh_args{"-c", "\"$0\" \"$@\" > " + out.string() + " 2>&1",
+                                     (kBin / "rsca").string()};
+    sh_args.insert(sh_args.end(), args.begin(), args.end());
+    ChildProcess cli("/bin/sh", sh_args, env_);
+    auto status = cli.wait_exit(60s);
+    std::ifstream in(out);
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    return {status && WIFEXITED(*status) ? WEXITSTATUS(*status) : -1, text};
+  }
+
+  void install(const std::string &application) {
+    auto [rc, out] =
+        cli({"install", "--sdrroot", kTestSdr.string(),
+             (kTestSdr / fmt::format("dom/waveforms/{0}/{0}.sad.xml", application)).string()});
+    INFO(out);
+    REQUIRE(rc == 0);
+  }
+
+  // Nothing of any application is left: no application, no allocation, no component process.
+  void require_clean(const std::vector<long> &pids) {
+    auto apps = call("app.list");
+    REQUIRE(apps.has_value());
+    CHECK(apps->at("applications").empty());
+    auto devices = call("domain.devices");
+    REQUIRE(devices.has_value());
+    for (const auto &d : devices->at("devices")) {
+      for (const auto &[name, c] : d.at("capacity").items()) {
+        INFO(d.at("id") << " " << name);
+        CHECK(c.at("allocated").get<double>() == Approx(0.0).margin(1e-9));
+      }
+      for (const auto &cpu : d.at("cpu_tasks")) {
+        INFO(d.at("id") << " cpu tasks " << cpu.dump());
+        CHECK(cpu.at("tasks").empty());
+      }
+    }
+    for (long pid : pids) {
+      INFO("component pid " << pid);
+      CHECK(wait_for([&] { return !process_exists(pid); }));
+    }
+    auto nodes = call("domain.nodes");
+    REQUIRE(nodes.has_value());
+    for (const auto &node : nodes->at("nodes")) {
+      auto status = client_->call_sync(node.at("address"), "node.status", Json::object(), 5s);
+      REQUIRE(status.has_value());
+      CHECK(status->at("processes").empty());
+    }
+  }
+
+  // Every component process the nodes run now.
+  std::vector<long> running_pids() {
+    std::vector<long> pids;
+    for (int i = 0; i < static_cast<int>(nodes_.size()); ++i) {
+      if (!nodes_[i])
+        continue;
+      auto status = client_->call_sync(fmt::format("rsca/node/node{}", i + 1), "node.status",
+                                       Json::object(), 5s);
+      if (status)
+        for (const auto &p : status->at("processes"))
+          pids.push_back(p.at("pid").get<long>());
+    }
+    return pids;
+  }
+
+  // Stops the domain daemon and starts a new one on the same repository.
+  void restart_domaind(int registration_timeout_ms = 3000) {
+    domaind_->signal(SIGTERM);
+    REQUIRE(domaind_->wait_exit(5s).has_value());
+    domaind_ = std::make_unique<ChildProcess>(
+        (kBin / "rsca-domaind").string(),
+        std::vector<std::string>{
+            "--dmd", (kSource / "profiles/dom/domain/DomainManager.dmd.xml").string(),
+            "--repository", (run_ / "repository").string(), "--registration-timeout-ms",
+            std::to_string(registration_timeout_ms)},
+        env_);
+  }
+
+  void kill_node(int index) {
+    nodes_[index - 1]->signal(SIGKILL);
+    nodes_[index - 1]->wait_exit(5s);
+    nodes_[index - 1].reset();
+  }
+
+  template <typename Predicate>
+  static bool wait_for(Predicate done, std::chrono::milliseconds limit = 10s) {
+    const auto deadline = std::chrono::steady_clock::now() + limit;
+    while (std::chrono::steady_clock::now() < deadline) {
+      if (done())
+        return true;
+      std::this_thread::sleep_for(20ms); // pacing a poll of real processes
+    }
+    return done();
+  }
+
+  const fs::path &run_dir() const { return run_; }
+
+private:
+  fs::path run_;
+  ChildProcess::Environment env_;
+  std::unique_ptr<ChildProcess> domaind_;
+  std::vector<std::unique_ptr<ChildProcess>> nodes_;
+  std::shared_ptr<rsca::dds::Participant> participant_;
+  std::unique_ptr<rsca::control::Endpoint> client_;
+};
+
+inline std::vector<long> pids_of(const Json &app) {
+  std::vector<long> pids;
+  for (const auto &c : app.at("components"))
+    pids.push_back(c.at("pid").get<long>());
+  return pids;
+}
+
+inline long received(TestDomain &domain, const std::string &app) {
+  auto q = domain.call("app.query",
+                       Json{{"app", app}, {"component", "Consumer_1"}, {"ids", {"received"}}});
+  if (!q)
+    return -1;
+  return q->at("properties").at("received").get<long>();
+}
+
+} // namespace rsca::test
