@@ -5,6 +5,7 @@
 #include <cerrno>
 #include <charconv>
 #include <csignal>
+#include <cstdlib>
 #include <cstring>
 #include <functional>
 #include <map>
@@ -19,6 +20,7 @@
 #include <sys/signalfd.h>
 #include <unistd.h>
 
+#include "common/exec_environment.hpp"
 #include "component/host.hpp"
 
 namespace rsca::component {
@@ -256,10 +258,13 @@ int run_component(int argc, char **argv, const Factory &factory) {
   // A component does not outlive the node daemon that started it. With the node gone nobody could
   // escalate a stuck shutdown, so its death kills the component outright; the domain learns of
   // it from the lost announcements.
-  const pid_t parent = getppid();
+  // The node may die before this line runs, its orphan adopted by another process: the node's pid
+  // in the environment tells them apart.
+  const char *node = std::getenv(kNodePidVariable);
+  const pid_t parent = node != nullptr ? static_cast<pid_t>(std::atol(node)) : getppid();
   prctl(PR_SET_PDEATHSIG, SIGKILL);
   if (getppid() != parent)
-    return kExitFailure;               // the parent died before the request took effect
+    return kExitFailure;               // the node died before the request took effect
   auto events = ExitEvents::install(); // first: before any thread starts
   if (!events) {
     spdlog::error("{}", events.error());

@@ -12,6 +12,7 @@
 
 #include "allocator/plan_json.hpp"
 #include "common/elapsed.hpp"
+#include "control/domain_events.hpp"
 #include "profile/profile_loader.hpp"
 #include "profile/property_binding.hpp"
 #include "profile/property_json.hpp"
@@ -102,6 +103,13 @@ Json connection_json(const Application &app, const ConnectionInstance &c,
           {"provides_state", end_state(status_of, c.provides, c.id)}};
 }
 
+Json device_ids(const Json &node_body) {
+  Json ids = Json::array();
+  for (const auto &d : node_body.value("devices", Json::array()))
+    ids.push_back(d.value("id", ""));
+  return ids;
+}
+
 std::vector<allocator::Device> devices_of(const std::string &node, const Json &body) {
   std::vector<allocator::Device> devices;
   for (const auto &d : body.value("devices", Json::array()))
@@ -135,6 +143,7 @@ struct DomainManager::Impl {
   std::unique_ptr<control::Endpoint> endpoint;
   allocator::ResourceAllocator allocator;
   ComponentRegistry components;
+  std::unique_ptr<control::DomainEvents> events;
   std::optional<EventChannelManager> channels; // made when the domain's name is known
   std::optional<DomainStore> store;
 
@@ -342,8 +351,16 @@ CallResult<Json> DomainManager::Impl::create_application(const Json &body) {
   progress->done = true;
   if (!app) {
     applications.erase(request.name);
+    events->publish(app.error().status == Status::Rejected ? "application.rejected"
+                                                           : "application.failed",
+                    {{"application", request.name},
+                     {"installed", request.installed},
+                     {"error", app.error().message}});
     return tl::unexpected(app.error());
   }
+  events->publish("application.created", {{"application", request.name},
+                                          {"installed", request.installed},
+                                          {"components", (*app)->components.size()}});
   applications[request.name] = *app;
   Json reply = to_json(**app);
   reply["launch"] = {{"steps", steps_json(progress->steps)}, {"ms", ms_since(began)}};
@@ -383,6 +400,7 @@ CallResult<Json> DomainManager::Impl::release(const Json &body) {
   }
   auto unconfirmed = factory().release(**app);
   spdlog::info("application {} released", (*app)->name);
+  events->publish("application.released", {{"application", (*app)->name}});
   if (!unconfirmed)
     return control::call_error(
         unconfirmed.error().status,
@@ -578,6 +596,8 @@ CallResult<Json> DomainManager::Impl::component_exited(const Json &body) {
         continue;
       c.state = "exited";
       spdlog::warn("component {} of application {} exited unexpectedly: {}", c.id, name, why);
+      events->publish("component.exited",
+                      {{"application", name}, {"component", c.id}, {"node", c.node}, {"why", why}});
     }
   }
   return Json::object();
@@ -590,9 +610,11 @@ void DomainManager::Impl::on_announcement(const control::AnnouncementEvent &even
     std::lock_guard lock(mutex);
     const bool known = nodes.count(node) != 0;
     nodes[node] = {node, event.address, event.body};
-    if (!known)
+    if (!known) {
       spdlog::info("node {} registered with {} device(s)", node,
                    event.body.value("devices", Json::array()).size());
+      events->publish("node.added", {{"node", node}, {"devices", device_ids(event.body)}});
+    }
     return;
   }
   if (event.kind == control::AnnouncementEvent::Kind::Alive && event.endpoint_kind == "component") {
@@ -607,6 +629,8 @@ void DomainManager::Impl::on_announcement(const control::AnnouncementEvent &even
     if (it->second.address != event.address)
       continue;
     spdlog::warn("node {} is gone; its devices leave the domain", it->first);
+    events->publish("node.removed",
+                    {{"node", it->first}, {"devices", device_ids(it->second.body)}});
     allocator.remove_node(it->first);
     nodes.erase(it);
     return;
@@ -697,6 +721,10 @@ DomainManager::create(std::shared_ptr<dds::Participant> participant, DomainOptio
   if (!store)
     return tl::unexpected(store.error());
   impl->store.emplace(std::move(*store));
+  auto events = control::DomainEvents::open(participant, impl->options.name);
+  if (!events)
+    return tl::unexpected(events.error());
+  impl->events = std::move(*events);
   if (auto ok = impl->load_installed(); !ok)
     return tl::unexpected(ok.error());
   Impl *raw = impl.get();

@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "common/exec_environment.hpp"
 #include "host_info.hpp"
 
 namespace rsca::gpp {
@@ -73,6 +74,8 @@ CallResult<Json> GppDevice::execute(const Json &body) {
   request.executable = find_executable(body.value("entrypoint", ""), body.value("spd_dir", ""));
   request.args = body.value("args", std::vector<std::string>{});
   request.env = context_.dds.environment();
+  // The component dies with this node: it checks that its parent is still this process.
+  request.env.emplace_back(kNodePidVariable, std::to_string(::getpid()));
   request.log_file = context_.log_dir / application / (component + ".log");
   request.label = fmt::format("{}/{}", application, component);
   auto pid = launcher_.execute(request);

@@ -4,6 +4,7 @@
 #include <signal.h>
 
 #include <fstream>
+#include <sstream>
 
 #include <catch2/catch.hpp>
 #include <fmt/format.h>
@@ -261,4 +262,31 @@ TEST_CASE("admission: launches fill the domain, the next is rejected with the re
   REQUIRE(domain.call("app.release", Json{{"app", "g2"}}).has_value());
   REQUIRE(domain.call("app.release", Json{{"app", "g3"}}).has_value());
   domain.require_clean(pids);
+}
+
+TEST_CASE("the domain publishes what happens to it, and rsca events follows it",
+          "[integration][domain][events]") {
+  TestDomain domain;
+  domain.install("Healthy");
+  auto app = domain.call("app.create", Json{{"application", "Healthy"}});
+  REQUIRE(app.has_value());
+  REQUIRE(domain.call("app.release", Json{{"app", "Healthy"}}).has_value());
+  domain.kill_node(2);
+  // A follower that starts now still gets the recent events, in order, one JSON object a line.
+  auto [rc, out] = domain.cli({"--json", "events", "--count", "5", "--wait-ms", "10000"});
+  INFO(out);
+  REQUIRE(rc == 0);
+  std::vector<std::string> kinds;
+  std::istringstream lines(out);
+  for (std::string line; std::getline(lines, line);) {
+    const Json event = Json::parse(line);
+    kinds.push_back(event.at("kind"));
+    if (event.at("kind") == "application.created")
+      CHECK(event.at("details").at("application") == "Healthy");
+    if (event.at("kind") == "node.removed")
+      CHECK(event.at("details").at("node") == "node2");
+  }
+  CHECK(kinds == std::vector<std::string>{"node.added", "node.added", "application.created",
+                                          "application.released", "node.removed"});
+  domain.require_clean(pids_of(*app));
 }

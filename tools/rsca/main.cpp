@@ -26,6 +26,7 @@ int main(int argc, char **argv) {
   rsca::cli::add_show_command(app, global, exit_code);
   rsca::cli::add_application_commands(app, global, exit_code);
   rsca::cli::add_plan_command(app, global, exit_code);
+  rsca::cli::add_events_command(app, global, exit_code);
   rsca::cli::add_ls_command(app, global, exit_code);
   rsca::cli::add_domain_command(app, global, exit_code);
   try {
