@@ -13,6 +13,7 @@
 #include "allocator/plan_json.hpp"
 #include "common/elapsed.hpp"
 #include "control/domain_events.hpp"
+#include "domain/connection_manager.hpp"
 #include "profile/profile_loader.hpp"
 #include "profile/property_binding.hpp"
 #include "profile/property_json.hpp"
@@ -144,7 +145,8 @@ struct DomainManager::Impl {
   allocator::ResourceAllocator allocator;
   ComponentRegistry components;
   std::unique_ptr<control::DomainEvents> events;
-  std::optional<EventChannelManager> channels; // made when the domain's name is known
+  std::optional<ConnectionManager> runtime_connections; // made once the endpoint is open
+  std::optional<EventChannelManager> channels;          // made when the domain's name is known
   std::optional<DomainStore> store;
 
   std::mutex mutex; // guards everything below
@@ -194,6 +196,9 @@ struct DomainManager::Impl {
   CallResult<Json> create_channel(const Json &body);
   CallResult<Json> destroy_channel(const Json &body);
   CallResult<Json> list_connections(const Json &body);
+  CallResult<Json> create_connection(const Json &body);
+  Json runtime_end_state(const PortRef &end, const std::string &connection);
+  CallResult<Json> destroy_connection(const Json &body);
   CallResult<Json> component_exited(const Json &body);
   std::string unique_name(const std::string &wanted) const;
   CallResult<std::string> target_of(const Application &app, const Json &body) const;
@@ -394,6 +399,8 @@ CallResult<Json> DomainManager::Impl::release(const Json &body) {
   auto app = find_application(body);
   if (!app)
     return tl::unexpected(app.error());
+  // Its runtime connections go first, while both ends still answer.
+  runtime_connections->application_released((*app)->name);
   {
     std::lock_guard lock(mutex);
     applications.erase((*app)->name);
@@ -553,7 +560,74 @@ CallResult<Json> DomainManager::Impl::list_connections(const Json &body) {
     for (const auto &c : app->connections)
       list.push_back(connection_json(*app, c, status_of));
   }
+  for (const auto &c : runtime_connections->list())
+    if (only.empty() || c.uses.application == only || c.provides.application == only) {
+      Json entry = to_json(c);
+      entry["application"] = "(runtime)";
+      entry["uses_state"] = runtime_end_state(c.uses, c.id);
+      entry["provides_state"] = runtime_end_state(c.provides, c.id);
+      list.push_back(std::move(entry));
+    }
   return Json{{"connections", list}};
+}
+
+namespace {
+
+CallResult<PortRef> port_ref(const Json &body, const char *key) {
+  if (!body.contains(key) || !body.at(key).is_object())
+    return control::call_error(Status::BadRequest,
+                               fmt::format("the request has no \"{}\" port", key));
+  const Json &end = body.at(key);
+  PortRef ref{end.value("application", ""), end.value("component", ""), end.value("port", "")};
+  if (ref.application.empty() || ref.component.empty() || ref.port.empty())
+    return control::call_error(Status::BadRequest,
+                               fmt::format("\"{}\" needs application, component and port", key));
+  return ref;
+}
+
+} // namespace
+
+// A runtime connection's end as its component reports it.
+Json DomainManager::Impl::runtime_end_state(const PortRef &end, const std::string &connection) {
+  std::string address;
+  {
+    std::lock_guard lock(mutex);
+    auto it = applications.find(end.application);
+    const auto *component = it != applications.end() && it->second
+                                ? it->second->find_component(end.component)
+                                : nullptr;
+    if (component == nullptr)
+      return nullptr;
+    address = component->address;
+  }
+  auto status =
+      endpoint->call_sync(address, "component.status", Json::object(), options.call_timeout);
+  if (!status)
+    return nullptr;
+  return end_state({{end.component, *status}}, ConnectionEnd{end.component, end.port}, connection);
+}
+
+CallResult<Json> DomainManager::Impl::create_connection(const Json &body) {
+  auto uses = port_ref(body, "uses");
+  if (!uses)
+    return tl::unexpected(uses.error());
+  auto provides = port_ref(body, "provides");
+  if (!provides)
+    return tl::unexpected(provides.error());
+  auto made = runtime_connections->connect(*uses, *provides, body.value("id", ""),
+                                           body.value("qos", Json::object()));
+  if (!made)
+    return tl::unexpected(made.error());
+  return to_json(*made);
+}
+
+CallResult<Json> DomainManager::Impl::destroy_connection(const Json &body) {
+  auto id = required<std::string>(body, "id");
+  if (!id)
+    return tl::unexpected(id.error());
+  if (auto ok = runtime_connections->disconnect(*id); !ok)
+    return tl::unexpected(ok.error());
+  return Json{{"id", *id}};
 }
 
 // Admission and placement of an installed application on the domain as it is, reserving nothing.
@@ -660,6 +734,8 @@ void DomainManager::Impl::serve() {
   bind("channel.create", &Impl::create_channel);
   bind("channel.destroy", &Impl::destroy_channel);
   bind("connection.list", &Impl::list_connections);
+  bind("connection.create", &Impl::create_connection);
+  bind("connection.destroy", &Impl::destroy_connection);
   bind("app.progress", &Impl::progress);
   bind("app.release", &Impl::release);
   bind("app.configure", &Impl::configure);
@@ -735,6 +811,14 @@ DomainManager::create(std::shared_ptr<dds::Participant> participant, DomainOptio
   if (!endpoint)
     return tl::unexpected(endpoint.error());
   impl->endpoint = std::move(*endpoint);
+  impl->runtime_connections.emplace(
+      impl->options.name, impl->endpoint.get(),
+      [raw](const std::string &name) -> std::shared_ptr<const Application> {
+        std::lock_guard lock(raw->mutex);
+        auto it = raw->applications.find(name);
+        return it == raw->applications.end() ? nullptr : it->second;
+      },
+      impl->options.call_timeout);
   impl->serve();
   spdlog::info("domain {} serving at {}", impl->options.name, impl->endpoint->address());
   return std::unique_ptr<DomainManager>(new DomainManager(std::move(impl)));

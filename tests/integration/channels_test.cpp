@@ -198,3 +198,96 @@ TEST_CASE("an operator's channel lives until the operator destroys it", "[integr
   CHECK(nrc == 3);
   domain.require_clean(pids_of(*app));
 }
+
+namespace {
+
+Json runtime_connection(TestDomain &domain, const std::string &id) {
+  auto list = domain.call("connection.list");
+  REQUIRE(list.has_value());
+  for (const auto &c : list->at("connections"))
+    if (c.at("application") == "(runtime)" && c.at("id") == id)
+      return c;
+  return nullptr;
+}
+
+long delivered(TestDomain &domain, const std::string &id) {
+  const Json c = runtime_connection(domain, id);
+  return c.is_null() || c.at("provides_state").is_null()
+             ? -1
+             : c.at("provides_state").at("samples").get<long>();
+}
+
+} // namespace
+
+TEST_CASE("runtime connections between running applications: made, checked, carrying data, "
+          "removed, and gone with an application",
+          "[integration][connections]") {
+  TestDomain domain;
+  const auto sad =
+      (kSource / "profiles/dom/waveforms/ProducerConsumer/ProducerConsumer.sad.xml").string();
+  auto [arc, aout] = domain.cli({"launch", sad, "--name", "a"});
+  REQUIRE(arc == 0);
+  auto [brc, bout] = domain.cli({"launch", "ProducerConsumer", "--name", "b"});
+  REQUIRE(brc == 0);
+  std::vector<long> pids;
+  for (const char *name : {"a", "b"}) {
+    auto app = domain.call("app.show", Json{{"app", name}});
+    REQUIRE(app.has_value());
+    for (long pid : pids_of(*app))
+      pids.push_back(pid);
+  }
+
+  // a's producer feeds b's consumer too, with the QoS asked for.
+  auto [rc, out] =
+      domain.cli({"connect", "a/Producer_1.samples_out", "b/Consumer_1.samples_in", "--id", "cross",
+                  "--qos", "reliability=besteffort", "--qos", "depth=4"});
+  INFO(out);
+  REQUIRE(rc == 0);
+  CHECK(TestDomain::wait_for([&] { return delivered(domain, "cross") > 10; }));
+  const Json cross = runtime_connection(domain, "cross");
+  CHECK(cross.at("qos").at("reliability") == "besteffort");
+  CHECK(cross.at("qos").at("depth") == 4);
+
+  // Checked before anything is made.
+  auto [trc, tout] = domain.cli({"connect", "a/Producer_1.events_out", "b/Consumer_1.samples_in"});
+  CHECK(trc == 1);
+  CHECK_THAT(tout,
+             Catch::Contains("port type: a/Producer_1.events_out sends IDL:rsca/PropertyEvent:1.0, "
+                             "but b/Consumer_1.samples_in takes IDL:rsca/SampleSeq:1.0"));
+  auto [prc, pout] = domain.cli({"connect", "a/Producer_1.samples_out", "b/Consumer_1.nope"});
+  CHECK(prc == 3);
+  CHECK_THAT(pout, Catch::Contains("b/Consumer_1.nope is not a provides port"));
+
+  // Removed while data flows: b's consumer keeps only its own connection.
+  auto [drc, dout] = domain.cli({"disconnect", "cross"});
+  REQUIRE(drc == 0);
+  CHECK(runtime_connection(domain, "cross").is_null());
+  auto b_status = [&] {
+    auto app = domain.call("app.show", Json{{"app", "b"}});
+    for (const auto &c : app->at("components"))
+      if (c.at("id") == "Consumer_1")
+        return domain.client().call_sync(c.at("address"), "component.status", Json::object(), 5s);
+    return rsca::control::CallResult<Json>(
+        rsca::control::call_error(rsca::control::Status::NotFound, ""));
+  };
+  auto status = b_status();
+  REQUIRE(status.has_value());
+  for (const auto &port : status->at("ports"))
+    if (port.at("name") == "samples_in")
+      CHECK(port.at("connections").size() == 1);
+
+  // A connection goes with either of its applications.
+  REQUIRE(
+      domain
+          .cli({"connect", "a/Producer_1.samples_out", "b/Consumer_1.samples_in", "--id", "again"})
+          .first == 0);
+  REQUIRE(domain.call("app.release", Json{{"app", "a"}}).has_value());
+  CHECK(runtime_connection(domain, "again").is_null());
+  status = b_status();
+  REQUIRE(status.has_value());
+  for (const auto &port : status->at("ports"))
+    if (port.at("name") == "samples_in")
+      CHECK(port.at("connections").size() == 1);
+  REQUIRE(domain.call("app.release", Json{{"app", "b"}}).has_value());
+  domain.require_clean(pids);
+}

@@ -201,6 +201,8 @@ public:
   }
 
   const fs::path &run_dir() const { return run_; }
+  // The test's own endpoint, for calls to nodes and components.
+  rsca::control::Endpoint &client() { return *client_; }
 
 private:
   fs::path run_;

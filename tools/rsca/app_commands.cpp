@@ -222,6 +222,29 @@ std::pair<std::string, std::string> split_target(const std::string &target) {
   return {target.substr(0, slash), target.substr(slash + 1)};
 }
 
+// APP/COMPONENT.PORT as {"application", "component", "port"}.
+std::optional<Json> port_json(const std::string &text) {
+  const auto slash = text.find('/');
+  const auto dot = text.rfind('.');
+  if (slash == std::string::npos || dot == std::string::npos || dot < slash || slash == 0 ||
+      dot == slash + 1 || dot + 1 == text.size())
+    return std::nullopt;
+  return Json{{"application", text.substr(0, slash)},
+              {"component", text.substr(slash + 1, dot - slash - 1)},
+              {"port", text.substr(dot + 1)}};
+}
+
+// QoS values given as text: numbers (depth, strength, ...) as numbers, the rest as text.
+Json typed_qos(const Json &values) {
+  Json out = Json::object();
+  for (const auto &[k, v] : values.items()) {
+    const std::string text = v.get<std::string>();
+    const bool number = !text.empty() && text.find_first_not_of("0123456789") == std::string::npos;
+    out[k] = number ? Json(std::stoll(text)) : Json(text);
+  }
+  return out;
+}
+
 // prop=value arguments; values are sent as text and typed by the domain against the PRF.
 std::optional<Json> parse_assignments(const std::vector<std::string> &args) {
   Json values = Json::object();
@@ -295,6 +318,45 @@ void add_application_commands(CLI::App &app, const GlobalOptions &global, int &e
       ->check(CLI::IsMember({"pack", "spread"}));
   launch_cmd->callback([=, &global, &exit_code] {
     exit_code = launch(*what, *instance, *no_start, *assign, *strategy, global);
+  });
+
+  auto *connect_cmd = app.add_subcommand(
+      "connect", "Connect a uses port to a provides port of running applications: "
+                 "APP/COMPONENT.PORT APP/COMPONENT.PORT");
+  auto uses_end = std::make_shared<std::string>();
+  auto provides_end = std::make_shared<std::string>();
+  auto connection_id = std::make_shared<std::string>();
+  auto qos_args = std::make_shared<std::vector<std::string>>();
+  connect_cmd->add_option("uses", *uses_end, "APP/COMPONENT.PORT of a uses port")->required();
+  connect_cmd->add_option("provides", *provides_end, "APP/COMPONENT.PORT of a provides port")
+      ->required();
+  connect_cmd->add_option("--id", *connection_id, "The connection's id (default: runtime_N)");
+  connect_cmd->add_option("--qos", *qos_args, "QoS as in the SAD: name=value (repeatable)");
+  connect_cmd->callback([=, &global, &exit_code] {
+    auto uses = port_json(*uses_end);
+    auto provides = port_json(*provides_end);
+    auto qos = parse_assignments(*qos_args);
+    if (!uses || !provides || !qos) {
+      fmt::print(stderr, "rsca connect: give ports as APP/COMPONENT.PORT and QoS as name=value\n");
+      exit_code = kUsage;
+      return;
+    }
+    Json body{{"uses", *uses}, {"provides", *provides}, {"qos", typed_qos(*qos)}};
+    if (!connection_id->empty())
+      body["id"] = *connection_id;
+    exit_code = simple_call("connect", "connection.create", body, global, [](const Json &r) {
+      fmt::print("connected {}: {} -> {} [{}]\n", r.value("id", ""), r.value("uses", ""),
+                 r.value("provides", ""), r.value("topic", ""));
+    });
+  });
+  auto *disconnect_cmd =
+      app.add_subcommand("disconnect", "Remove a connection made with rsca connect");
+  auto disconnect_id = std::make_shared<std::string>();
+  disconnect_cmd->add_option("id", *disconnect_id, "The connection's id")->required();
+  disconnect_cmd->callback([=, &global, &exit_code] {
+    exit_code =
+        simple_call("disconnect", "connection.destroy", Json{{"id", *disconnect_id}}, global,
+                    [](const Json &r) { fmt::print("disconnected {}\n", r.value("id", "")); });
   });
 
   auto *channel_cmd = app.add_subcommand(
