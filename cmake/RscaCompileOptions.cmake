@@ -9,6 +9,7 @@ if(RSCA_SANITIZE)
   target_compile_options(rsca_compile_options INTERFACE
     -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer)
   target_link_options(rsca_compile_options INTERFACE -fsanitize=address,undefined)
+  target_compile_definitions(rsca_compile_options INTERFACE RSCA_SANITIZE=1)
 endif()
 
 function(rsca_target_options target)

@@ -40,7 +40,8 @@ Expected<std::shared_ptr<XmlReader>> XmlReader::acquire() {
     return held;
   std::string tried;
   for (const auto &candidate : module_candidates()) {
-    void *handle = dlopen(candidate.c_str(), RTLD_NOW | RTLD_LOCAL);
+    void *handle =
+        dlopen(candidate.c_str(), RTLD_NOW | RTLD_LOCAL | (kUnloads ? 0 : RTLD_NODELETE));
     if (handle == nullptr) {
       tried += fmt::format("\n  {}", dlerror());
       continue;

@@ -22,6 +22,14 @@ public:
   static Expected<std::shared_ptr<XmlReader>> acquire();
   // Whether the module is loaded now (some reader is held).
   static bool loaded();
+  // Whether releasing the last reader takes Xerces out of the process. Not in sanitizer builds:
+  // LeakSanitizer's thread tracer crashes on the stale thread-local storage entries an unloaded
+  // library leaves in other threads, so there the module stays mapped (RTLD_NODELETE).
+#ifdef RSCA_SANITIZE
+  static constexpr bool kUnloads = false;
+#else
+  static constexpr bool kUnloads = true;
+#endif
 
 private:
   struct Token {
