@@ -125,12 +125,41 @@ private:
         problems.push_back(to_string(w));
       return control::call_error(Status::BadRequest, fmt::format("{}", fmt::join(problems, "\n")));
     }
+    if (auto unsupported = unsupported_connections(); !unsupported.empty())
+      return control::call_error(Status::BadRequest,
+                                 fmt::format("{}", fmt::join(unsupported, "\n")));
     if (auto joined = s_.channels->join(channel_members()); !joined)
       return joined;
     joined_channels_ = true;
     detail_ = fmt::format("{} components, {} connections", count_instances(),
                           request_.profile->sad->connections.size());
     return {};
+  }
+
+  // Connections rsca cannot make yet, each named with why: refused here rather than left out.
+  std::vector<std::string> unsupported_connections() const {
+    using Kind = profile::EndpointTarget::Kind;
+    std::vector<std::string> out;
+    const auto &sad = *request_.profile->sad;
+    for (std::size_t i = 0; i < sad.connections.size(); ++i) {
+      const auto &c = sad.connections[i];
+      const std::string id = connection_id(c, i);
+      for (const auto *end : {&c.uses.target, &c.provides.target}) {
+        if (end->kind == Kind::DeviceThatLoadedThisComponent ||
+            end->kind == Kind::DeviceUsedByThisComponent)
+          out.push_back(
+              fmt::format("connection {}: connections to device ports are not supported yet", id));
+        else if (end->kind == Kind::FindBy && !end->findby.is_event_channel())
+          out.push_back(fmt::format("connection {}: only event channels can be found by findby; "
+                                    "\"{}\" is not one",
+                                    id, end->findby.name));
+      }
+      if (c.provides.kind == profile::ProvidesEnd::Kind::SupportedInterface)
+        out.push_back(fmt::format("connection {}: connections to a component's supported interface "
+                                  "are not supported yet",
+                                  id));
+    }
+    return out;
   }
 
   // This application's publishers and subscribers of event channels, by channel name.

@@ -291,3 +291,16 @@ TEST_CASE("runtime connections between running applications: made, checked, carr
   REQUIRE(domain.call("app.release", Json{{"app", "b"}}).has_value());
   domain.require_clean(pids);
 }
+
+TEST_CASE("a connection rsca cannot make is refused before anything runs, not left out",
+          "[integration][connections][failure]") {
+  TestDomain domain;
+  domain.install("FoundByName");
+  auto [rc, out] = domain.cli({"launch", "FoundByName"});
+  INFO(out);
+  CHECK(rc == 1);
+  CHECK_THAT(out, Catch::Contains("failed at step 'check'"));
+  CHECK_THAT(out, Catch::Contains("connection elsewhere: only event channels can be found by "
+                                  "findby; \"Elsewhere\" is not one"));
+  domain.require_clean({});
+}
