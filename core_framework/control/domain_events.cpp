@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "common/dds_names.hpp"
 #include "ports.h" // generated from dds/ports.idl
 
 namespace rsca::control {
@@ -19,10 +20,7 @@ std::uint64_t now_ns() {
 } // namespace
 
 std::string domain_events_topic(const std::string &domain) {
-  std::string name;
-  for (char c : domain)
-    name += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
-  return fmt::format("rsca_{}_domain_events", name);
+  return fmt::format("rsca_{}_domain_events", dds_name(domain));
 }
 
 dds::Qos domain_events_qos() {

@@ -7,6 +7,7 @@
 #include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
+#include "common/dds_names.hpp"
 #include "common/elapsed.hpp"
 #include "dds/port_qos.hpp"
 #include "profile/property_binding.hpp"
@@ -58,13 +59,6 @@ CallResult<void> call_all(control::Endpoint &endpoint, const std::vector<Call> &
   return first_failure(calls, call_each_of(endpoint, calls, timeout));
 }
 
-std::string sanitize(std::string_view text) {
-  std::string out;
-  for (char c : text)
-    out += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
-  return out;
-}
-
 bool is_execparam_only(const profile::PropertyDefinition &d) {
   const auto &c = profile::common_of(d);
   return c.has_kind(profile::PropertyKind::ExecParam) &&
@@ -76,7 +70,7 @@ bool is_execparam_only(const profile::PropertyDefinition &d) {
 
 std::string ApplicationFactory::topic_name(const std::string &domain, const std::string &app,
                                            const std::string &connection) {
-  return fmt::format("rsca_{}_{}_{}", sanitize(domain), sanitize(app), sanitize(connection));
+  return fmt::format("rsca_{}_{}_{}", dds_name(domain), dds_name(app), dds_name(connection));
 }
 
 // The state of one launch, step by step, and how to undo it.

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "common/dds_names.hpp"
 #include "dds/port_qos.hpp"
 
 namespace rsca::domain {
@@ -14,13 +15,6 @@ namespace {
 using control::CallResult;
 using control::Json;
 using control::Status;
-
-std::string sanitize(std::string_view text) {
-  std::string out;
-  for (char c : text)
-    out += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
-  return out;
-}
 
 } // namespace
 
@@ -72,7 +66,7 @@ CallResult<RuntimeConnection> ConnectionManager::connect(const PortRef &uses,
       c.id = fmt::format("runtime_{}", ++next_);
     if (connections_.count(c.id) != 0)
       return control::call_error(Status::Rejected, fmt::format("a connection {} exists", c.id));
-    c.topic = fmt::format("rsca_{}_runtime_{}", sanitize(domain_), sanitize(c.id));
+    c.topic = fmt::format("rsca_{}_runtime_{}", dds_name(domain_), dds_name(c.id));
     connections_[c.id] = c; // reserved; removed again on failure
   }
   auto body = [&](const PortRef &end, const char *direction) {

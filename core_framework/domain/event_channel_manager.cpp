@@ -7,6 +7,7 @@
 #include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
+#include "common/dds_names.hpp"
 #include "dds/port_qos.hpp"
 
 namespace rsca::domain {
@@ -14,13 +15,6 @@ namespace {
 
 using control::Status;
 using Role = ChannelMember::Role;
-
-std::string sanitize(std::string_view text) {
-  std::string out;
-  for (char c : text)
-    out += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
-  return out;
-}
 
 std::string end_of(const ChannelMember &m) {
   return fmt::format("{}/{}.{}", m.application, m.component, m.port);
@@ -33,7 +27,7 @@ std::string_view to_string(ChannelMember::Role role) {
 }
 
 std::string EventChannelManager::topic_of(const std::string &name) const {
-  return fmt::format("rsca_{}_channel_{}", sanitize(domain_), sanitize(name));
+  return fmt::format("rsca_{}_channel_{}", dds_name(domain_), dds_name(name));
 }
 
 std::optional<std::string> EventChannelManager::misfit(const EventChannel &channel,

@@ -53,13 +53,7 @@ public:
              fmt::format("rsca-it-{}-{}", getpid(), std::random_device{}())) {
     fs::create_directories(run_ / "logs");
     env_ = {{"RSCA_DDS_DOMAIN", std::to_string(rsca::test::isolated_domain_id())}};
-    domaind_ = std::make_unique<ChildProcess>(
-        (kBin / "rsca-domaind").string(),
-        std::vector<std::string>{
-            "--dmd", (kSource / "profiles/dom/domain/DomainManager.dmd.xml").string(),
-            "--repository", (run_ / "repository").string(), "--registration-timeout-ms",
-            std::to_string(registration_timeout_ms)},
-        env_);
+    start_domaind(registration_timeout_ms);
     for (const auto &dcd : dcds)
       nodes_.push_back(std::make_unique<ChildProcess>(
           (kBin / "rsca-noded").string(),
@@ -174,6 +168,11 @@ public:
   void restart_domaind(int registration_timeout_ms = 3000) {
     domaind_->signal(SIGTERM);
     REQUIRE(domaind_->wait_exit(5s).has_value());
+    start_domaind(registration_timeout_ms);
+  }
+
+  // A domain daemon on this domain's repository.
+  void start_domaind(int registration_timeout_ms) {
     domaind_ = std::make_unique<ChildProcess>(
         (kBin / "rsca-domaind").string(),
         std::vector<std::string>{
