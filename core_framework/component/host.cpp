@@ -233,9 +233,37 @@ PortBase *Host::find_port(const std::string &name) const {
 
 void Host::poll_ports() {
   const bool deliver = delivering_.load();
-  for (const auto &port : c().ports_)
-    if (port->direction() == profile::PortDirection::Provides)
-      port->take_all(deliver);
+  std::vector<ConnectionProblem> problems;
+  for (const auto &port : c().ports_) {
+    if (port->direction() != profile::PortDirection::Provides)
+      continue;
+    port->take_all(deliver);
+    for (auto &p : port->take_problems())
+      problems.push_back(std::move(p));
+  }
+  report_problems(std::move(problems));
+}
+
+void Host::report_problems(std::vector<ConnectionProblem> problems) {
+  for (const auto &p : problems)
+    unreported_problems_[{p.connection, p.problem}] += p.count;
+  const auto now = std::chrono::steady_clock::now();
+  if (unreported_problems_.empty() || now - last_problem_report_ < std::chrono::seconds(1))
+    return;
+  last_problem_report_ = now;
+  const std::string domain = c().context().domain.empty() ? "rsca" : c().context().domain;
+  for (const auto &[key, count] : unreported_problems_) {
+    log().warn("connection {}: {} ({} times)", key.first, key.second, count);
+    // Not waited for: the receive thread never blocks on the domain.
+    endpoint_->call(domain + "/domain", "domain.connection_problem",
+                    Json{{"application", c().context().application},
+                         {"component", c().context().name},
+                         {"connection", key.first},
+                         {"problem", key.second},
+                         {"count", count}},
+                    std::chrono::seconds(2));
+  }
+  unreported_problems_.clear();
 }
 
 // ---- The service thread

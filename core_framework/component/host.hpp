@@ -7,6 +7,7 @@
 #include <atomic>
 #include <condition_variable>
 #include <functional>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -57,6 +58,8 @@ private:
   void set_state(State state);
   PortBase *find_port(const std::string &name) const;
   void poll_ports();
+  // Tells the domain of connection problems, at most once a second (only the receive thread).
+  void report_problems(std::vector<ConnectionProblem> problems);
   void start_service();
   void stop_service();
   void service_loop();
@@ -84,6 +87,8 @@ private:
 
   std::mutex lifecycle_; // one lifecycle operation at a time
   std::atomic<bool> delivering_{false};
+  std::map<std::pair<std::string, std::string>, std::uint32_t> unreported_problems_;
+  std::chrono::steady_clock::time_point last_problem_report_{};
 
   std::mutex service_mutex_;
   std::condition_variable service_wake_;

@@ -30,6 +30,8 @@ struct DataConnection {
   ~DataConnection() {
     if (loop != nullptr && read_condition)
       loop->detach(read_condition.get());
+    if (loop != nullptr && entity)
+      loop->detach(entity.get());
   }
 };
 
@@ -140,6 +142,11 @@ Expected<std::unique_ptr<DataConnection>> open_reader(dds_entity_t participant,
   c->read_condition = std::move(*condition);
   if (auto attached = loop->attach(c->read_condition.get()); !attached)
     return tl::unexpected(attached.error());
+  // The loop also wakes when the writer misses the deadline or loses its liveliness.
+  dds_set_status_mask(c->entity.get(),
+                      DDS_REQUESTED_DEADLINE_MISSED_STATUS | DDS_LIVELINESS_CHANGED_STATUS);
+  if (auto attached = loop->attach(c->entity.get()); !attached)
+    return tl::unexpected(attached.error());
   c->loop = loop;
   return c;
 }
@@ -210,6 +217,26 @@ std::vector<ConnectionStatus> PortBase::status() const {
   for (const auto &[id, c] : connections_)
     out.push_back({id, c->topic_name, matched_count(c->entity.get(), direction_), c->samples.load(),
                    c->filtered.load()});
+  return out;
+}
+
+std::vector<ConnectionProblem> PortBase::take_problems() {
+  std::vector<ConnectionProblem> out;
+  if (direction_ != profile::PortDirection::Provides)
+    return out;
+  std::shared_lock lock(mutex_);
+  for (const auto &[id, c] : connections_) {
+    dds_requested_deadline_missed_status_t deadline{};
+    if (dds_get_requested_deadline_missed_status(c->entity.get(), &deadline) == 0 &&
+        deadline.total_count_change > 0)
+      out.push_back(
+          {id, "deadline missed", static_cast<std::uint32_t>(deadline.total_count_change)});
+    dds_liveliness_changed_status_t liveliness{};
+    if (dds_get_liveliness_changed_status(c->entity.get(), &liveliness) == 0 &&
+        liveliness.not_alive_count_change > 0)
+      out.push_back(
+          {id, "liveliness lost", static_cast<std::uint32_t>(liveliness.not_alive_count_change)});
+  }
   return out;
 }
 

@@ -36,6 +36,14 @@ struct ConnectionStatus {
   std::uint64_t filtered = 0; // provides: received but not delivered (the content filter)
 };
 
+// A QoS problem of a provides port's connection since it was last reported: the writer missed
+// the deadline the connection asks for, or lost its liveliness.
+struct ConnectionProblem {
+  std::string connection;
+  std::string problem; // "deadline missed", "liveliness lost"
+  std::uint32_t count = 0;
+};
+
 // How many connections a write reached, or why one failed (the others were still written).
 using WriteResult = tl::expected<std::size_t, std::string>;
 
@@ -59,6 +67,8 @@ public:
   bool disconnect(const std::string &connection);
   void disconnect_all();
   std::vector<ConnectionStatus> status() const;
+  // Provides ports: the QoS problems of each connection since the last call.
+  std::vector<ConnectionProblem> take_problems();
   // Takes what every connection received; hands it to the callback when `deliver`.
   virtual void take_all(bool deliver);
   // Returns once no callback of this port is running (one that starts later sees the caller's

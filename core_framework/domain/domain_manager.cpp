@@ -200,6 +200,7 @@ struct DomainManager::Impl {
   Json runtime_end_state(const PortRef &end, const std::string &connection);
   CallResult<Json> destroy_connection(const Json &body);
   CallResult<Json> component_exited(const Json &body);
+  CallResult<Json> connection_problem(const Json &body);
   std::string unique_name(const std::string &wanted) const;
   CallResult<std::string> target_of(const Application &app, const Json &body) const;
 };
@@ -677,6 +678,22 @@ CallResult<Json> DomainManager::Impl::component_exited(const Json &body) {
   return Json::object();
 }
 
+// A component saw its writer miss a connection's deadline or lose liveliness.
+CallResult<Json> DomainManager::Impl::connection_problem(const Json &body) {
+  const Json details{{"application", body.value("application", "")},
+                     {"component", body.value("component", "")},
+                     {"connection", body.value("connection", "")},
+                     {"problem", body.value("problem", "")},
+                     {"count", body.value("count", 0)}};
+  spdlog::warn("connection {} of application {} ({}): {} ({} times)",
+               details.at("connection").get<std::string>(),
+               details.at("application").get<std::string>(),
+               details.at("component").get<std::string>(), details.at("problem").get<std::string>(),
+               details.at("count").get<int>());
+  events->publish("connection.problem", details);
+  return Json::object();
+}
+
 void DomainManager::Impl::on_announcement(const control::AnnouncementEvent &event) {
   if (event.kind == control::AnnouncementEvent::Kind::Alive && event.endpoint_kind == "node") {
     const std::string node = event.body.value("node", event.address);
@@ -728,6 +745,7 @@ void DomainManager::Impl::serve() {
   bind0("domain.nodes", &Impl::list_nodes);
   bind0("domain.devices", &Impl::list_devices);
   bind("domain.component_exited", &Impl::component_exited);
+  bind("domain.connection_problem", &Impl::connection_problem);
   bind("app.create", &Impl::create_application);
   bind("app.plan", &Impl::plan_application);
   bind0("channel.list", &Impl::list_channels);

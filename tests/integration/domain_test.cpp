@@ -290,3 +290,35 @@ TEST_CASE("the domain publishes what happens to it, and rsca events follows it",
                                           "application.released", "node.removed"});
   domain.require_clean(pids_of(*app));
 }
+
+TEST_CASE("a deadline the writer stops meeting is reported as a domain event",
+          "[integration][domain][events]") {
+  TestDomain domain;
+  auto [rc, out] = domain.cli(
+      {"launch",
+       (kSource / "profiles/dom/waveforms/ProducerConsumer/ProducerConsumer.sad.xml").string()});
+  REQUIRE(rc == 0);
+  auto app = domain.call("app.show", Json{{"app", "ProducerConsumer"}});
+  REQUIRE(app.has_value());
+  // The connection asks for a sample every 100 ms at least; at 2 Hz the producer misses it.
+  REQUIRE(domain.cli({"configure", "ProducerConsumer/Producer_1", "rate_hz=2"}).first == 0);
+  Json problem;
+  CHECK(TestDomain::wait_for([&] {
+    auto [erc, events] = domain.cli({"--json", "events", "--wait-ms", "300"});
+    std::istringstream lines(events);
+    for (std::string line; std::getline(lines, line);) {
+      const Json event = Json::parse(line, nullptr, false);
+      if (!event.is_discarded() && event.value("kind", "") == "connection.problem")
+        problem = event.at("details");
+    }
+    return !problem.is_null();
+  }));
+  INFO(problem.dump());
+  CHECK(problem.value("application", "") == "ProducerConsumer");
+  CHECK(problem.value("component", "") == "Consumer_1");
+  CHECK(problem.value("connection", "") == "samples");
+  CHECK(problem.value("problem", "") == "deadline missed");
+  CHECK(problem.value("count", 0) > 0);
+  REQUIRE(domain.call("app.release", Json{{"app", "ProducerConsumer"}}).has_value());
+  domain.require_clean(pids_of(*app));
+}
