@@ -27,6 +27,8 @@ namespace rsca::allocator {
 struct DeviceLoad {
   std::map<std::string, double> allocated;
   std::vector<std::vector<Task>> cpu_tasks; // one task set per CPU (empty: none yet)
+
+  friend bool operator==(const DeviceLoad &, const DeviceLoad &) = default;
 };
 
 struct DeviceState {

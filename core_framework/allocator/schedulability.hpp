@@ -28,6 +28,8 @@ struct Task {
                    // D > T is allowed (several jobs of a task may then be pending at once).
   // Fixed priority, larger = more urgent; none = deadline monotonic. Ignored by EDF.
   std::optional<std::uint32_t> priority;
+
+  friend bool operator==(const Task &, const Task &) = default;
 };
 
 enum class SchedulingPolicy : std::uint8_t { FixedPriority, Edf };

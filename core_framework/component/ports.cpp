@@ -225,7 +225,13 @@ std::vector<ConnectionProblem> PortBase::take_problems() {
   if (direction_ != profile::PortDirection::Provides)
     return out;
   std::shared_lock lock(mutex_);
+  constexpr std::uint32_t kProblems =
+      DDS_REQUESTED_DEADLINE_MISSED_STATUS | DDS_LIVELINESS_CHANGED_STATUS;
   for (const auto &[id, c] : connections_) {
+    // One cheap look at the triggered statuses: this runs at every wake of the receive loop.
+    std::uint32_t changed = 0;
+    if (dds_get_status_changes(c->entity.get(), &changed) != 0 || (changed & kProblems) == 0)
+      continue;
     dds_requested_deadline_missed_status_t deadline{};
     if (dds_get_requested_deadline_missed_status(c->entity.get(), &deadline) == 0 &&
         deadline.total_count_change > 0)

@@ -3,6 +3,7 @@
 // against a brute-force search. Silent on success; a failure prints the seed and the case.
 #include "allocator/planner.hpp"
 #include "allocator/resource_allocator.hpp"
+#include "planner_state.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -312,40 +313,6 @@ std::string describe(const Plan &plan) {
   return out.str();
 }
 
-bool same_tasks(const std::vector<std::vector<Task>> &a, const std::vector<std::vector<Task>> &b) {
-  auto non_empty = [](const std::vector<std::vector<Task>> &sets) {
-    std::size_t n = sets.size();
-    while (n > 0 && sets[n - 1].empty())
-      --n;
-    return n;
-  };
-  if (non_empty(a) != non_empty(b))
-    return false;
-  for (std::size_t cpu = 0; cpu < non_empty(a); ++cpu) {
-    if (a[cpu].size() != b[cpu].size())
-      return false;
-    for (std::size_t k = 0; k < a[cpu].size(); ++k)
-      if (a[cpu][k].id != b[cpu][k].id || a[cpu][k].period != b[cpu][k].period ||
-          a[cpu][k].execution != b[cpu][k].execution || a[cpu][k].priority != b[cpu][k].priority)
-        return false;
-  }
-  return true;
-}
-
-// Bit-exact equality of what is reserved (a rejected allocation must not touch anything).
-bool same_load(const DomainState &a, const DomainState &b) {
-  if (a.size() != b.size())
-    return false;
-  for (const auto &[id, s] : a) {
-    auto it = b.find(id);
-    if (it == b.end() || it->second.load.allocated != s.load.allocated ||
-        it->second.load.cpu_tasks.size() != s.load.cpu_tasks.size() ||
-        !same_tasks(it->second.load.cpu_tasks, s.load.cpu_tasks))
-      return false;
-  }
-  return true;
-}
-
 // Equality within kTolerance, a capacity absent counting as zero (release leaves zeros behind).
 bool close_load(const DomainState &a, const DomainState &b) {
   if (a.size() != b.size())
@@ -363,7 +330,7 @@ bool close_load(const DomainState &a, const DomainState &b) {
       if (std::abs(amount(s.load.allocated, name) - amount(it->second.load.allocated, name)) >
           kTolerance)
         return false;
-    if (!same_tasks(s.load.cpu_tasks, it->second.load.cpu_tasks))
+    if (!(s.load.cpu_tasks == it->second.load.cpu_tasks))
       return false;
   }
   return true;
@@ -455,7 +422,7 @@ TEST_CASE("planner property: ResourceAllocator is all or nothing and release rou
       FAIL("allocate and make_plan disagree\n" << describe(c));
     if (!result) {
       // (c) a rejection reserves nothing.
-      if (!same_load(allocator.snapshot(), before))
+      if (!rsca::test::same_load(allocator.snapshot(), before))
         FAIL("a rejected allocate changed the state\n"
              << describe(c) << "before:\n"
              << describe(before) << "after:\n"

@@ -3,6 +3,7 @@
 // by hand in a comment next to it.
 #include "allocator/planner.hpp"
 #include "allocator/resource_allocator.hpp"
+#include "planner_state.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -206,35 +207,6 @@ std::string device_of(const Plan &plan, const std::string &instance) {
 
 std::string implementation_of(const Plan &plan, const std::string &instance) {
   return placement_of(plan, instance).implementation->id;
-}
-
-bool same_tasks(const std::vector<std::vector<Task>> &a, const std::vector<std::vector<Task>> &b) {
-  if (a.size() != b.size())
-    return false;
-  for (std::size_t cpu = 0; cpu < a.size(); ++cpu) {
-    if (a[cpu].size() != b[cpu].size())
-      return false;
-    for (std::size_t k = 0; k < a[cpu].size(); ++k) {
-      const Task &x = a[cpu][k], &y = b[cpu][k];
-      if (x.id != y.id || x.period != y.period || x.execution != y.execution ||
-          x.deadline != y.deadline || x.priority != y.priority)
-        return false;
-    }
-  }
-  return true;
-}
-
-// Exact equality of what is reserved: a rejected allocation must not touch a single bit.
-bool same_load(const DomainState &a, const DomainState &b) {
-  if (a.size() != b.size())
-    return false;
-  for (const auto &[id, s] : a) {
-    auto it = b.find(id);
-    if (it == b.end() || it->second.load.allocated != s.load.allocated ||
-        !same_tasks(it->second.load.cpu_tasks, s.load.cpu_tasks))
-      return false;
-  }
-  return true;
 }
 
 double allocated(const DomainState &state, const std::string &device, const std::string &capacity) {
@@ -890,7 +862,7 @@ TEST_CASE("planner: ResourceAllocator commits whole plans and gives everything b
 
   const auto planned = allocator.plan(app1, {});
   REQUIRE(planned.has_value());
-  CHECK(same_load(allocator.snapshot(), empty)); // plan() reserves nothing
+  CHECK(rsca::test::same_load(allocator.snapshot(), empty)); // plan() reserves nothing
 
   const auto first = allocator.allocate(app1, {});
   REQUIRE(first.has_value());
@@ -906,7 +878,7 @@ TEST_CASE("planner: ResourceAllocator commits whole plans and gives everything b
     PlanRequest app2 = request_of({component("x", big), component("y", big)});
     app2.components[0].collocation = app2.components[1].collocation = "g";
     CHECK_FALSE(allocator.allocate(app2, {}).has_value());
-    CHECK(same_load(allocator.snapshot(), after_first));
+    CHECK(rsca::test::same_load(allocator.snapshot(), after_first));
   }
 
   SECTION("release gives everything back") {
@@ -927,7 +899,7 @@ TEST_CASE("planner: ResourceAllocator commits whole plans and gives everything b
     REQUIRE(s.size() == 3);
     CHECK(s.at("n1:GPP").device.capacity.at(kCpuCapacity) == 200); // the new description
     CHECK(s.at("n1:GPP").load.allocated == after_first.at("n1:GPP").load.allocated);
-    CHECK(same_tasks(s.at("n1:GPP").load.cpu_tasks, after_first.at("n1:GPP").load.cpu_tasks));
+    CHECK((s.at("n1:GPP").load.cpu_tasks == after_first.at("n1:GPP").load.cpu_tasks));
     CHECK(s.at("n1:GPP_2").load.allocated.empty());
     CHECK(s.at("n2:GPP").load.allocated == after_first.at("n2:GPP").load.allocated);
 
@@ -942,6 +914,6 @@ TEST_CASE("planner: ResourceAllocator commits whole plans and gives everything b
     REQUIRE(s.size() == 1);
     CHECK(s.count("n2:GPP") == 1);
     allocator.release(*first); // its devices are gone: nothing to give back, nothing breaks
-    CHECK(same_load(allocator.snapshot(), s));
+    CHECK(rsca::test::same_load(allocator.snapshot(), s));
   }
 }
