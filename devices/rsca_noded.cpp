@@ -8,6 +8,7 @@
 #include "common/termination_signals.hpp"
 #include "dds/participant.hpp"
 #include "gpp/gpp_device.hpp"
+#include "monitor/host_monitor.hpp"
 #include "node/device_manager.hpp"
 
 namespace {
@@ -51,6 +52,7 @@ int main(int argc, char **argv) {
 
   rsca::node::DeviceRegistry registry;
   rsca::gpp::register_gpp(registry);
+  rsca::monitor::register_host_monitor(registry);
   auto participant = rsca::dds::Participant::create(rsca::dds::DdsSettings::from_environment());
   if (!participant) {
     spdlog::error("{}", participant.error().to_string());

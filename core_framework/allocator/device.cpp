@@ -79,6 +79,8 @@ std::map<std::string, std::string> deployer_requires_of(const profile::Component
   return out;
 }
 
+} // namespace
+
 Device describe_offline(const std::string &node, const std::string &id,
                         const profile::ComponentInstantiation &ci,
                         const profile::ResolvedSoftPkg &pkg) {
@@ -108,8 +110,6 @@ Device describe_offline(const std::string &node, const std::string &id,
   device.cpus = cpus_of(device, cores);
   return device;
 }
-
-} // namespace
 
 const MatchingProperty *Device::find_property(std::string_view id_or_name) const {
   for (const auto &p : properties)

@@ -66,5 +66,9 @@ Device device_from_announcement(const std::string &node, const nlohmann::json &e
 // The devices a DCD declares, described from their PRFs and the DCD's overrides alone (nothing
 // is measured): what offline planning (`rsca plan --node DCD`) places on.
 std::vector<Device> devices_of_node(const profile::ResolvedNode &node);
+// One device of a DCD, described the same way.
+Device describe_offline(const std::string &node, const std::string &id,
+                        const profile::ComponentInstantiation &ci,
+                        const profile::ResolvedSoftPkg &pkg);
 
 } // namespace rsca::allocator

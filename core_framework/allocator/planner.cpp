@@ -380,7 +380,21 @@ private:
   }
 
   // The step that places component `i` on the candidate, or why it does not fit now.
-  tl::expected<Step, std::string> try_candidate(std::size_t i, const Candidate &candidate) const {
+  static bool uses_any_device(const ComponentRequest &c) {
+    if (c.softpkg == nullptr)
+      return false;
+    if (c.softpkg->spd && !c.softpkg->spd->uses_devices.empty())
+      return true;
+    return std::any_of(
+        c.softpkg->implementations.begin(), c.softpkg->implementations.end(), [](const auto &impl) {
+          return impl.implementation != nullptr && !impl.implementation->uses_devices.empty();
+        });
+  }
+
+  // The step that places component `i` on the candidate, or why it does not fit now. The devices
+  // it uses are looked for on the candidate's node, or anywhere with `remote_devices`.
+  tl::expected<Step, std::string> try_candidate(std::size_t i, const Candidate &candidate,
+                                                bool remote_devices) const {
     const auto &c = request_.components[i];
     const auto &s = *candidate.state;
     const auto &impl = *candidate.implementation->implementation;
@@ -408,8 +422,16 @@ private:
     }
     // What this step reserves so far: its own usesdevice entries must not count a device twice.
     Reservations pending{{candidate.device, step.placement.demand}};
-    for (const auto &uses : impl.uses_devices) {
-      auto used = find_used_device(uses, s.device.node, pending);
+    // The softpkg's usesdevice apply to every implementation; the implementation adds its own.
+    std::vector<const profile::UsesDevice *> all_uses;
+    if (c.softpkg != nullptr && c.softpkg->spd)
+      for (const auto &uses : c.softpkg->spd->uses_devices)
+        all_uses.push_back(&uses);
+    for (const auto &uses : impl.uses_devices)
+      all_uses.push_back(&uses);
+    for (const auto *uses_ptr : all_uses) {
+      const auto &uses = *uses_ptr;
+      auto used = find_used_device(uses, remote_devices ? "" : s.device.node, pending);
       if (!used)
         return tl::unexpected(used.error());
       add(pending[used->device], used->demand, +1);
@@ -439,9 +461,10 @@ private:
       if (first_reason.empty())
         first_reason = fmt::format("{}: {}", id, *why);
     }
-    return tl::unexpected(fmt::format("usesdevice {}: no device {}{}", uses.id,
-                                      node.empty() ? "in the domain" : "on node " + node + " fits",
-                                      first_reason.empty() ? "" : " (" + first_reason + ")"));
+    return tl::unexpected(
+        fmt::format("usesdevice {}: no device {}{}", uses.id,
+                    node.empty() ? "in the domain fits" : "on node " + node + " fits",
+                    first_reason.empty() ? "" : " (" + first_reason + ")"));
   }
 
   void apply(Step &step, double sign) {
@@ -470,32 +493,40 @@ private:
     const auto &c = request_.components[i];
     bool any_fit = false;
     std::vector<std::string> reasons;
-    for (const auto &candidate : ranked(i)) {
-      if (++tries_ > options_.budget) {
-        budget_exhausted_ = true;
-        return false;
+    const auto candidates = ranked(i);
+    // A component prefers the nodes of the devices it uses; only when no candidate has them at
+    // hand does it use them across the network (their ports are DDS connections either way).
+    const int passes = uses_any_device(c) ? 2 : 1;
+    for (int pass = 0; pass < passes; ++pass) {
+      reasons.clear(); // the broadest attempt explains a rejection
+      for (const auto &candidate : candidates) {
+        if (++tries_ > options_.budget) {
+          budget_exhausted_ = true;
+          return false;
+        }
+        auto step = try_candidate(i, candidate, /*remote_devices=*/pass == 1);
+        if (!step) {
+          reasons.push_back(fmt::format("{} ({}): {}", candidate.device,
+                                        candidate.implementation->implementation->id,
+                                        step.error()));
+          continue;
+        }
+        any_fit = true;
+        const bool opens_group = !c.collocation.empty() && group_node_.count(c.collocation) == 0;
+        if (opens_group)
+          group_node_[c.collocation] = step->placement.node;
+        node_of_[c.instance] = step->placement.node;
+        apply(*step, +1);
+        steps_[k] = std::move(*step);
+        if (place(k + 1))
+          return true;
+        apply(steps_[k], -1);
+        node_of_.erase(c.instance);
+        if (opens_group)
+          group_node_.erase(c.collocation);
+        if (budget_exhausted_)
+          return false;
       }
-      auto step = try_candidate(i, candidate);
-      if (!step) {
-        reasons.push_back(fmt::format("{} ({}): {}", candidate.device,
-                                      candidate.implementation->implementation->id, step.error()));
-        continue;
-      }
-      any_fit = true;
-      const bool opens_group = !c.collocation.empty() && group_node_.count(c.collocation) == 0;
-      if (opens_group)
-        group_node_[c.collocation] = step->placement.node;
-      node_of_[c.instance] = step->placement.node;
-      apply(*step, +1);
-      steps_[k] = std::move(*step);
-      if (place(k + 1))
-        return true;
-      apply(steps_[k], -1);
-      node_of_.erase(c.instance);
-      if (opens_group)
-        group_node_.erase(c.collocation);
-      if (budget_exhausted_)
-        return false;
     }
     if (!any_fit && blocked_ == nullptr_index) {
       blocked_ = i;

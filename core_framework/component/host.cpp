@@ -1,6 +1,7 @@
 #include "component/host.hpp"
 
 #include <algorithm>
+#include <tuple>
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -162,6 +163,7 @@ Expected<void> Host::open(std::shared_ptr<dds::Participant> participant,
   serve("component.start", &Host::op_start);
   serve("component.stop", &Host::op_stop);
   serve("component.status", &Host::op_status);
+  serve("component.await_matched", &Host::op_await_matched);
   serve("component.release", &Host::op_release);
   std::lock_guard lock(lifecycle_);
   return endpoint_->announce("component", announcement());
@@ -196,7 +198,21 @@ void Host::serve(const std::string &operation, Operation op) {
       });
 }
 
-Json Host::announcement() const {
+Expected<void> Host::bring_up(const Json &properties) {
+  const std::string where = softpkg_->spd_path.string();
+  for (const auto &[name, operation, body] :
+       {std::tuple{"initialize", &Host::op_initialize, Json::object()},
+        std::tuple{"configure", &Host::op_configure, Json{{"properties", properties}}},
+        std::tuple{"start", &Host::op_start, Json::object()}}) {
+    if (std::string_view(name) == "configure" && properties.empty())
+      continue;
+    if (auto ok = (this->*operation)(body); !ok)
+      return make_error({where, 0, 0}, name, ok.error().message);
+  }
+  return {};
+}
+
+Json Host::ports_json() const {
   Json ports = Json::array();
   for (const auto &port : c().ports_) {
     const auto *definition =
@@ -206,12 +222,16 @@ Json Host::announcement() const {
          {"direction", direction_name(port->direction())},
          {"repid", definition ? definition->repid : std::string(port::repid_of(port->type()))}});
   }
+  return ports;
+}
+
+Json Host::announcement() const {
   return {{"id", c().identifier()},
           {"name", c().name()},
           {"application", c().context().application},
           {"pid", ::getpid()},
           {"state", to_string(c().state())},
-          {"ports", ports}};
+          {"ports", ports_json()}};
 }
 
 // Called with lifecycle_ held.
@@ -489,6 +509,52 @@ CallResult<Json> Host::op_status(const Json &) {
                      {"connections", std::move(connections)}});
   }
   return Json{{"state", to_string(c().state())}, {"ports", std::move(ports)}};
+}
+
+// Waits, bounded, until each named connection has matched the peers the domain expects: a
+// launch starts its components only once their first samples will find their readers. Replies
+// with what each connection matched; "complete" says whether all got there in time.
+CallResult<Json> Host::op_await_matched(const Json &body) {
+  struct Awaited {
+    const PortBase *port;
+    std::string connection;
+    std::int32_t peers;
+    std::int32_t matched = 0;
+  };
+  std::vector<Awaited> awaited;
+  for (const auto &entry : body.value("connections", Json::array())) {
+    const PortBase *port = find_port(entry.value("port", ""));
+    if (port == nullptr)
+      return control::call_error(Status::NotFound,
+                                 fmt::format("no port \"{}\"", entry.value("port", "")));
+    awaited.push_back({port, entry.value("connection", ""), entry.value("peers", 1)});
+  }
+  const auto deadline =
+      std::chrono::steady_clock::now() + std::chrono::milliseconds(body.value("timeout_ms", 2000));
+  auto all_matched = [&awaited] {
+    bool all = true;
+    for (auto &a : awaited) {
+      a.matched = a.port->matched(a.connection).value_or(0);
+      all = all && a.matched >= a.peers;
+    }
+    return all;
+  };
+  // Discovery runs on Cyclone's threads; polling the matched counts costs nothing measurable
+  // and keeps the readers' status masks (the receive loop's) untouched.
+  auto pause = std::chrono::microseconds(50);
+  bool complete = all_matched();
+  while (!complete && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(pause);
+    pause = std::min(pause * 2, std::chrono::microseconds(2000));
+    complete = all_matched();
+  }
+  Json connections = Json::array();
+  for (const auto &a : awaited)
+    connections.push_back({{"port", a.port->name()},
+                           {"connection", a.connection},
+                           {"peers", a.peers},
+                           {"matched", a.matched}});
+  return Json{{"complete", complete}, {"connections", std::move(connections)}};
 }
 
 CallResult<Json> Host::op_release(const Json &) {

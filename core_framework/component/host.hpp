@@ -45,6 +45,11 @@ public:
                       std::function<void()> on_released);
   // Stops (when started) and releases the component and drops its connections. Idempotent.
   void shutdown(std::string_view why);
+  // Initializes, configures with `properties` and starts the component: what the domain would
+  // ask, for a component its own process brings up (a device in its node).
+  Expected<void> bring_up(const Json &properties);
+  // The component's ports: [{"name", "direction", "repid"}].
+  Json ports_json() const;
   // Withdraws the announcement, closes the endpoint (waiting for running operations), stops the
   // threads and destroys the component. Idempotent.
   void close();
@@ -73,6 +78,7 @@ private:
   CallResult<Json> op_start(const Json &body);
   CallResult<Json> op_stop(const Json &body);
   CallResult<Json> op_status(const Json &body);
+  CallResult<Json> op_await_matched(const Json &body);
   CallResult<Json> op_release(const Json &body);
 
   Component &c() const { return *component_; }

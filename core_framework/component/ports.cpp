@@ -220,6 +220,14 @@ std::vector<ConnectionStatus> PortBase::status() const {
   return out;
 }
 
+std::optional<std::int32_t> PortBase::matched(const std::string &connection) const {
+  std::shared_lock lock(mutex_);
+  auto it = connections_.find(connection);
+  if (it == connections_.end())
+    return std::nullopt;
+  return matched_count(it->second->entity.get(), direction_);
+}
+
 std::vector<ConnectionProblem> PortBase::take_problems() {
   std::vector<ConnectionProblem> out;
   if (direction_ != profile::PortDirection::Provides)

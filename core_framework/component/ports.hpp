@@ -9,6 +9,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <shared_mutex>
 #include <string>
 #include <vector>
@@ -67,6 +68,9 @@ public:
   bool disconnect(const std::string &connection);
   void disconnect_all();
   std::vector<ConnectionStatus> status() const;
+  // The peers (readers of a uses port, writers of a provides port) one connection has matched;
+  // nothing when the port has no such connection.
+  std::optional<std::int32_t> matched(const std::string &connection) const;
   // Provides ports: the QoS problems of each connection since the last call.
   std::vector<ConnectionProblem> take_problems();
   // Takes what every connection received; hands it to the callback when `deliver`.

@@ -51,14 +51,12 @@ nlohmann::json to_json(const Application &app) {
   }
   nlohmann::json connections = nlohmann::json::array();
   for (const auto &c : app.connections)
-    connections.push_back(
-        {{"id", c.id},
-         {"uses", c.uses.component.empty() ? "" : c.uses.component + "." + c.uses.port},
-         {"provides",
-          c.provides.component.empty() ? "" : c.provides.component + "." + c.provides.port},
-         {"repid", c.repid},
-         {"topic", c.topic},
-         {"qos", c.qos}});
+    connections.push_back({{"id", c.id},
+                           {"uses", c.uses.name()},
+                           {"provides", c.provides.name()},
+                           {"repid", c.repid},
+                           {"topic", c.topic},
+                           {"qos", c.qos}});
   return {{"name", app.name},         {"installed", app.installed},
           {"sad", app.sad},           {"state", to_string(app.state)},
           {"components", components}, {"connections", connections}};

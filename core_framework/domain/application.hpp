@@ -30,9 +30,17 @@ struct ComponentInstance {
   bool assembly_controller = false;
 };
 
+// One end of a connection: a port of a component of the application, or of a device (which
+// outlives the application: its end is disconnected when the application goes).
 struct ConnectionEnd {
-  std::string component;
+  std::string component; // the component instantiation, or empty for a device
   std::string port;
+  std::string device;  // the device's id, for a device port
+  std::string address; // where the port's owner is served
+  bool empty() const { return component.empty() && device.empty(); }
+  std::string name() const {
+    return empty() ? std::string() : (device.empty() ? component : device) + "." + port;
+  }
 };
 
 struct ConnectionInstance {
@@ -44,6 +52,12 @@ struct ConnectionInstance {
   nlohmann::json qos;
   std::string filter; // a channel subscriber's content filter
 };
+
+// The id an end's owner knows the connection by: a device serves many applications, so its
+// connections go by their topic, unique in the domain; a component's by the SAD's id.
+inline const std::string &end_key(const ConnectionInstance &c, const ConnectionEnd &end) {
+  return end.device.empty() ? c.id : c.topic;
+}
 
 struct Application {
   std::string name;      // instance name, unique in the domain

@@ -139,15 +139,21 @@ private:
       const auto &c = sad.connections[i];
       const std::string id = connection_id(c, i);
       for (const auto *end : {&c.uses.target, &c.provides.target}) {
-        if (end->kind == Kind::DeviceThatLoadedThisComponent ||
-            end->kind == Kind::DeviceUsedByThisComponent)
-          out.push_back(
-              fmt::format("connection {}: connections to device ports are not supported yet", id));
-        else if (end->kind == Kind::FindBy && !end->findby.is_event_channel())
+        if (end->kind == Kind::FindBy && !end->findby.is_event_channel())
           out.push_back(fmt::format("connection {}: only event channels can be found by findby; "
                                     "\"{}\" is not one",
                                     id, end->findby.name));
       }
+      const auto is_device = [](const profile::EndpointTarget &t) {
+        return t.kind == Kind::DeviceThatLoadedThisComponent ||
+               t.kind == Kind::DeviceUsedByThisComponent;
+      };
+      if ((c.publishes_to_channel() && is_device(c.uses.target)) ||
+          (c.subscribes_to_channel() && is_device(c.provides.target)))
+        out.push_back(fmt::format(
+            "connection {}: a device port cannot be an event channel member yet: connect it "
+            "to a component port",
+            id));
       if (c.provides.kind == profile::ProvidesEnd::Kind::SupportedInterface)
         out.push_back(fmt::format("connection {}: connections to a component's supported interface "
                                   "are not supported yet",
@@ -281,24 +287,29 @@ private:
     std::vector<Call> provides_side, uses_side;
     for (std::size_t i = 0; i < sad.connections.size(); ++i) {
       const auto &c = sad.connections[i];
-      const std::string id = connection_id(c, i);
       ConnectionInstance ci;
-      ci.id = id;
+      ci.id = connection_id(c, i);
       ci.qos = dds::qos_to_json(c.qos.value_or(profile::ConnectionQos{}));
       ci.topic = c.publishes_to_channel() || c.subscribes_to_channel()
                      ? s_.channels->topic_of(channel_name(c))
-                     : topic_name(s_.domain_name, fmt::format("{}_{}", app_->name, launch_), id);
+                     : topic_name(s_.domain_name, fmt::format("{}_{}", app_->name, launch_), ci.id);
       ci.filter = c.filter.value_or("");
       ci.repid = repid_of(c);
-      if (c.uses.target.kind == profile::EndpointTarget::Kind::ComponentInstantiation) {
-        ci.uses = {c.uses.target.refid, c.uses.port};
+      auto uses = resolve_end(ci, c.uses.target, c.uses.port, profile::PortDirection::Uses);
+      if (!uses)
+        return tl::unexpected(uses.error());
+      ci.uses = std::move(*uses);
+      if (c.provides.kind == profile::ProvidesEnd::Kind::Port) {
+        auto provides =
+            resolve_end(ci, c.provides.target, c.provides.port, profile::PortDirection::Provides);
+        if (!provides)
+          return tl::unexpected(provides.error());
+        ci.provides = std::move(*provides);
+      }
+      if (!ci.uses.empty())
         uses_side.push_back(connect_call(ci, ci.uses, "uses"));
-      }
-      if (c.provides.target.kind == profile::EndpointTarget::Kind::ComponentInstantiation &&
-          c.provides.kind == profile::ProvidesEnd::Kind::Port) {
-        ci.provides = {c.provides.target.refid, c.provides.port};
+      if (!ci.provides.empty())
         provides_side.push_back(connect_call(ci, ci.provides, "provides"));
-      }
       app_->connections.push_back(std::move(ci));
     }
     // Readers first, so the first samples written find them.
@@ -306,8 +317,112 @@ private:
       return ok;
     if (auto ok = call_all(*s_.endpoint, uses_side, s_.call_timeout); !ok)
       return ok;
+    if (auto ok = await_matched(); !ok)
+      return ok;
     detail_ = fmt::format("{} connections", app_->connections.size());
     return {};
+  }
+
+  // One end of a SAD connection: a port of one of this application's components, or of the
+  // device that loaded or is used by one of them (checked against what its node announced);
+  // nothing for an event channel.
+  CallResult<ConnectionEnd> resolve_end(ConnectionInstance &ci,
+                                        const profile::EndpointTarget &target,
+                                        const std::string &port, profile::PortDirection direction) {
+    using Kind = profile::EndpointTarget::Kind;
+    if (target.kind == Kind::FindBy)
+      return ConnectionEnd{};
+    if (target.kind == Kind::ComponentInstantiation)
+      return ConnectionEnd{target.refid, port, "", app_->find_component(target.refid)->address};
+    auto device = device_of(target);
+    if (!device)
+      return control::call_error(Status::BadRequest,
+                                 fmt::format("connection {}: {}", ci.id, device.error()));
+    return device_end(ci, *device, port, direction);
+  }
+
+  tl::expected<std::string, std::string> device_of(const profile::EndpointTarget &target) const {
+    const auto *placement = placement_of(target.refid);
+    if (placement == nullptr)
+      return tl::unexpected(fmt::format("no component {} in the application", target.refid));
+    if (target.kind == profile::EndpointTarget::Kind::DeviceThatLoadedThisComponent)
+      return placement->device;
+    for (const auto &used : placement->used_devices)
+      if (used.uses_id == target.usesrefid)
+        return used.device;
+    return tl::unexpected(
+        fmt::format("component {} has no usesdevice {}", target.refid, target.usesrefid));
+  }
+
+  CallResult<ConnectionEnd> device_end(ConnectionInstance &ci, const std::string &device,
+                                       const std::string &port, profile::PortDirection direction) {
+    const char *wanted = direction == profile::PortDirection::Uses ? "uses" : "provides";
+    auto ports = s_.device_ports ? s_.device_ports(device) : std::nullopt;
+    const Json *found = nullptr;
+    if (ports)
+      for (const auto &p : ports->ports)
+        if (p.value("name", "") == port && p.value("direction", "") == wanted)
+          found = &p;
+    if (found == nullptr)
+      return control::call_error(
+          Status::BadRequest,
+          fmt::format("connection {}: device {} has no {} port {}", ci.id, device, wanted, port));
+    const std::string repid = found->value("repid", "");
+    if (ci.repid.empty())
+      ci.repid = repid;
+    if (repid != ci.repid)
+      return control::call_error(Status::BadRequest,
+                                 fmt::format("connection {}: port type: device port {}.{} carries "
+                                             "{}, but the other end carries {}",
+                                             ci.id, device, port, repid, ci.repid));
+    return ConnectionEnd{"", port, device, ports->address};
+  }
+
+  // Waits until every connection made has matched its peers in this application (a channel
+  // member: this application's members on the other side), so that nothing a component writes
+  // once started is lost to discovery still under way.
+  CallResult<void> await_matched() {
+    std::map<std::string, Json> awaited; // by address
+    auto await = [&](const ConnectionInstance &ci, const ConnectionEnd &end, int peers) {
+      if (end.empty() || peers == 0)
+        return;
+      awaited[end.address].push_back(
+          {{"port", end.port}, {"connection", end_key(ci, end)}, {"peers", peers}});
+    };
+    for (const auto &ci : app_->connections) {
+      const bool channel = ci.uses.empty() || ci.provides.empty();
+      await(ci, ci.uses, channel ? members_on(ci.topic, /*subscribers=*/true) : 1);
+      await(ci, ci.provides, channel ? members_on(ci.topic, /*subscribers=*/false) : 1);
+    }
+    std::vector<Call> calls;
+    for (auto &[address, connections] : awaited)
+      calls.push_back({address, "component.await_matched",
+                       Json{{"connections", connections}, {"timeout_ms", s_.call_timeout.count()}},
+                       address});
+    auto replies = call_each_of(*s_.endpoint, calls, 2 * s_.call_timeout);
+    if (auto ok = first_failure(calls, replies); !ok)
+      return ok;
+    std::vector<std::string> unmatched;
+    for (const auto &reply : replies)
+      for (const auto &c : reply->value("connections", Json::array()))
+        if (c.value("matched", 0) < c.value("peers", 1))
+          unmatched.push_back(fmt::format("{} on port {}: {} of {} peers matched",
+                                          c.value("connection", ""), c.value("port", ""),
+                                          c.value("matched", 0), c.value("peers", 1)));
+    if (!unmatched.empty())
+      return control::call_error(Status::Unavailable,
+                                 fmt::format("connections not matched after {} ms: {}",
+                                             s_.call_timeout.count(), fmt::join(unmatched, "; ")));
+    return {};
+  }
+
+  // This application's subscribers (or publishers) on a channel's topic.
+  int members_on(const std::string &topic, bool subscribers) const {
+    int n = 0;
+    for (const auto &ci : app_->connections)
+      if (ci.topic == topic && !(subscribers ? ci.provides : ci.uses).empty())
+        ++n;
+    return n;
   }
 
   CallResult<void> start() {
@@ -329,15 +444,15 @@ private:
   }
 
   Call connect_call(const ConnectionInstance &ci, const ConnectionEnd &end, const char *direction) {
-    return {app_->find_component(end.component)->address, "component.connect",
-            Json{{"connection", ci.id},
+    return {end.address, "component.connect",
+            Json{{"connection", end_key(ci, end)},
                  {"port", end.port},
                  {"direction", direction},
                  {"topic", ci.topic},
                  {"repid", ci.repid},
                  {"qos", ci.qos},
                  {"filter", std::string_view(direction) == "provides" ? ci.filter : ""}},
-            fmt::format("{} ({}.{})", ci.id, end.component, end.port)};
+            fmt::format("{} ({})", ci.id, end.name())};
   }
 
   std::string repid_of(const profile::Connection &c) const {
@@ -539,7 +654,24 @@ CallResult<void> ApplicationFactory::stop(Application &app) {
   return ok;
 }
 
+// Devices outlive the application: their ends of its connections go first.
+void ApplicationFactory::disconnect_devices(const Application &app) {
+  std::vector<Call> calls;
+  for (const auto &ci : app.connections)
+    for (const auto *end : {&ci.uses, &ci.provides})
+      if (!end->device.empty())
+        calls.push_back({end->address, "component.disconnect",
+                         Json{{"connection", end_key(ci, *end)}, {"port", end->port}},
+                         fmt::format("{} ({})", ci.id, end->name())});
+  const auto replies = call_each_of(*services_.endpoint, calls, services_.call_timeout);
+  for (std::size_t i = 0; i < replies.size(); ++i)
+    if (!replies[i])
+      spdlog::warn("application {}: disconnecting device end of {} failed: {}", app.name,
+                   calls[i].what, replies[i].error().message);
+}
+
 CallResult<std::vector<std::string>> ApplicationFactory::release(Application &app) {
+  disconnect_devices(app);
   std::vector<Call> releases;
   for (auto &c : app.components)
     if (c.pid != 0 && services_.components->registered(c.address))

@@ -35,6 +35,12 @@ struct LaunchRequest {
   bool start = true;
 };
 
+// A device's data ports as its node announced them.
+struct DevicePorts {
+  std::string address;
+  nlohmann::json ports; // [{"name", "direction", "repid"}]
+};
+
 // What the factory uses of the domain.
 struct DomainServices {
   std::string domain_name;
@@ -43,6 +49,7 @@ struct DomainServices {
   ComponentRegistry *components = nullptr;
   EventChannelManager *channels = nullptr;
   std::function<std::optional<std::string>(const std::string &node)> node_address;
+  std::function<std::optional<DevicePorts>(const std::string &device)> device_ports;
   // A number unique to each launch in this domain: component addresses and topics carry it, so
   // an application re-launched under the same name never meets its predecessor's leftovers.
   std::function<std::uint64_t()> next_launch;
@@ -70,6 +77,7 @@ public:
 
 private:
   class Launch;
+  void disconnect_devices(const Application &app);
   DomainServices services_;
 };
 

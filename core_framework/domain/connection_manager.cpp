@@ -1,8 +1,5 @@
 #include "domain/connection_manager.hpp"
 
-#include <cctype>
-#include <future>
-
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
@@ -10,119 +7,205 @@
 #include "dds/port_qos.hpp"
 
 namespace rsca::domain {
-namespace {
 
 using control::CallResult;
 using control::Json;
 using control::Status;
 
-} // namespace
+std::string PortRef::to_string() const {
+  switch (kind) {
+  case Kind::Component:
+    return owner + "/" + component + "." + port;
+  case Kind::External:
+  case Kind::Device:
+    break;
+  }
+  return owner + "." + port;
+}
 
-// The control address of the port's component, with the port's type; an error naming the end.
-CallResult<std::string> ConnectionManager::address_and_repid(const PortRef &ref, bool uses,
-                                                             std::string &repid) const {
-  auto app = find_(ref.application);
-  if (!app)
-    return control::call_error(Status::NotFound,
-                               fmt::format("no application {} runs", ref.application));
-  const auto *component = app->find_component(ref.component);
-  if (component == nullptr)
-    return control::call_error(Status::NotFound, fmt::format("application {} has no component {}",
-                                                             ref.application, ref.component));
-  const profile::ComponentPlacement *placement = nullptr;
-  app->profile->sad->find_instantiation(ref.component, &placement);
-  const auto *pkg = placement != nullptr ? app->profile->softpkg_of(*placement) : nullptr;
-  const auto direction = uses ? profile::PortDirection::Uses : profile::PortDirection::Provides;
-  const auto *port =
-      pkg != nullptr && pkg->scd ? pkg->scd->find_port(ref.port, direction) : nullptr;
-  if (port == nullptr)
-    return control::call_error(Status::NotFound, fmt::format("{} is not a {} port", ref.to_string(),
-                                                             uses ? "uses" : "provides"));
-  repid = port->repid;
-  return component->address;
+ConnectionManager::ConnectionManager(std::string domain,
+                                     const std::unique_ptr<control::Endpoint> &endpoint,
+                                     Resolve resolve, std::chrono::milliseconds timeout)
+    : domain_(std::move(domain)), endpoint_(endpoint), resolve_(std::move(resolve)),
+      timeout_(timeout), retrier_([this] { retry_loop(); }) {}
+
+void ConnectionManager::stop() {
+  {
+    std::lock_guard lock(mutex_);
+    stopping_ = true;
+  }
+  wake_.notify_all();
+  if (retrier_.joinable())
+    retrier_.join();
+}
+
+CallResult<void> ConnectionManager::wire(RuntimeConnection &c) {
+  auto uses = resolve_(c.uses, profile::PortDirection::Uses);
+  auto provides = resolve_(c.provides, profile::PortDirection::Provides);
+  for (const auto *end : {&uses, &provides})
+    if (!*end && end->error().status != Status::Unavailable)
+      return tl::unexpected(end->error());
+  if (uses && provides && uses->repid != provides->repid)
+    return control::call_error(Status::BadRequest,
+                               fmt::format("port type: {} sends {}, but {} takes {}",
+                                           c.uses.to_string(), uses->repid, c.provides.to_string(),
+                                           provides->repid));
+  if (!uses || !provides) {
+    c.waiting_for = (!uses ? uses : provides).error().message;
+    return {};
+  }
+  c.repid = uses->repid;
+  auto body = [&](const ResolvedEnd &end, const char *direction) {
+    return Json{{"connection", c.id}, {"port", end.port}, {"direction", direction},
+                {"topic", c.topic},   {"repid", c.repid}, {"qos", c.qos}};
+  };
+  // The reader first, so that the first samples written find it.
+  auto provided = endpoint_->call_sync(provides->address, "component.connect",
+                                       body(*provides, "provides"), timeout_);
+  auto used = provided ? endpoint_->call_sync(uses->address, "component.connect",
+                                              body(*uses, "uses"), timeout_)
+                       : provided;
+  if (!provided || !used) {
+    if (provided)
+      unwire_end(c, *provides);
+    const auto &error = !provided ? provided.error() : used.error();
+    return control::call_error(error.status, fmt::format("connection {}: {}", c.id, error.message));
+  }
+  c.uses_end = std::move(*uses);
+  c.provides_end = std::move(*provides);
+  c.waiting_for.clear();
+  spdlog::info("runtime connection {}: {} -> {} on topic {}", c.id, c.uses.to_string(),
+               c.provides.to_string(), c.topic);
+  return {};
+}
+
+void ConnectionManager::unwire_end(const RuntimeConnection &c, const ResolvedEnd &end) {
+  if (auto ok = endpoint_->call_sync(end.address, "component.disconnect",
+                                     Json{{"connection", c.id}, {"port", end.port}}, timeout_);
+      !ok)
+    spdlog::warn("runtime connection {}: disconnecting {} failed: {}", c.id, end.address,
+                 ok.error().message);
 }
 
 CallResult<RuntimeConnection> ConnectionManager::connect(const PortRef &uses,
                                                          const PortRef &provides, std::string id,
                                                          const Json &qos_json) {
-  std::string uses_repid, provides_repid;
-  auto uses_address = address_and_repid(uses, true, uses_repid);
-  if (!uses_address)
-    return tl::unexpected(uses_address.error());
-  auto provides_address = address_and_repid(provides, false, provides_repid);
-  if (!provides_address)
-    return tl::unexpected(provides_address.error());
-  if (uses_repid != provides_repid)
-    return control::call_error(
-        Status::BadRequest, fmt::format("port type: {} sends {}, but {} takes {}", uses.to_string(),
-                                        uses_repid, provides.to_string(), provides_repid));
   auto qos = dds::connection_qos_from_json(qos_json);
   if (!qos)
     return control::call_error(Status::BadRequest, qos.error().to_string());
-  RuntimeConnection c{std::move(id), uses, provides, "", uses_repid, dds::qos_to_json(*qos)};
+  std::lock_guard wiring(wiring_);
+  RuntimeConnection c{std::move(id), uses, provides, "", "", dds::qos_to_json(*qos), "", {}, {}};
   {
     std::lock_guard lock(mutex_);
     if (c.id.empty())
       c.id = fmt::format("runtime_{}", ++next_);
     if (connections_.count(c.id) != 0)
       return control::call_error(Status::Rejected, fmt::format("a connection {} exists", c.id));
-    c.topic = fmt::format("rsca_{}_runtime_{}", dds_name(domain_), dds_name(c.id));
-    connections_[c.id] = c; // reserved; removed again on failure
   }
-  auto body = [&](const PortRef &end, const char *direction) {
-    return Json{{"connection", c.id}, {"port", end.port}, {"direction", direction},
-                {"topic", c.topic},   {"repid", c.repid}, {"qos", c.qos}};
-  };
-  // The reader first, so that the first samples written find it.
-  auto provided = endpoint_->call_sync(*provides_address, "component.connect",
-                                       body(provides, "provides"), timeout_);
-  auto used = provided ? endpoint_->call_sync(*uses_address, "component.connect",
-                                              body(uses, "uses"), timeout_)
-                       : provided;
-  if (!provided || !used) {
-    endpoint_->call_sync(*provides_address, "component.disconnect",
-                         Json{{"connection", c.id}, {"port", provides.port}}, timeout_);
-    std::lock_guard lock(mutex_);
-    connections_.erase(c.id);
-    const auto &error = !provided ? provided.error() : used.error();
-    return control::call_error(error.status, fmt::format("connection {}: {}", c.id, error.message));
-  }
-  spdlog::info("runtime connection {}: {} -> {} on topic {}", c.id, uses.to_string(),
-               provides.to_string(), c.topic);
+  c.topic = fmt::format("rsca_{}_runtime_{}", dds_name(domain_), dds_name(c.id));
+  if (auto ok = wire(c); !ok)
+    return tl::unexpected(ok.error());
+  if (!c.connected())
+    spdlog::info("runtime connection {}: {} -> {} pending: {}", c.id, uses.to_string(),
+                 provides.to_string(), c.waiting_for);
+  std::lock_guard lock(mutex_);
+  connections_[c.id] = c;
   return c;
 }
 
 CallResult<void> ConnectionManager::disconnect(const std::string &id) {
+  std::lock_guard wiring(wiring_);
   RuntimeConnection c;
   {
     std::lock_guard lock(mutex_);
     auto it = connections_.find(id);
     if (it == connections_.end())
       return control::call_error(Status::NotFound, fmt::format("no runtime connection {}", id));
-    c = it->second;
+    c = std::move(it->second);
     connections_.erase(it);
   }
-  for (const auto *end : {&c.uses, &c.provides}) {
-    std::string repid;
-    auto address = address_and_repid(*end, end == &c.uses, repid);
-    if (address)
-      endpoint_->call_sync(*address, "component.disconnect",
-                           Json{{"connection", c.id}, {"port", end->port}}, timeout_);
+  if (c.connected()) {
+    unwire_end(c, c.uses_end);
+    unwire_end(c, c.provides_end);
   }
   spdlog::info("runtime connection {} removed", id);
   return {};
 }
 
-void ConnectionManager::application_released(const std::string &application) {
-  std::vector<std::string> ids;
+void ConnectionManager::owner_gone(const std::function<bool(const PortRef &)> &gone) {
+  std::lock_guard wiring(wiring_);
+  std::vector<RuntimeConnection> affected;
+  {
+    std::lock_guard lock(mutex_);
+    for (auto &[id, c] : connections_) {
+      if (!c.connected() || (!gone(c.uses) && !gone(c.provides)))
+        continue;
+      affected.push_back(c);
+      c.waiting_for = fmt::format("{} is gone", gone(c.uses) ? c.uses.owner : c.provides.owner);
+    }
+  }
+  for (const auto &c : affected) {
+    if (!gone(c.uses))
+      unwire_end(c, c.uses_end);
+    if (!gone(c.provides))
+      unwire_end(c, c.provides_end);
+    spdlog::info("runtime connection {} pending again: an end is gone", c.id);
+  }
+}
+
+void ConnectionManager::endpoints_changed() {
+  {
+    std::lock_guard lock(mutex_);
+    retry_ = true;
+  }
+  wake_.notify_all();
+}
+
+void ConnectionManager::owner_gone_later(std::function<bool(const PortRef &)> gone) {
+  {
+    std::lock_guard lock(mutex_);
+    gone_.push_back(std::move(gone));
+  }
+  wake_.notify_all();
+}
+
+void ConnectionManager::retry_loop() {
+  for (;;) {
+    bool retry = false;
+    std::vector<std::function<bool(const PortRef &)>> gone;
+    {
+      std::unique_lock lock(mutex_);
+      wake_.wait(lock, [this] { return retry_ || !gone_.empty() || stopping_; });
+      if (stopping_)
+        return;
+      retry = std::exchange(retry_, false);
+      gone.swap(gone_);
+    }
+    for (const auto &g : gone)
+      owner_gone(g);
+    if (retry)
+      retry_pending();
+  }
+}
+
+void ConnectionManager::retry_pending() {
+  std::lock_guard wiring(wiring_);
+  std::vector<RuntimeConnection> pending;
   {
     std::lock_guard lock(mutex_);
     for (const auto &[id, c] : connections_)
-      if (c.uses.application == application || c.provides.application == application)
-        ids.push_back(id);
+      if (!c.connected())
+        pending.push_back(c);
   }
-  for (const auto &id : ids)
-    disconnect(id); // the released application's own end is going anyway
+  for (auto &c : pending) {
+    if (auto ok = wire(c); !ok) {
+      c.waiting_for = ok.error().message; // e.g. the port type of what appeared does not fit
+      spdlog::warn("runtime connection {} cannot be completed: {}", c.id, c.waiting_for);
+    }
+    std::lock_guard lock(mutex_);
+    if (auto it = connections_.find(c.id); it != connections_.end())
+      it->second = c;
+  }
 }
 
 std::vector<RuntimeConnection> ConnectionManager::list() const {
@@ -134,8 +217,16 @@ std::vector<RuntimeConnection> ConnectionManager::list() const {
 }
 
 nlohmann::json to_json(const RuntimeConnection &c) {
-  return {{"id", c.id},       {"uses", c.uses.to_string()}, {"provides", c.provides.to_string()},
-          {"topic", c.topic}, {"repid", c.repid},           {"qos", c.qos}};
+  Json out{{"id", c.id},
+           {"uses", c.uses.to_string()},
+           {"provides", c.provides.to_string()},
+           {"topic", c.topic},
+           {"repid", c.repid},
+           {"qos", c.qos},
+           {"state", c.connected() ? "connected" : "pending"}};
+  if (!c.connected())
+    out["waiting_for"] = c.waiting_for;
+  return out;
 }
 
 } // namespace rsca::domain

@@ -1,28 +1,48 @@
-// ConnectionManager, runtime part: connections made and removed while applications run
-// (`rsca connect` / `rsca disconnect`), between ports of components of any running applications.
-// A connection is checked before anything is made (both ports exist with the right direction,
-// they carry the same port type), gets a topic of its own, and goes when either application is
-// released (the other end is disconnected).
+// ConnectionManager, runtime part: connections the operator makes and removes while the domain
+// runs (`rsca connect` / `rsca disconnect`), between ports of running applications' components,
+// applications' external ports and devices. A connection is checked before anything is made
+// (both ends have the port in the right direction, and they carry the same port type) and gets a
+// topic of its own. As REDHAWK's ConnectionManager, it waits for an end that is not there: a
+// connection to an application not launched yet or a device whose node has not registered is
+// pending, and is completed when the end appears; when an end goes (its application released,
+// its node gone), the other end is disconnected and the connection is pending again. It lasts
+// until it is disconnected.
 #pragma once
 
 #include <chrono>
+#include <condition_variable>
 #include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "control/endpoint.hpp"
-#include "domain/application.hpp"
+#include "profile/scd.hpp"
 
 namespace rsca::domain {
 
+// An end as the operator names it.
 struct PortRef {
-  std::string application;
-  std::string component;
+  enum class Kind : std::uint8_t {
+    Component, // APP/COMPONENT.PORT
+    External,  // APP.PORT: an external port of the application's SAD
+    Device,    // NODE:DEVICE.PORT
+  };
+  Kind kind = Kind::Component;
+  std::string owner;     // the application, or the device's id
+  std::string component; // Component only
   std::string port;
-  std::string to_string() const { return application + "/" + component + "." + port; }
+  std::string to_string() const;
+};
+
+// Where an end is served once it exists.
+struct ResolvedEnd {
+  std::string address;
+  std::string port; // the owner's port (an external port's is the component's)
+  std::string repid;
 };
 
 struct RuntimeConnection {
@@ -32,36 +52,65 @@ struct RuntimeConnection {
   std::string topic;
   std::string repid;
   nlohmann::json qos;
+  std::string waiting_for; // empty when connected; else what it waits for
+  ResolvedEnd uses_end, provides_end;
+  bool connected() const { return waiting_for.empty(); }
 };
 
 class ConnectionManager {
 public:
-  using FindApplication = std::function<std::shared_ptr<const Application>(const std::string &)>;
+  // Finds an end. Status::Unavailable means its owner is not there (yet): the connection waits;
+  // any other error refuses it.
+  using Resolve =
+      std::function<control::CallResult<ResolvedEnd>(const PortRef &, profile::PortDirection)>;
 
-  ConnectionManager(std::string domain, control::Endpoint *endpoint, FindApplication find,
-                    std::chrono::milliseconds timeout)
-      : domain_(std::move(domain)), endpoint_(endpoint), find_(std::move(find)), timeout_(timeout) {
-  }
+  // `endpoint` may still be empty: the manager exists before the domain's endpoint opens (whose
+  // announcements it hears), and calls through it only once connections are asked for.
+  ConnectionManager(std::string domain, const std::unique_ptr<control::Endpoint> &endpoint,
+                    Resolve resolve, std::chrono::milliseconds timeout);
+  ~ConnectionManager() { stop(); }
+  // Stops retrying (joins the manager's thread). Idempotent.
+  void stop();
+  ConnectionManager(const ConnectionManager &) = delete;
+  ConnectionManager &operator=(const ConnectionManager &) = delete;
 
   // Connects uses → provides with `qos` (SAD <qos> names, defaults filled in); `id` may be empty.
+  // The result is pending (waiting_for says for what) when an end is not there yet.
   control::CallResult<RuntimeConnection> connect(const PortRef &uses, const PortRef &provides,
                                                  std::string id, const nlohmann::json &qos);
   control::CallResult<void> disconnect(const std::string &id);
-  // `application` is being released: the other ends of its runtime connections are disconnected.
-  void application_released(const std::string &application);
+  // Something appeared (an application launched, a node registered): pending connections are
+  // tried again, on the manager's own thread.
+  void endpoints_changed();
+  // An owner (application name, or device id) is going or gone: its connections are undone at
+  // the other end and wait for it again. Only the other end is called: the gone one may not
+  // answer.
+  void owner_gone(const std::function<bool(const PortRef &)> &gone);
+  // The same, done on the manager's own thread: for callers that must not block.
+  void owner_gone_later(std::function<bool(const PortRef &)> gone);
   std::vector<RuntimeConnection> list() const;
 
 private:
-  control::CallResult<std::string> address_and_repid(const PortRef &ref, bool uses,
-                                                     std::string &repid) const;
+  // Makes both ends, or leaves the connection pending. Called with wiring_ held.
+  control::CallResult<void> wire(RuntimeConnection &c);
+  void unwire_end(const RuntimeConnection &c, const ResolvedEnd &end);
+  void retry_pending();
+  void retry_loop();
 
   std::string domain_;
-  control::Endpoint *endpoint_;
-  FindApplication find_;
+  const std::unique_ptr<control::Endpoint> &endpoint_;
+  Resolve resolve_;
   std::chrono::milliseconds timeout_;
-  mutable std::mutex mutex_;
+
+  std::mutex wiring_;        // one wiring change at a time (held across control calls)
+  mutable std::mutex mutex_; // guards connections_ and the retry flags
   std::map<std::string, RuntimeConnection> connections_;
   std::uint64_t next_ = 0;
+  std::condition_variable wake_;
+  bool retry_ = false;
+  std::vector<std::function<bool(const PortRef &)>> gone_; // owner_gone_later's, in order
+  bool stopping_ = false;
+  std::thread retrier_;
 };
 
 nlohmann::json to_json(const RuntimeConnection &connection);

@@ -69,14 +69,15 @@ std::optional<fs::path> safe_relative(const std::string &path) {
   return p;
 }
 
-// One end's live state from its component's status: {"matched", "samples"}, or null.
-Json end_state(const std::map<std::string, Json> &status_of, const ConnectionEnd &end,
-               const std::string &connection) {
-  auto it = status_of.find(end.component);
-  if (end.component.empty() || it == status_of.end())
+// One end's live state from its owner's status (by address): {"matched", "samples",
+// "filtered"}, or null.
+Json end_state(const std::map<std::string, Json> &status_of, const std::string &address,
+               const std::string &port_name, const std::string &connection) {
+  auto it = status_of.find(address);
+  if (address.empty() || it == status_of.end())
     return nullptr;
   for (const auto &port : it->second.value("ports", Json::array())) {
-    if (port.value("name", "") != end.port)
+    if (port.value("name", "") != port_name)
       continue;
     for (const auto &c : port.value("connections", Json::array()))
       if (c.value("connection", "") == connection)
@@ -89,19 +90,19 @@ Json end_state(const std::map<std::string, Json> &status_of, const ConnectionEnd
 
 Json connection_json(const Application &app, const ConnectionInstance &c,
                      const std::map<std::string, Json> &status_of) {
-  auto end = [](const ConnectionEnd &e) {
-    return e.component.empty() ? std::string() : e.component + "." + e.port;
+  auto state = [&](const ConnectionEnd &e) {
+    return end_state(status_of, e.address, e.port, end_key(c, e));
   };
   return {{"application", app.name},
           {"id", c.id},
-          {"uses", end(c.uses)},
-          {"provides", end(c.provides)},
+          {"uses", c.uses.name()},
+          {"provides", c.provides.name()},
           {"topic", c.topic},
           {"repid", c.repid},
           {"qos", c.qos},
           {"filter", c.filter},
-          {"uses_state", end_state(status_of, c.uses, c.id)},
-          {"provides_state", end_state(status_of, c.provides, c.id)}};
+          {"uses_state", state(c.uses)},
+          {"provides_state", state(c.provides)}};
 }
 
 Json device_ids(const Json &node_body) {
@@ -145,7 +146,7 @@ struct DomainManager::Impl {
   allocator::ResourceAllocator allocator;
   ComponentRegistry components;
   std::unique_ptr<control::DomainEvents> events;
-  std::optional<ConnectionManager> runtime_connections; // made once the endpoint is open
+  std::optional<ConnectionManager> runtime_connections; // made before the endpoint opens
   std::optional<EventChannelManager> channels;          // made when the domain's name is known
   std::optional<DomainStore> store;
 
@@ -170,6 +171,13 @@ struct DomainManager::Impl {
         return std::nullopt;
       return it->second.address;
     };
+    s.device_ports = [this](const std::string &id) -> std::optional<DevicePorts> {
+      std::lock_guard lock(mutex);
+      const Json *device = find_device(id);
+      if (device == nullptr || !device->contains("address"))
+        return std::nullopt;
+      return DevicePorts{device->value("address", ""), device->value("ports", Json::array())};
+    };
     s.next_launch = [this] { return ++launch_counter; };
     s.call_timeout = options.call_timeout;
     s.registration_timeout = options.registration_timeout;
@@ -177,6 +185,13 @@ struct DomainManager::Impl {
     return ApplicationFactory(std::move(s));
   }
 
+  // A device as its node announced it; null when its node has not registered or has no such
+  // device. Called with `mutex` held.
+  const Json *find_device(const std::string &id) const;
+  CallResult<ResolvedEnd> resolve_end(const PortRef &ref, profile::PortDirection direction);
+  CallResult<ResolvedEnd> resolve_component_end(const PortRef &ref,
+                                                profile::PortDirection direction);
+  CallResult<ResolvedEnd> resolve_device_end(const PortRef &ref, profile::PortDirection direction);
   void serve();
   void on_announcement(const control::AnnouncementEvent &event);
   Expected<void> load_installed();
@@ -197,7 +212,7 @@ struct DomainManager::Impl {
   CallResult<Json> destroy_channel(const Json &body);
   CallResult<Json> list_connections(const Json &body);
   CallResult<Json> create_connection(const Json &body);
-  Json runtime_end_state(const PortRef &end, const std::string &connection);
+  Json runtime_end_state(const ResolvedEnd &end, const std::string &connection);
   CallResult<Json> destroy_connection(const Json &body);
   CallResult<Json> component_exited(const Json &body);
   CallResult<Json> connection_problem(const Json &body);
@@ -368,6 +383,7 @@ CallResult<Json> DomainManager::Impl::create_application(const Json &body) {
                                           {"installed", request.installed},
                                           {"components", (*app)->components.size()}});
   applications[request.name] = *app;
+  runtime_connections->endpoints_changed(); // connections waiting for it
   Json reply = to_json(**app);
   reply["launch"] = {{"steps", steps_json(progress->steps)}, {"ms", ms_since(began)}};
   return reply;
@@ -400,8 +416,11 @@ CallResult<Json> DomainManager::Impl::release(const Json &body) {
   auto app = find_application(body);
   if (!app)
     return tl::unexpected(app.error());
-  // Its runtime connections go first, while both ends still answer.
-  runtime_connections->application_released((*app)->name);
+  // Its runtime connections wait for it again; their other ends are disconnected.
+  const std::string name = (*app)->name;
+  runtime_connections->owner_gone([&name](const PortRef &ref) {
+    return ref.kind != PortRef::Kind::Device && ref.owner == name;
+  });
   {
     std::lock_guard lock(mutex);
     applications.erase((*app)->name);
@@ -551,22 +570,30 @@ CallResult<Json> DomainManager::Impl::list_connections(const Json &body) {
   Json list = Json::array();
   for (const auto &app : apps) {
     std::map<std::string, std::future<CallResult<Json>>> statuses;
+    auto ask = [&](const std::string &address) {
+      if (!address.empty() && statuses.count(address) == 0)
+        statuses.emplace(address, endpoint->call(address, "component.status", Json::object(),
+                                                 options.call_timeout));
+    };
     for (const auto &c : app->components)
-      statuses.emplace(c.id, endpoint->call(c.address, "component.status", Json::object(),
-                                            options.call_timeout));
+      ask(c.address);
+    for (const auto &c : app->connections)
+      for (const auto *end : {&c.uses, &c.provides})
+        ask(end->address); // device ends
     std::map<std::string, Json> status_of;
-    for (auto &[id, f] : statuses)
+    for (auto &[address, f] : statuses)
       if (auto s = f.get())
-        status_of[id] = *s;
+        status_of[address] = *s;
     for (const auto &c : app->connections)
       list.push_back(connection_json(*app, c, status_of));
   }
   for (const auto &c : runtime_connections->list())
-    if (only.empty() || c.uses.application == only || c.provides.application == only) {
+    if (only.empty() || c.uses.owner == only || c.provides.owner == only) {
       Json entry = to_json(c);
       entry["application"] = "(runtime)";
-      entry["uses_state"] = runtime_end_state(c.uses, c.id);
-      entry["provides_state"] = runtime_end_state(c.provides, c.id);
+      entry["uses_state"] = c.connected() ? runtime_end_state(c.uses_end, c.id) : Json(nullptr);
+      entry["provides_state"] =
+          c.connected() ? runtime_end_state(c.provides_end, c.id) : Json(nullptr);
       list.push_back(std::move(entry));
     }
   return Json{{"connections", list}};
@@ -574,38 +601,118 @@ CallResult<Json> DomainManager::Impl::list_connections(const Json &body) {
 
 namespace {
 
+// {"application", "component", "port"}, {"application", "port"} (an external port) or
+// {"device", "port"}.
 CallResult<PortRef> port_ref(const Json &body, const char *key) {
   if (!body.contains(key) || !body.at(key).is_object())
     return control::call_error(Status::BadRequest,
                                fmt::format("the request has no \"{}\" port", key));
   const Json &end = body.at(key);
-  PortRef ref{end.value("application", ""), end.value("component", ""), end.value("port", "")};
-  if (ref.application.empty() || ref.component.empty() || ref.port.empty())
-    return control::call_error(Status::BadRequest,
-                               fmt::format("\"{}\" needs application, component and port", key));
+  PortRef ref;
+  ref.port = end.value("port", "");
+  if (end.contains("device")) {
+    ref.kind = PortRef::Kind::Device;
+    ref.owner = end.value("device", "");
+  } else {
+    ref.owner = end.value("application", "");
+    ref.component = end.value("component", "");
+    ref.kind = ref.component.empty() ? PortRef::Kind::External : PortRef::Kind::Component;
+  }
+  if (ref.owner.empty() || ref.port.empty())
+    return control::call_error(
+        Status::BadRequest,
+        fmt::format("\"{}\" needs a port and an application (with a component) or a device", key));
   return ref;
 }
 
 } // namespace
 
-// A runtime connection's end as its component reports it.
-Json DomainManager::Impl::runtime_end_state(const PortRef &end, const std::string &connection) {
-  std::string address;
-  {
-    std::lock_guard lock(mutex);
-    auto it = applications.find(end.application);
-    const auto *component = it != applications.end() && it->second
-                                ? it->second->find_component(end.component)
-                                : nullptr;
-    if (component == nullptr)
-      return nullptr;
-    address = component->address;
+const Json *DomainManager::Impl::find_device(const std::string &id) const {
+  const auto colon = id.find(':');
+  auto node = nodes.find(id.substr(0, colon));
+  if (colon == std::string::npos || node == nodes.end())
+    return nullptr;
+  const Json &body = node->second.body;
+  auto devices = body.find("devices"); // a reference into the record: value() would copy
+  if (devices == body.end() || !devices->is_array())
+    return nullptr;
+  for (const auto &d : *devices)
+    if (d.value("id", "") == id)
+      return &d;
+  return nullptr;
+}
+
+CallResult<ResolvedEnd> DomainManager::Impl::resolve_end(const PortRef &ref,
+                                                         profile::PortDirection direction) {
+  return ref.kind == PortRef::Kind::Device ? resolve_device_end(ref, direction)
+                                           : resolve_component_end(ref, direction);
+}
+
+CallResult<ResolvedEnd>
+DomainManager::Impl::resolve_component_end(const PortRef &ref, profile::PortDirection direction) {
+  const bool uses = direction == profile::PortDirection::Uses;
+  std::lock_guard lock(mutex);
+  auto it = applications.find(ref.owner);
+  if (it == applications.end() || !it->second)
+    return control::call_error(Status::Unavailable,
+                               fmt::format("application {} is not running", ref.owner));
+  const Application &app = *it->second;
+  std::string component = ref.component, port = ref.port;
+  if (ref.kind == PortRef::Kind::External) {
+    const auto wanted =
+        uses ? profile::ExternalPort::Kind::Uses : profile::ExternalPort::Kind::Provides;
+    const profile::ExternalPort *external = nullptr;
+    for (const auto &e : app.profile->sad->external_ports)
+      if (e.external_name == ref.port && e.kind == wanted)
+        external = &e;
+    if (external == nullptr)
+      return control::call_error(Status::NotFound,
+                                 fmt::format("{} is not an external {} port", ref.to_string(),
+                                             uses ? "uses" : "provides"));
+    component = external->component_ref;
+    port = external->port;
   }
+  const auto *instance = app.find_component(component);
+  if (instance == nullptr)
+    return control::call_error(
+        Status::NotFound, fmt::format("application {} has no component {}", ref.owner, component));
+  const profile::ComponentPlacement *placement = nullptr;
+  app.profile->sad->find_instantiation(component, &placement);
+  const auto *pkg = placement != nullptr ? app.profile->softpkg_of(*placement) : nullptr;
+  const auto *definition =
+      pkg != nullptr && pkg->scd ? pkg->scd->find_port(port, direction) : nullptr;
+  if (definition == nullptr)
+    return control::call_error(Status::NotFound, fmt::format("{} is not a {} port", ref.to_string(),
+                                                             uses ? "uses" : "provides"));
+  return ResolvedEnd{instance->address, port, definition->repid};
+}
+
+CallResult<ResolvedEnd> DomainManager::Impl::resolve_device_end(const PortRef &ref,
+                                                                profile::PortDirection direction) {
+  const char *wanted = direction == profile::PortDirection::Uses ? "uses" : "provides";
+  std::lock_guard lock(mutex);
+  const std::string node = ref.owner.substr(0, ref.owner.find(':'));
+  if (nodes.count(node) == 0)
+    return control::call_error(Status::Unavailable,
+                               fmt::format("device {} has not registered", ref.owner));
+  const Json *device = find_device(ref.owner);
+  if (device == nullptr)
+    return control::call_error(Status::NotFound,
+                               fmt::format("node {} has no device {}", node, ref.owner));
+  for (const auto &p : device->value("ports", Json::array()))
+    if (p.value("name", "") == ref.port && p.value("direction", "") == wanted)
+      return ResolvedEnd{device->value("address", ""), ref.port, p.value("repid", "")};
+  return control::call_error(Status::NotFound,
+                             fmt::format("{} is not a {} port", ref.to_string(), wanted));
+}
+
+// A runtime connection's end as its owner reports it.
+Json DomainManager::Impl::runtime_end_state(const ResolvedEnd &end, const std::string &connection) {
   auto status =
-      endpoint->call_sync(address, "component.status", Json::object(), options.call_timeout);
+      endpoint->call_sync(end.address, "component.status", Json::object(), options.call_timeout);
   if (!status)
     return nullptr;
-  return end_state({{end.component, *status}}, ConnectionEnd{end.component, end.port}, connection);
+  return end_state({{end.address, *status}}, end.address, end.port, connection);
 }
 
 CallResult<Json> DomainManager::Impl::create_connection(const Json &body) {
@@ -701,6 +808,7 @@ void DomainManager::Impl::on_announcement(const control::AnnouncementEvent &even
     std::lock_guard lock(mutex);
     const bool known = nodes.count(node) != 0;
     nodes[node] = {node, event.address, event.body};
+    runtime_connections->endpoints_changed(); // connections waiting for its devices
     if (!known) {
       spdlog::info("node {} registered with {} device(s)", node,
                    event.body.value("devices", Json::array()).size());
@@ -723,6 +831,9 @@ void DomainManager::Impl::on_announcement(const control::AnnouncementEvent &even
     events->publish("node.removed",
                     {{"node", it->first}, {"devices", device_ids(it->second.body)}});
     allocator.remove_node(it->first);
+    runtime_connections->owner_gone_later([prefix = it->first + ":"](const PortRef &ref) {
+      return ref.kind == PortRef::Kind::Device && ref.owner.starts_with(prefix);
+    });
     nodes.erase(it);
     return;
   }
@@ -798,6 +909,7 @@ DomainManager::DomainManager(std::unique_ptr<Impl> impl) : impl_(std::move(impl)
 
 DomainManager::~DomainManager() {
   // Releasing applications is the operator's decision; the domain only stops serving.
+  impl_->runtime_connections->stop(); // its thread calls through the endpoint
   impl_->endpoint.reset();
 }
 
@@ -822,6 +934,12 @@ DomainManager::create(std::shared_ptr<dds::Participant> participant, DomainOptio
   if (auto ok = impl->load_installed(); !ok)
     return tl::unexpected(ok.error());
   Impl *raw = impl.get();
+  impl->runtime_connections.emplace(
+      impl->options.name, impl->endpoint,
+      [raw](const PortRef &ref, profile::PortDirection direction) {
+        return raw->resolve_end(ref, direction);
+      },
+      impl->options.call_timeout);
   auto endpoint = control::Endpoint::open(
       participant, address_of(impl->options.name),
       {.workers = 16,
@@ -829,14 +947,6 @@ DomainManager::create(std::shared_ptr<dds::Participant> participant, DomainOptio
   if (!endpoint)
     return tl::unexpected(endpoint.error());
   impl->endpoint = std::move(*endpoint);
-  impl->runtime_connections.emplace(
-      impl->options.name, impl->endpoint.get(),
-      [raw](const std::string &name) -> std::shared_ptr<const Application> {
-        std::lock_guard lock(raw->mutex);
-        auto it = raw->applications.find(name);
-        return it == raw->applications.end() ? nullptr : it->second;
-      },
-      impl->options.call_timeout);
   impl->serve();
   spdlog::info("domain {} serving at {}", impl->options.name, impl->endpoint->address());
   return std::unique_ptr<DomainManager>(new DomainManager(std::move(impl)));

@@ -77,8 +77,11 @@ Expected<void> DeviceManager::Impl::start_devices(const DeviceRegistry &registry
       DeviceContext context{id,
                             label,
                             dcd->name,
-                            placed.softpkg.get(),
+                            options.domain_name,
+                            placed.softpkg,
+                            &ci,
                             overrides_of(ci, *placed.softpkg),
+                            participant,
                             options.exec_path,
                             options.log_dir,
                             participant->settings(),
@@ -100,15 +103,21 @@ Expected<void> DeviceManager::Impl::start_devices(const DeviceRegistry &registry
 
 Json DeviceManager::Impl::announcement() const {
   Json list = Json::array();
-  for (const auto &d : devices)
-    list.push_back({{"id", d.id},
-                    {"label", d.label},
-                    {"softpkg", d.softpkg},
-                    {"kind", d.device->kind()},
-                    {"properties", d.device->properties()},
-                    {"capacity", d.device->capacity()},
-                    {"allocation", d.allocation},
-                    {"deployerrequires", d.deployer_requires}});
+  for (const auto &d : devices) {
+    Json entry{{"id", d.id},
+               {"label", d.label},
+               {"softpkg", d.softpkg},
+               {"kind", d.device->kind()},
+               {"properties", d.device->properties()},
+               {"capacity", d.device->capacity()},
+               {"allocation", d.allocation},
+               {"deployerrequires", d.deployer_requires}};
+    if (auto address = d.device->address(); !address.empty()) {
+      entry["address"] = address;
+      entry["ports"] = d.device->ports();
+    }
+    list.push_back(std::move(entry));
+  }
   char host[256] = {};
   gethostname(host, sizeof(host) - 1);
   return {

@@ -11,6 +11,7 @@
 
 #include "control/endpoint.hpp"
 #include "dds/dds_settings.hpp"
+#include "dds/participant.hpp"
 #include "profile/profile_loader.hpp"
 
 namespace rsca::node {
@@ -23,11 +24,14 @@ struct DeviceContext {
   std::string id;    // "<node>:<usage name>"
   std::string label; // the DCD's usage name
   std::string node;
-  const profile::ResolvedSoftPkg *softpkg = nullptr;
+  std::string domain;
+  std::shared_ptr<const profile::ResolvedSoftPkg> softpkg;
+  const profile::ComponentInstantiation *instantiation = nullptr; // in the DCD
   Json overrides; // the DCD's property values for this device, by property name and id
-  std::vector<std::filesystem::path> exec_path; // where bare entrypoint names are looked for
-  std::filesystem::path log_dir;                // component logs go here
-  dds::DdsSettings dds;                         // what launched processes must join
+  std::shared_ptr<dds::Participant> participant; // the node's: devices with ports join it
+  std::vector<std::filesystem::path> exec_path;  // where bare entrypoint names are looked for
+  std::filesystem::path log_dir;                 // component logs go here
+  dds::DdsSettings dds;                          // what launched processes must join
   // Reports a process that exited on its own (a crash, for a component). Must not block.
   std::function<void(const Json &report)> report_exit;
 };
@@ -38,6 +42,9 @@ public:
   virtual std::string kind() const = 0; // "gpp" runs components; "device" is used by them
   virtual Json properties() const = 0;  // matching properties, by name
   virtual Json capacity() const = 0;    // total capacities, by name
+  // Devices with data ports serve them at a control address, as components do.
+  virtual std::string address() const { return {}; }
+  virtual Json ports() const { return Json::array(); } // [{"name", "direction", "repid"}]
 };
 
 class ExecutableDevice : public LogicalDevice {

@@ -203,26 +203,6 @@ TEST_CASE("an operator's channel lives until the operator destroys it", "[integr
   domain.require_clean(pids_of(*app));
 }
 
-namespace {
-
-Json runtime_connection(TestDomain &domain, const std::string &id) {
-  auto list = domain.call("connection.list");
-  REQUIRE(list.has_value());
-  for (const auto &c : list->at("connections"))
-    if (c.at("application") == "(runtime)" && c.at("id") == id)
-      return c;
-  return nullptr;
-}
-
-long delivered(TestDomain &domain, const std::string &id) {
-  const Json c = runtime_connection(domain, id);
-  return c.is_null() || c.at("provides_state").is_null()
-             ? -1
-             : c.at("provides_state").at("samples").get<long>();
-}
-
-} // namespace
-
 TEST_CASE("runtime connections between running applications: made, checked, carrying data, "
           "removed, and gone with an application",
           "[integration][connections]") {
@@ -280,18 +260,23 @@ TEST_CASE("runtime connections between running applications: made, checked, carr
     if (port.at("name") == "samples_in")
       CHECK(port.at("connections").size() == 1);
 
-  // A connection goes with either of its applications.
+  // A connection outlives its applications: with one released it waits for it again, and the
+  // other end is disconnected.
   REQUIRE(
       domain
           .cli({"connect", "a/Producer_1.samples_out", "b/Consumer_1.samples_in", "--id", "again"})
           .first == 0);
   REQUIRE(domain.call("app.release", Json{{"app", "a"}}).has_value());
-  CHECK(runtime_connection(domain, "again").is_null());
+  const Json again = runtime_connection(domain, "again");
+  CHECK(again.at("state") == "pending");
+  CHECK(again.at("waiting_for") == "a is gone");
   status = b_status();
   REQUIRE(status.has_value());
   for (const auto &port : status->at("ports"))
     if (port.at("name") == "samples_in")
       CHECK(port.at("connections").size() == 1);
+  REQUIRE(domain.cli({"disconnect", "again"}).first == 0);
+  CHECK(runtime_connection(domain, "again").is_null());
   REQUIRE(domain.call("app.release", Json{{"app", "b"}}).has_value());
   domain.require_clean(pids);
 }

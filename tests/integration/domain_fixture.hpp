@@ -55,11 +55,7 @@ public:
     env_ = {{"RSCA_DDS_DOMAIN", std::to_string(rsca::test::isolated_domain_id())}};
     start_domaind(registration_timeout_ms);
     for (const auto &dcd : dcds)
-      nodes_.push_back(std::make_unique<ChildProcess>(
-          (kBin / "rsca-noded").string(),
-          std::vector<std::string>{"--dcd", dcd.string(), "--log-dir", (run_ / "logs").string(),
-                                   "--exec-path", kBin.string()},
-          env_));
+      launch_node(dcd);
     auto pp = rsca::test::participant();
     auto endpoint = rsca::control::Endpoint::open(pp, fmt::format("rsca/cli/test-{}", getpid()));
     REQUIRE(endpoint.has_value());
@@ -182,6 +178,18 @@ public:
         env_);
   }
 
+  // Starts one more node daemon (index: nodes so far + 1) and waits until the domain knows it.
+  void start_node(const fs::path &dcd) {
+    auto before = call("domain.nodes");
+    REQUIRE(before.has_value());
+    const std::size_t known = before->at("nodes").size();
+    launch_node(dcd);
+    REQUIRE(wait_for([&] {
+      auto r = call("domain.nodes");
+      return r && r->at("nodes").size() > known;
+    }));
+  }
+
   void kill_node(int index) {
     nodes_[index - 1]->signal(SIGKILL);
     nodes_[index - 1]->wait_exit(5s);
@@ -200,6 +208,17 @@ public:
   }
 
   const fs::path &run_dir() const { return run_; }
+
+private:
+  void launch_node(const fs::path &dcd) {
+    nodes_.push_back(std::make_unique<ChildProcess>(
+        (kBin / "rsca-noded").string(),
+        std::vector<std::string>{"--dcd", dcd.string(), "--log-dir", (run_ / "logs").string(),
+                                 "--exec-path", kBin.string()},
+        env_));
+  }
+
+public:
   // The test's own endpoint, for calls to nodes and components.
   rsca::control::Endpoint &client() { return *client_; }
 
@@ -225,6 +244,36 @@ inline long received(TestDomain &domain, const std::string &app) {
   if (!q)
     return -1;
   return q->at("properties").at("received").get<long>();
+}
+
+// A runtime connection as `connection.list` shows it; null when there is none.
+inline Json runtime_connection(TestDomain &domain, const std::string &id) {
+  auto list = domain.call("connection.list");
+  REQUIRE(list.has_value());
+  for (const auto &c : list->at("connections"))
+    if (c.at("application") == "(runtime)" && c.at("id") == id)
+      return c;
+  return nullptr;
+}
+
+// Samples its provides end received; -1 while it is not connected.
+inline long delivered(TestDomain &domain, const std::string &id) {
+  const Json c = runtime_connection(domain, id);
+  return c.is_null() || c.at("provides_state").is_null()
+             ? -1
+             : c.at("provides_state").at("samples").get<long>();
+}
+
+// The connections one port of a component or device has, from its own status.
+inline long port_connections(TestDomain &domain, const std::string &address,
+                             const std::string &port) {
+  auto status = domain.client().call_sync(address, "component.status", Json::object(), 5s);
+  if (!status)
+    return -1;
+  for (const auto &p : status->at("ports"))
+    if (p.at("name") == port)
+      return static_cast<long>(p.at("connections").size());
+  return -1;
 }
 
 } // namespace rsca::test

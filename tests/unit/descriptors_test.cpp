@@ -587,7 +587,7 @@ TEST_CASE("the loader resolves the project's own profiles cleanly", "[descriptor
     else if (!validated->warnings.empty())
       problems.push_back(entry.path().string() + ": " + validated->warnings.front().message);
   }
-  CHECK(checked == 18);
+  CHECK(checked > 20); // the walk found the profiles (22 when this was written)
   INFO(Catch::Detail::stringify(problems));
   CHECK(problems.empty());
 }

@@ -597,7 +597,22 @@ TEST_CASE("planner: usesdevice places on the used device's node and allocates it
     const auto rejections = require_rejection(
         make_plan(state, request_of({component("c1", pkg), component("c2", pkg)})));
     CHECK(rejections[0].instance == "c2");
-    CHECK_THAT(to_string(rejections), Catch::Contains("usesdevice cam: no device on node n2 fits"));
+    CHECK_THAT(to_string(rejections),
+               Catch::Contains("usesdevice cam: no device in the domain fits"));
+  }
+
+  SECTION("a device on a node without a GPP is used across the network") {
+    const Device sensor = peripheral("robot:sensor", "robot",
+                                     {{"model", "model", "imx219", profile::Action::Eq}}, {});
+    const auto remote = domain({gpp("n1:GPP", "n1"), sensor});
+    const Plan plan = require_plan(make_plan(
+        remote,
+        request_of({component("c", softpkg("comp", {ImplSpec("cpp").uses(uses_device(
+                                                       "cam", {ref("model", "imx219")}))}))})));
+    const Placement &p = placement_of(plan, "c");
+    CHECK(p.device == "n1:GPP");
+    REQUIRE(p.used_devices.size() == 1);
+    CHECK(p.used_devices[0].device == "robot:sensor");
   }
 
   SECTION("two usesdevice of one implementation cannot both take the single channel") {

@@ -169,7 +169,7 @@ TEST_CASE("a simple with enumerations takes their values or labels only", "[prop
   CHECK(error_of(mode, "auto") == "property \"mode\": \"auto\" is not a short");
 }
 
-TEST_CASE("structs are objects of their members; unknown members are refused", "[property_json]") {
+TEST_CASE("structs are objects of their members, unknown members are refused", "[property_json]") {
   const PropertyDefinition stream = stream_struct();
   round_trips(stream, {{"stream_id", "s1"}, {"sample_rate", 48000.0}, {"taps", {0.5, 0.25}}});
   // A configure may name some members only.

@@ -223,15 +223,23 @@ std::pair<std::string, std::string> split_target(const std::string &target) {
 }
 
 // APP/COMPONENT.PORT as {"application", "component", "port"}.
+// APP/COMPONENT.PORT (a component's port), NODE:DEVICE.PORT (a device's) or APP.PORT (an
+// application's external port).
 std::optional<Json> port_json(const std::string &text) {
-  const auto slash = text.find('/');
   const auto dot = text.rfind('.');
-  if (slash == std::string::npos || dot == std::string::npos || dot < slash || slash == 0 ||
-      dot == slash + 1 || dot + 1 == text.size())
+  if (dot == std::string::npos || dot == 0 || dot + 1 == text.size())
     return std::nullopt;
-  return Json{{"application", text.substr(0, slash)},
-              {"component", text.substr(slash + 1, dot - slash - 1)},
-              {"port", text.substr(dot + 1)}};
+  const std::string owner = text.substr(0, dot), port = text.substr(dot + 1);
+  if (const auto slash = owner.find('/'); slash != std::string::npos) {
+    if (slash == 0 || slash + 1 == owner.size())
+      return std::nullopt;
+    return Json{{"application", owner.substr(0, slash)},
+                {"component", owner.substr(slash + 1)},
+                {"port", port}};
+  }
+  if (owner.find(':') != std::string::npos)
+    return Json{{"device", owner}, {"port", port}};
+  return Json{{"application", owner}, {"port", port}};
 }
 
 // QoS values given as text: numbers (depth, strength, ...) as numbers, the rest as text.
@@ -321,15 +329,16 @@ void add_application_commands(CLI::App &app, const GlobalOptions &global, int &e
   });
 
   auto *connect_cmd = app.add_subcommand(
-      "connect", "Connect a uses port to a provides port of running applications: "
-                 "APP/COMPONENT.PORT APP/COMPONENT.PORT");
+      "connect",
+      "Connect a uses port to a provides port: APP/COMPONENT.PORT, APP.PORT (an external port) "
+      "or NODE:DEVICE.PORT. An end not there yet (an application not launched, a device not "
+      "registered) makes the connection pending until it appears; it lasts until disconnected");
   auto uses_end = std::make_shared<std::string>();
   auto provides_end = std::make_shared<std::string>();
   auto connection_id = std::make_shared<std::string>();
   auto qos_args = std::make_shared<std::vector<std::string>>();
-  connect_cmd->add_option("uses", *uses_end, "APP/COMPONENT.PORT of a uses port")->required();
-  connect_cmd->add_option("provides", *provides_end, "APP/COMPONENT.PORT of a provides port")
-      ->required();
+  connect_cmd->add_option("uses", *uses_end, "The uses port")->required();
+  connect_cmd->add_option("provides", *provides_end, "The provides port")->required();
   connect_cmd->add_option("--id", *connection_id, "The connection's id (default: runtime_N)");
   connect_cmd->add_option("--qos", *qos_args, "QoS as in the SAD: name=value (repeatable)");
   connect_cmd->callback([=, &global, &exit_code] {
@@ -337,7 +346,8 @@ void add_application_commands(CLI::App &app, const GlobalOptions &global, int &e
     auto provides = port_json(*provides_end);
     auto qos = parse_assignments(*qos_args);
     if (!uses || !provides || !qos) {
-      fmt::print(stderr, "rsca connect: give ports as APP/COMPONENT.PORT and QoS as name=value\n");
+      fmt::print(stderr, "rsca connect: give ports as APP/COMPONENT.PORT, APP.PORT or "
+                         "NODE:DEVICE.PORT, and QoS as name=value\n");
       exit_code = kUsage;
       return;
     }
@@ -345,8 +355,12 @@ void add_application_commands(CLI::App &app, const GlobalOptions &global, int &e
     if (!connection_id->empty())
       body["id"] = *connection_id;
     exit_code = simple_call("connect", "connection.create", body, global, [](const Json &r) {
-      fmt::print("connected {}: {} -> {} [{}]\n", r.value("id", ""), r.value("uses", ""),
-                 r.value("provides", ""), r.value("topic", ""));
+      if (r.value("state", "") == "pending")
+        fmt::print("pending {}: {} -> {} (waiting: {})\n", r.value("id", ""), r.value("uses", ""),
+                   r.value("provides", ""), r.value("waiting_for", ""));
+      else
+        fmt::print("connected {}: {} -> {} [{}]\n", r.value("id", ""), r.value("uses", ""),
+                   r.value("provides", ""), r.value("topic", ""));
     });
   });
   auto *disconnect_cmd =

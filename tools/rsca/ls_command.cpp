@@ -79,6 +79,10 @@ void print_connections(const Json &r) {
     fmt::print("  qos {} {} {}{}\n", q.value("reliability", ""), q.value("durability", ""),
                q.value("history", ""),
                q.contains("depth") ? fmt::format(" depth {}", q.at("depth").dump()) : "");
+    if (c.value("state", "") == "pending") {
+      fmt::print("  pending: {}\n", c.value("waiting_for", ""));
+      continue;
+    }
     fmt::print("  uses: {}   provides: {}\n", end_state(c.at("uses_state")),
                end_state(c.at("provides_state")));
   }

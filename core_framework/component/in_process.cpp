@@ -1,0 +1,52 @@
+#include "component/in_process.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include "component/host.hpp"
+
+namespace rsca::component {
+
+InProcessComponent::InProcessComponent(std::unique_ptr<detail::Host> host, std::string address)
+    : host_(std::move(host)), address_(std::move(address)) {}
+
+InProcessComponent::~InProcessComponent() {
+  host_->shutdown("its owner stops");
+  host_->close();
+}
+
+Expected<std::unique_ptr<InProcessComponent>>
+InProcessComponent::open(const Factory &factory, Context context,
+                         std::shared_ptr<const profile::ResolvedSoftPkg> softpkg,
+                         std::shared_ptr<dds::Participant> participant) {
+  const std::string address = context.control_address;
+  const std::string where = softpkg->spd_path.string();
+  std::unique_ptr<Component> component;
+  try {
+    component = factory(context);
+  } catch (const std::exception &e) {
+    return make_error({where, 0, 0}, "component", e.what());
+  }
+  auto host = std::make_unique<detail::Host>(std::move(component), std::move(softpkg));
+  if (auto prepared = host->prepare({}); !prepared)
+    return tl::unexpected(prepared.error());
+  if (auto opened = host->open(std::move(participant), {}); !opened)
+    return tl::unexpected(opened.error());
+  return std::unique_ptr<InProcessComponent>(new InProcessComponent(std::move(host), address));
+}
+
+Expected<void> InProcessComponent::bring_up(const control::Json &properties) {
+  return host_->bring_up(properties);
+}
+
+control::Json InProcessComponent::ports() const {
+  return host_->ports_json();
+}
+
+std::shared_ptr<spdlog::logger> in_process_logger(const std::string &name) {
+  const auto &sinks = spdlog::default_logger()->sinks();
+  auto logger = std::make_shared<spdlog::logger>(name, sinks.begin(), sinks.end());
+  logger->set_level(spdlog::default_logger()->level());
+  return logger;
+}
+
+} // namespace rsca::component

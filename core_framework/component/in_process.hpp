@@ -1,0 +1,50 @@
+// A component run inside the calling process rather than as a process of its own: a device with
+// ports inside its node daemon. It is served exactly as a component process is (the component.*
+// operations at its control address, its announcement), so the domain connects, configures and
+// queries it the same way.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "component/component.hpp"
+#include "component/runtime.hpp"
+#include "dds/participant.hpp"
+#include "profile/profile_loader.hpp"
+
+namespace rsca::component {
+
+namespace detail {
+class Host;
+}
+
+class InProcessComponent {
+public:
+  // Constructs the component, checks it against its profile (PRF and SCD) and serves it at
+  // `context.control_address` on `participant`.
+  static Expected<std::unique_ptr<InProcessComponent>>
+  open(const Factory &factory, Context context,
+       std::shared_ptr<const profile::ResolvedSoftPkg> softpkg,
+       std::shared_ptr<dds::Participant> participant);
+  ~InProcessComponent(); // stops and releases the component, then withdraws it
+  InProcessComponent(const InProcessComponent &) = delete;
+  InProcessComponent &operator=(const InProcessComponent &) = delete;
+
+  // Initializes, configures with `properties` (by id) and starts it, as its owner decides (a
+  // node brings its devices up itself; no domain does).
+  Expected<void> bring_up(const control::Json &properties);
+  const std::string &address() const { return address_; }
+  // Its ports as announced: [{"name", "direction", "repid"}].
+  control::Json ports() const;
+
+private:
+  explicit InProcessComponent(std::unique_ptr<detail::Host> host, std::string address);
+  std::unique_ptr<detail::Host> host_;
+  std::string address_;
+};
+
+// A logger for an in-process component: named after it, writing where the process's default
+// logger writes.
+std::shared_ptr<spdlog::logger> in_process_logger(const std::string &name);
+
+} // namespace rsca::component
