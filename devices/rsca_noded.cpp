@@ -9,6 +9,7 @@
 #include "dds/participant.hpp"
 #include "gpp/gpp_device.hpp"
 #include "monitor/host_monitor.hpp"
+#include "robot/robot_devices.hpp"
 #include "node/device_manager.hpp"
 
 namespace {
@@ -53,6 +54,7 @@ int main(int argc, char **argv) {
   rsca::node::DeviceRegistry registry;
   rsca::gpp::register_gpp(registry);
   rsca::monitor::register_host_monitor(registry);
+  rsca::robot::register_robot_devices(registry);
   auto participant = rsca::dds::Participant::create(rsca::dds::DdsSettings::from_environment());
   if (!participant) {
     spdlog::error("{}", participant.error().to_string());

@@ -188,6 +188,7 @@ struct DomainManager::Impl {
   // A device as its node announced it; null when its node has not registered or has no such
   // device. Called with `mutex` held.
   const Json *find_device(const std::string &id) const;
+  CallResult<std::string> device_address(const std::string &id);
   CallResult<ResolvedEnd> resolve_end(const PortRef &ref, profile::PortDirection direction);
   CallResult<ResolvedEnd> resolve_component_end(const PortRef &ref,
                                                 profile::PortDirection direction);
@@ -480,7 +481,45 @@ CallResult<Json> typed_values(const Application &app, const ComponentInstance &c
 
 } // namespace
 
+// A device's control address, for "device" requests of app.configure and app.query.
+CallResult<std::string> DomainManager::Impl::device_address(const std::string &id) {
+  std::lock_guard lock(mutex);
+  const Json *device = find_device(id);
+  if (device == nullptr)
+    return control::call_error(Status::NotFound, fmt::format("no device {} has registered", id));
+  if (!device->contains("address"))
+    return control::call_error(Status::NotFound,
+                               fmt::format("device {} has no properties to reach", id));
+  return device->value("address", "");
+}
+
+namespace {
+
+// Values given as text, for a device (whose PRF the domain does not hold): booleans and numbers
+// as such, the rest as text.
+Json json_values(const Json &values) {
+  Json out = Json::object();
+  for (const auto &[id, v] : values.items()) {
+    const std::string text = v.is_string() ? v.get<std::string>() : v.dump();
+    const Json parsed = Json::parse(text, nullptr, false);
+    out[id] =
+        !parsed.is_discarded() && (parsed.is_boolean() || parsed.is_number()) ? parsed : Json(text);
+  }
+  return out;
+}
+
+} // namespace
+
 CallResult<Json> DomainManager::Impl::configure(const Json &body) {
+  if (body.contains("device")) {
+    auto address = device_address(body.value("device", ""));
+    if (!address)
+      return tl::unexpected(address.error());
+    return endpoint->call_sync(
+        *address, "component.configure",
+        Json{{"properties", json_values(body.value("values", Json::object()))}},
+        options.call_timeout);
+  }
   auto app = find_application(body);
   if (!app)
     return tl::unexpected(app.error());
@@ -503,6 +542,14 @@ CallResult<Json> DomainManager::Impl::configure(const Json &body) {
 }
 
 CallResult<Json> DomainManager::Impl::query(const Json &body) {
+  if (body.contains("device")) {
+    auto address = device_address(body.value("device", ""));
+    if (!address)
+      return tl::unexpected(address.error());
+    return endpoint->call_sync(*address, "component.query",
+                               Json{{"ids", body.value("ids", Json::array())}},
+                               options.call_timeout);
+  }
   auto app = find_application(body);
   if (!app)
     return tl::unexpected(app.error());

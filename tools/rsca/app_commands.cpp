@@ -214,12 +214,16 @@ int simple_call(const char *what, const std::string &operation, Json body,
   return kOk;
 }
 
-// APP or APP/COMPONENT
-std::pair<std::string, std::string> split_target(const std::string &target) {
-  auto slash = target.find('/');
-  if (slash == std::string::npos)
-    return {target, ""};
-  return {target.substr(0, slash), target.substr(slash + 1)};
+// APP, APP/COMPONENT or NODE:DEVICE, with the request's other fields.
+Json target_json(const std::string &target, Json body) {
+  if (target.find(':') != std::string::npos) {
+    body["device"] = target;
+    return body;
+  }
+  const auto slash = target.find('/');
+  body["app"] = target.substr(0, slash);
+  body["component"] = slash == std::string::npos ? "" : target.substr(slash + 1);
+  return body;
 }
 
 // APP/COMPONENT.PORT as {"application", "component", "port"}.
@@ -410,10 +414,12 @@ void add_application_commands(CLI::App &app, const GlobalOptions &global, int &e
   }
 
   auto *configure_cmd = app.add_subcommand(
-      "configure", "Set properties of an application's assembly controller or one component");
+      "configure", "Set properties of an application's assembly controller, one component, or "
+                   "a device (NODE:DEVICE)");
   auto configure_target = std::make_shared<std::string>();
   auto assignments = std::make_shared<std::vector<std::string>>();
-  configure_cmd->add_option("target", *configure_target, "APP or APP/COMPONENT")->required();
+  configure_cmd->add_option("target", *configure_target, "APP, APP/COMPONENT or NODE:DEVICE")
+      ->required();
   configure_cmd->add_option("values", *assignments, "property=value ...")->required();
   configure_cmd->callback([=, &global, &exit_code] {
     auto values = parse_assignments(*assignments);
@@ -422,22 +428,20 @@ void add_application_commands(CLI::App &app, const GlobalOptions &global, int &e
       exit_code = kUsage;
       return;
     }
-    auto [app_name, component] = split_target(*configure_target);
     exit_code = simple_call("configure", "app.configure",
-                            Json{{"app", app_name}, {"component", component}, {"values", *values}},
-                            global, [](const Json &) { fmt::print("configured\n"); });
+                            target_json(*configure_target, {{"values", *values}}), global,
+                            [](const Json &) { fmt::print("configured\n"); });
   });
 
   auto *query_cmd = app.add_subcommand(
-      "query", "Read properties of an application's assembly controller or one component");
+      "query", "Read properties of an application's assembly controller, one component, or a "
+               "device (NODE:DEVICE)");
   auto query_target = std::make_shared<std::string>();
   auto ids = std::make_shared<std::vector<std::string>>();
-  query_cmd->add_option("target", *query_target, "APP or APP/COMPONENT")->required();
+  query_cmd->add_option("target", *query_target, "APP, APP/COMPONENT or NODE:DEVICE")->required();
   query_cmd->add_option("properties", *ids, "Property ids (default: all)");
   query_cmd->callback([=, &global, &exit_code] {
-    auto [app_name, component] = split_target(*query_target);
-    exit_code = simple_call("query", "app.query",
-                            Json{{"app", app_name}, {"component", component}, {"ids", *ids}},
+    exit_code = simple_call("query", "app.query", target_json(*query_target, {{"ids", *ids}}),
                             global, [](const Json &r) {
                               const Json properties = r.value("properties", Json::object());
                               for (const auto &[id, value] : properties.items())

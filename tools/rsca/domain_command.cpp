@@ -140,7 +140,18 @@ Expected<fs::path> node_dcd(int i, const fs::path &sdrroot, const fs::path &run)
   return out;
 }
 
-int up(int nodes, const fs::path &run, const GlobalOptions &global) {
+// One node daemon in the background for `dcd`, its log and pid file named `name`.
+Expected<pid_t> spawn_node(const fs::path &dcd, const std::string &name, const fs::path &run,
+                           const GlobalOptions &global) {
+  const fs::path bin = own_folder();
+  return spawn_daemon(bin / "rsca-noded",
+                      {"--dcd", dcd.string(), "--domain", global.domain, "--log-dir",
+                       (run / "logs").string(), "--exec-path", bin.string()},
+                      run / (name + ".log"), run / (name + ".pid"));
+}
+
+int up(int nodes, const std::vector<std::string> &extra_dcds, const fs::path &run,
+       const GlobalOptions &global) {
   std::error_code ec;
   fs::create_directories(run / "logs", ec);
   if (auto pid = read_pid(run / "domaind.pid"); pid && alive(*pid)) {
@@ -167,17 +178,24 @@ int up(int nodes, const fs::path &run, const GlobalOptions &global) {
       fmt::print(stderr, "rsca domain up: {}\n", dcd.error().to_string());
       return kFailed;
     }
-    const fs::path log = run / fmt::format("node{}.log", i);
-    auto pid = spawn_daemon(bin / "rsca-noded",
-                            {"--dcd", dcd->string(), "--domain", global.domain, "--log-dir",
-                             (run / "logs").string(), "--exec-path", bin.string()},
-                            log, run / fmt::format("node{}.pid", i));
+    const std::string name = fmt::format("node{}", i);
+    auto pid = spawn_node(*dcd, name, run, global);
     if (!pid) {
       fmt::print(stderr, "rsca domain up: {}\n", pid.error().to_string());
       return kFailed;
     }
-    started.emplace_back(*pid, log);
+    started.emplace_back(*pid, run / (name + ".log"));
   }
+  for (const auto &dcd : extra_dcds) {
+    const std::string name = fs::path(dcd).parent_path().filename().string();
+    auto pid = spawn_node(fs::absolute(dcd), name, run, global);
+    if (!pid) {
+      fmt::print(stderr, "rsca domain up: {}\n", pid.error().to_string());
+      return kFailed;
+    }
+    started.emplace_back(*pid, run / (name + ".log"));
+  }
+  const std::size_t expected = static_cast<std::size_t>(nodes) + extra_dcds.size();
   auto client = DomainClient::connect(global);
   if (!client) {
     fmt::print(stderr, "rsca domain up: {}\n", client.error().to_string());
@@ -194,7 +212,7 @@ int up(int nodes, const fs::path &run, const GlobalOptions &global) {
         return kFailed;
       }
     auto listed = client->call("domain.nodes", Json::object(), 1s);
-    if (listed && listed->at("nodes").size() >= static_cast<std::size_t>(nodes)) {
+    if (listed && listed->at("nodes").size() >= expected) {
       reply = *listed;
       break;
     }
@@ -210,7 +228,7 @@ int up(int nodes, const fs::path &run, const GlobalOptions &global) {
     print_json(reply);
   } else {
     fmt::print("domain {} up: domaind pid {}, {} node(s); logs in {}\n", global.domain, *domaind,
-               nodes, run.string());
+               expected, run.string());
   }
   return kOk;
 }
@@ -256,8 +274,11 @@ void add_domain_command(CLI::App &app, const GlobalOptions &global, int &exit_co
   up_cmd->add_option("--nodes", *nodes, "How many node daemons")
       ->capture_default_str()
       ->check(CLI::Range(1, 100));
+  auto extra = std::make_shared<std::vector<std::string>>();
+  up_cmd->add_option("--node", *extra, "One more node daemon, for this DCD (repeatable)")
+      ->check(CLI::ExistingFile);
   up_cmd->add_option("--run-dir", *run, "Logs and pid files go here")->capture_default_str();
-  up_cmd->callback([=, &global, &exit_code] { exit_code = up(*nodes, *run, global); });
+  up_cmd->callback([=, &global, &exit_code] { exit_code = up(*nodes, *extra, *run, global); });
   auto *down_cmd = domain->add_subcommand("down", "Stop the daemons started by `rsca domain up`");
   down_cmd->add_option("--run-dir", *run, "Where `domain up` put its pid files")
       ->capture_default_str();

@@ -1,0 +1,40 @@
+// Differential-drive kinematics and the braking model the tolerance of a stop is explained by.
+#pragma once
+
+#include "sim/pose.hpp"
+#include "sim/scenario.hpp"
+
+namespace rsca::sim {
+
+inline constexpr double gravity = 9.81; // m/s², the world's
+
+// Wheel angular speeds (rad/s, positive rolls the robot forward).
+struct WheelPair {
+  double left = 0.0;
+  double right = 0.0;
+
+  bool operator==(const WheelPair &) const = default;
+};
+
+// The wheel speeds that realise `command`, scaled down together when one would exceed the
+// motors' max speed so the robot keeps the commanded curvature rather than veering.
+WheelPair wheel_targets(const RobotParams &robot, Twist command);
+
+// The body velocity the wheel speeds give when they roll without slipping.
+Twist twist_of(const RobotParams &robot, WheelPair wheels);
+
+// The steady deceleration when both motors brake at their torque limit, or the one friction
+// allows if that is lower. The friction limit takes the wheels' static share of the weight
+// (braking shifts weight onto them, so it is conservative); the torque limit counts the wheels'
+// rotational inertia (the wheels are spheres: I = 2/5 m r²).
+double braking_deceleration(const RobotParams &robot, double friction);
+
+// v² / 2a: how far the robot rolls from `speed` once the motors target zero.
+double braking_distance(const RobotParams &robot, double friction, double speed);
+
+// How far past a range threshold a periodic controller lets the robot get: it keeps driving at
+// `speed` for up to `latency` after the reading crosses the threshold (control period + sensor
+// update period + the one step before a command takes effect), then brakes.
+double stop_tolerance(const RobotParams &robot, double friction, double speed, double latency);
+
+} // namespace rsca::sim
