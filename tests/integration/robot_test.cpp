@@ -1,0 +1,132 @@
+// The robot in the loop through a real domain: the robot node's devices (Robot, IRSensor,
+// DriveSystem) and StopCrash as a component process on another node, wired by the domain.
+#include "domain_fixture.hpp"
+#include "sim/drive.hpp"
+#include "sim/scenario.hpp"
+
+using namespace rsca::test;
+using namespace std::chrono_literals;
+
+namespace {
+
+const fs::path kRobotNode = kSource / "profiles/dev/nodes/robot/DeviceManager.dcd.xml";
+const fs::path kRangeStop = kSource / "profiles/dom/waveforms/RangeStop/RangeStop.sad.xml";
+
+Json properties(TestDomain &domain, Json target) {
+  auto q = domain.call("app.query", std::move(target));
+  REQUIRE(q.has_value());
+  return q->at("properties");
+}
+
+double robot(TestDomain &domain, const std::string &id) {
+  return properties(domain, {{"device", "robot:Robot_1"}, {"ids", {id}}}).at(id).get<double>();
+}
+
+Json drive(TestDomain &domain) {
+  return properties(domain, {{"device", "robot:DriveSystem_1"}, {"ids", Json::array()}});
+}
+
+// Launches RangeStop with StopCrash's speed and threshold, started.
+Json launch(TestDomain &domain, double speed, double threshold) {
+  auto [rc, out] = domain.cli({"launch", kRangeStop.string(), "--no-start"});
+  INFO(out);
+  REQUIRE(rc == 0);
+  REQUIRE(
+      domain
+          .call("app.configure", Json{{"app", "RangeStop"},
+                                      {"component", "StopCrash_1"},
+                                      {"properties", {{"speed", speed}, {"threshold", threshold}}}})
+          .has_value());
+  REQUIRE(domain.call("app.start", Json{{"app", "RangeStop"}}).has_value());
+  auto app = domain.call("app.show", Json{{"app", "RangeStop"}});
+  REQUIRE(app.has_value());
+  return *app;
+}
+
+bool at_rest(TestDomain &domain) {
+  return std::abs(robot(domain, "speed")) < 1e-3;
+}
+
+// Waits for the robot to come to rest after it has moved.
+bool rests(TestDomain &domain) {
+  return TestDomain::wait_for([&] { return at_rest(domain) && robot(domain, "sim_time") > 1; },
+                              60s);
+}
+
+} // namespace
+
+TEST_CASE("RangeStop through the domain: StopCrash on node1 stops the robot at the threshold, "
+          "within what the physics explains",
+          "[integration][robot]") {
+  TestDomain domain({TestDomain::shipped_nodes(1)[0], kRobotNode});
+  const double speed = 0.3, threshold = 0.6;
+  const Json app = launch(domain, speed, threshold);
+  CHECK(app.at("components")[0].at("device") == "node1:GPP_1");
+  REQUIRE(TestDomain::wait_for([&] { return robot(domain, "speed") > 0.25; }, 20s));
+  REQUIRE(rests(domain));
+  // The tolerance: up to a sensor period (20 ms) plus the middleware's hops (bounded here by
+  // another 20 ms) at speed before the stop takes effect, then the braking distance.
+  const auto scenario = rsca::sim::default_scenario();
+  const double tolerance =
+      rsca::sim::stop_tolerance(scenario.robot, scenario.friction, speed, 0.040) + 0.005;
+  const double distance = robot(domain, "distance_to_wall");
+  INFO("rested " << distance << " m from the wall; tolerance " << tolerance);
+  CHECK(distance < threshold);
+  CHECK(distance > threshold - tolerance);
+  const Json d = drive(domain);
+  CHECK(d.at("latency_samples").get<long>() > 50);
+  CHECK(d.at("latency_p50_us").get<double>() > 0);
+  CHECK(d.at("safety_stops") == 0);
+
+  REQUIRE(domain.call("app.release", Json{{"app", "RangeStop"}}).has_value());
+  // The devices stay, without the application's connections.
+  CHECK(port_connections(domain, "rsca/device/robot/IRSensor_1", "range_out") == 0);
+  CHECK(port_connections(domain, "rsca/device/robot/DriveSystem_1", "command_in") == 0);
+  domain.require_clean(pids_of(app));
+}
+
+TEST_CASE("StopCrash killed mid-run: the drive's own command deadline stops the robot",
+          "[integration][robot][failure]") {
+  TestDomain domain({TestDomain::shipped_nodes(1)[0], kRobotNode});
+  // A threshold the robot never reaches before the wall: only the drive's safety can stop it.
+  const Json app = launch(domain, 0.3, 0.05);
+  REQUIRE(TestDomain::wait_for([&] { return robot(domain, "speed") > 0.25; }, 20s));
+  const double before = robot(domain, "distance_to_wall");
+  ::kill(static_cast<pid_t>(app.at("components")[0].at("pid").get<long>()), SIGKILL);
+  REQUIRE(rests(domain));
+  const double after = robot(domain, "distance_to_wall");
+  INFO("killed at " << before << " m from the wall, rested at " << after);
+  CHECK(drive(domain).at("safety_stops") == 1);
+  // Within the deadline (200 ms) at speed plus braking: far from the wall.
+  CHECK(before - after < 0.3 * 0.25 + 0.05);
+  CHECK(after > 0.5);
+  REQUIRE(domain.call("app.release", Json{{"app", "RangeStop"}}).has_value());
+  domain.require_clean(pids_of(app));
+}
+
+TEST_CASE("the drive's emergency stop halts the robot within its braking distance and refuses "
+          "commands until lifted",
+          "[integration][robot]") {
+  TestDomain domain({TestDomain::shipped_nodes(1)[0], kRobotNode});
+  const Json app = launch(domain, 0.3, 0.05);
+  REQUIRE(TestDomain::wait_for([&] { return robot(domain, "speed") > 0.25; }, 20s));
+  const double before = robot(domain, "distance_to_wall");
+  REQUIRE(domain
+              .call("app.configure", Json{{"device", "robot:DriveSystem_1"},
+                                          {"values", {{"emergency_stop", "true"}}}})
+              .has_value());
+  REQUIRE(rests(domain));
+  const auto scenario = rsca::sim::default_scenario();
+  const double braking = rsca::sim::braking_distance(scenario.robot, scenario.friction, 0.3);
+  const double after = robot(domain, "distance_to_wall");
+  INFO("e-stopped at " << before << " m, rested at " << after << ", braking " << braking);
+  // The configure call's round trip (a few ms at 0.3 m/s) plus the braking distance.
+  CHECK(before - after < braking + 0.3 * 0.05);
+  // StopCrash keeps commanding forward motion: refused while the stop holds.
+  const long commands = drive(domain).at("commands_received").get<long>();
+  CHECK(TestDomain::wait_for(
+      [&] { return drive(domain).at("commands_received").get<long>() > commands + 5; }));
+  CHECK(at_rest(domain));
+  REQUIRE(domain.call("app.release", Json{{"app", "RangeStop"}}).has_value());
+  domain.require_clean(pids_of(app));
+}
