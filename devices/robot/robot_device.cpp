@@ -13,6 +13,18 @@ using component::Clock;
 using component::failure;
 using component::Result;
 
+namespace {
+
+// The sensor and the drive attach to the node's Robot: without one they cannot start.
+Result require_robot(const char *device) {
+  if (RobotWorld::current())
+    return {};
+  return failure(fmt::format(
+      "no simulated robot on this node: place a Robot device before {} in the DCD", device));
+}
+
+} // namespace
+
 // The world as the DCD describes it; re-created (the robot back at its start) by `reset`.
 class Robot final : public component::Component {
 public:
@@ -120,11 +132,7 @@ public:
   }
 
 private:
-  Result start() override {
-    if (!RobotWorld::current())
-      return failure("no simulated robot on this node: place a Robot device before IRSensor");
-    return {};
-  }
+  Result start() override { return require_robot("IRSensor"); }
 
   std::optional<Clock::duration> service() override {
     if (auto world = RobotWorld::current()) {
@@ -164,11 +172,7 @@ public:
   }
 
 private:
-  Result start() override {
-    if (!RobotWorld::current())
-      return failure("no simulated robot on this node: place a Robot device before DriveSystem");
-    return {};
-  }
+  Result start() override { return require_robot("DriveSystem"); }
 
   // "velocity" [linear m/s, angular rad/s], "stop", "estop". A command's timestamp_ns is when
   // the measurement it answers was taken: sensor-to-command latency is measured here.
