@@ -9,8 +9,8 @@
 #include "dds/participant.hpp"
 #include "gpp/gpp_device.hpp"
 #include "monitor/host_monitor.hpp"
-#include "robot/robot_devices.hpp"
 #include "node/device_manager.hpp"
+#include "robot/robot_devices.hpp"
 
 namespace {
 
