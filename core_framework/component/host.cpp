@@ -503,7 +503,8 @@ CallResult<Json> Host::op_status(const Json &) {
                              {"topic", s.topic},
                              {"matched", s.matched},
                              {"samples", s.samples},
-                             {"filtered", s.filtered}});
+                             {"filtered", s.filtered},
+                             {"deadline_missed", s.deadline_missed}});
     ports.push_back({{"name", port->name()},
                      {"direction", direction_name(port->direction())},
                      {"connections", std::move(connections)}});

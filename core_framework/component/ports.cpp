@@ -164,6 +164,16 @@ std::int32_t matched_count(dds_entity_t entity, profile::PortDirection direction
              : 0;
 }
 
+// How often the writer (uses) or the reader's writers (provides) missed the connection's deadline.
+std::uint32_t deadline_misses(dds_entity_t entity, profile::PortDirection direction) {
+  if (direction == profile::PortDirection::Uses) {
+    dds_offered_deadline_missed_status_t status{};
+    return dds_get_offered_deadline_missed_status(entity, &status) == 0 ? status.total_count : 0;
+  }
+  dds_requested_deadline_missed_status_t status{};
+  return dds_get_requested_deadline_missed_status(entity, &status) == 0 ? status.total_count : 0;
+}
+
 } // namespace
 
 PortBase::PortBase(std::string name, profile::PortDirection direction, port::PortType type)
@@ -216,7 +226,7 @@ std::vector<ConnectionStatus> PortBase::status() const {
   out.reserve(connections_.size());
   for (const auto &[id, c] : connections_)
     out.push_back({id, c->topic_name, matched_count(c->entity.get(), direction_), c->samples.load(),
-                   c->filtered.load()});
+                   c->filtered.load(), deadline_misses(c->entity.get(), direction_)});
   return out;
 }
 

@@ -32,9 +32,10 @@ class ReceiveLoop;
 struct ConnectionStatus {
   std::string connection;
   std::string topic;
-  std::int32_t matched = 0;   // readers (uses) or writers (provides) matched on the topic
-  std::uint64_t samples = 0;  // written (uses) or received (provides)
-  std::uint64_t filtered = 0; // provides: received but not delivered (the content filter)
+  std::int32_t matched = 0;          // readers (uses) or writers (provides) matched on the topic
+  std::uint64_t samples = 0;         // written (uses) or received (provides)
+  std::uint64_t filtered = 0;        // provides: received but not delivered (the content filter)
+  std::uint32_t deadline_missed = 0; // the connection's deadline, missed (offered or requested)
 };
 
 // A QoS problem of a provides port's connection since it was last reported: the writer missed

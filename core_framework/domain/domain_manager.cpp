@@ -83,7 +83,8 @@ Json end_state(const std::map<std::string, Json> &status_of, const std::string &
       if (c.value("connection", "") == connection)
         return Json{{"matched", c.value("matched", 0)},
                     {"samples", c.value("samples", 0)},
-                    {"filtered", c.value("filtered", 0)}};
+                    {"filtered", c.value("filtered", 0)},
+                    {"deadline_missed", c.value("deadline_missed", 0)}};
   }
   return nullptr;
 }

@@ -319,6 +319,12 @@ TEST_CASE("a deadline the writer stops meeting is reported as a domain event",
   CHECK(problem.value("connection", "") == "samples");
   CHECK(problem.value("problem", "") == "deadline missed");
   CHECK(problem.value("count", 0) > 0);
+  // Both ends count the misses in the connection's live state.
+  auto list = domain.call("connection.list", Json{{"app", "ProducerConsumer"}});
+  REQUIRE(list.has_value());
+  const Json &samples = list->at("connections")[0];
+  CHECK(samples.at("uses_state").at("deadline_missed").get<int>() > 0);
+  CHECK(samples.at("provides_state").at("deadline_missed").get<int>() > 0);
   REQUIRE(domain.call("app.release", Json{{"app", "ProducerConsumer"}}).has_value());
   domain.require_clean(pids_of(*app));
 }

@@ -65,8 +65,10 @@ void print_channels(const Json &r) {
 std::string end_state(const Json &state) {
   if (state.is_null())
     return "-";
-  return fmt::format("{} matched, {} samples", state.value("matched", 0),
-                     state.value("samples", 0));
+  const int missed = state.value("deadline_missed", 0);
+  return fmt::format("{} matched, {} samples{}", state.value("matched", 0),
+                     state.value("samples", 0),
+                     missed == 0 ? "" : fmt::format(", {} deadlines missed", missed));
 }
 
 void print_connections(const Json &r) {
