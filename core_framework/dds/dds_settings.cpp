@@ -1,5 +1,6 @@
 #include "dds/dds_settings.hpp"
 
+#include <cctype>
 #include <cstdlib>
 #include <string_view>
 
@@ -43,6 +44,11 @@ DdsSettings DdsSettings::from_environment() {
   s.lease = std::chrono::milliseconds(
       env_number_or("RSCA_DDS_LEASE_MS", static_cast<std::uint64_t>(s.lease.count())));
   s.trace = env_or("RSCA_DDS_TRACE", s.trace);
+  s.tag = env_or("RSCA_DDS_TAG", s.tag);
+  // Only characters that need no escaping in the XML configuration.
+  std::erase_if(s.tag, [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) == 0 && c != '-' && c != '_';
+  });
   return s;
 }
 
@@ -51,7 +57,8 @@ std::vector<std::pair<std::string, std::string>> DdsSettings::environment() cons
           {"RSCA_DDS_INTERFACE", interface_name},
           {"RSCA_DDS_PEER", peer},
           {"RSCA_DDS_LEASE_MS", std::to_string(lease.count())},
-          {"RSCA_DDS_TRACE", trace}};
+          {"RSCA_DDS_TRACE", trace},
+          {"RSCA_DDS_TAG", tag}};
 }
 
 std::string cyclone_config(const DdsSettings &settings) {
@@ -63,6 +70,7 @@ std::string cyclone_config(const DdsSettings &settings) {
   replace_all(text, "${MAX_PARTICIPANTS}", std::to_string(settings.max_participants));
   replace_all(text, "${LEASE}", fmt::format("{}ms", settings.lease.count()));
   replace_all(text, "${TRACE}", settings.trace);
+  replace_all(text, "${TAG}", settings.tag);
   return text;
 }
 

@@ -17,9 +17,13 @@ struct DdsSettings {
   std::uint32_t max_participants = 600;
   std::chrono::milliseconds lease{1000};
   std::string trace = "warning";
+  // Cyclone's discovery tag: participants only discover those with the same domain id and tag.
+  // Tests and benchmarks give each run one of its own, so runs that happen to share a domain id
+  // never meet. Letters, digits, '-' and '_' only.
+  std::string tag;
 
   // Defaults overridden by RSCA_DDS_DOMAIN, RSCA_DDS_INTERFACE, RSCA_DDS_PEER, RSCA_DDS_LEASE_MS,
-  // RSCA_DDS_TRACE.
+  // RSCA_DDS_TRACE, RSCA_DDS_TAG.
   static DdsSettings from_environment();
   // The variables that make a child process join the same domain.
   std::vector<std::pair<std::string, std::string>> environment() const;

@@ -52,7 +52,8 @@ public:
       : run_(fs::temp_directory_path() /
              fmt::format("rsca-it-{}-{}", getpid(), std::random_device{}())) {
     fs::create_directories(run_ / "logs");
-    env_ = {{"RSCA_DDS_DOMAIN", std::to_string(rsca::test::isolated_domain_id())}};
+    env_ = {{"RSCA_DDS_DOMAIN", std::to_string(rsca::test::isolated_domain_id())},
+            {"RSCA_DDS_TAG", rsca::test::isolated_tag()}};
     start_domaind(registration_timeout_ms);
     for (const auto &dcd : dcds)
       launch_node(dcd);

@@ -2,6 +2,9 @@
 // parallel (and leftovers of a crashed run) never see each other.
 #pragma once
 
+#include <random>
+#include <string>
+
 #include <memory>
 #include <unistd.h>
 
@@ -17,9 +20,20 @@ inline std::uint32_t isolated_domain_id() {
   return 1 + static_cast<std::uint32_t>(::getpid()) % 230;
 }
 
+// A discovery tag of this test process's own: two test processes whose domain ids collide
+// (or a benchmark on the same machine) still never discover each other.
+inline const std::string &isolated_tag() {
+  static const std::string tag = [] {
+    std::random_device random;
+    return "test-" + std::to_string(::getpid()) + "-" + std::to_string(random());
+  }();
+  return tag;
+}
+
 inline dds::DdsSettings isolated_settings() {
   auto settings = dds::DdsSettings::from_environment();
   settings.domain_id = isolated_domain_id();
+  settings.tag = isolated_tag();
   return settings;
 }
 
