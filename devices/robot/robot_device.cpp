@@ -166,6 +166,7 @@ public:
     property("command_timeout_ms", command_timeout_ms_);
     property("commands_received", commands_);
     property("safety_stops", safety_stops_);
+    property("latency_mean_us", latency_mean_us_);
     property("latency_p50_us", latency_p50_us_);
     property("latency_p99_us", latency_p99_us_);
     property("latency_samples", latency_samples_);
@@ -201,6 +202,8 @@ private:
   void record_latency(double us) {
     latencies_.push_back(us);
     latency_samples_ = latencies_.size();
+    latency_sum_us_ += us;
+    latency_mean_us_ = latency_sum_us_ / static_cast<double>(latencies_.size());
     if (latencies_.size() % 10 != 1)
       return; // percentiles are refreshed every 10 commands
     auto sorted = latencies_;
@@ -228,10 +231,12 @@ private:
   std::uint32_t command_timeout_ms_ = 200;
   std::uint64_t commands_ = 0;
   std::uint64_t safety_stops_ = 0;
+  double latency_mean_us_ = 0;
   double latency_p50_us_ = 0;
   double latency_p99_us_ = 0;
   std::uint64_t latency_samples_ = 0;
   std::vector<double> latencies_;
+  double latency_sum_us_ = 0;
   std::optional<Clock::time_point> last_command_;
 };
 

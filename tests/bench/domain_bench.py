@@ -17,53 +17,9 @@ import os
 import statistics
 import subprocess
 import sys
-import tempfile
 import time
 
-
-def percentile(values, p):
-    ordered = sorted(values)
-    index = min(len(ordered) - 1, max(0, round(p / 100 * (len(ordered) - 1))))
-    return ordered[index]
-
-
-def summary(values):
-    return {"median": statistics.median(values), "p95": percentile(values, 95),
-            "min": min(values), "max": max(values), "runs": len(values)}
-
-
-class Domain:
-    def __init__(self, rsca, nodes):
-        self.rsca = rsca
-        self.run_dir = tempfile.mkdtemp(prefix="rsca-bench-")
-        self.env = dict(os.environ, RSCA_RUN_DIR=self.run_dir,
-                        RSCA_DDS_DOMAIN=str(150 + os.getpid() % 80))
-        self.nodes = nodes
-
-    def cli(self, *args, check=True):
-        started = time.perf_counter()
-        out = subprocess.run([self.rsca, "--json", *args], env=self.env, capture_output=True,
-                             text=True)
-        elapsed = (time.perf_counter() - started) * 1e3
-        if check and out.returncode != 0:
-            raise RuntimeError(f"rsca {' '.join(args)} failed ({out.returncode}): {out.stderr}")
-        return (json.loads(out.stdout) if out.stdout.strip() else {}), elapsed
-
-    def __enter__(self):
-        subprocess.run([self.rsca, "domain", "up", "--nodes", str(self.nodes)], env=self.env,
-                       check=True, stdout=subprocess.DEVNULL)
-        return self
-
-    def __exit__(self, *exc):
-        subprocess.run([self.rsca, "domain", "down"], env=self.env, stdout=subprocess.DEVNULL)
-
-    def daemon_pids(self):
-        pids = {}
-        for name in sorted(os.listdir(self.run_dir)):
-            if name.endswith(".pid"):
-                with open(os.path.join(self.run_dir, name)) as f:
-                    pids[name[:-4]] = int(f.read().split()[0])
-        return pids
+from local_domain import Domain, summary
 
 
 def memory_kb(pid):

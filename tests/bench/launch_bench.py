@@ -1,0 +1,97 @@
+#!/usr/bin/env python3
+"""Launch and teardown at scale on a real local domain (run by tools/bench, never by ctest).
+
+Starts `rsca domain up --nodes 10` on a DDS domain id and run folder of its own, writes chains of
+N Relay components with tools/gen-app (N = 10, 100), and for each N launches and releases the
+chain `runs` times, spread over the 10 nodes:
+- launch: until every component runs and every connection is matched (the domain's connect step
+  waits for that before start), as the domain timed it and as the CLI saw it;
+- teardown: `rsca release`, CLI wall clock (an upper bound: it includes the CLI's own start and
+  DDS discovery, about 40 ms);
+- baseline: a plain fork/exec of N processes of the same executable, started at once and waited
+  for (they exit at once: no exec parameters), the cost of process creation alone.
+Growth from one N to the next says whether launch time is about linear in N.
+"""
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+
+from local_domain import Domain, summary
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+
+def generate(n, out):
+    path = subprocess.run([os.path.join(ROOT, "tools/gen-app"), "--shape", "chain",
+                           "--components", str(n), "--out", out],
+                          check=True, capture_output=True, text=True).stdout.strip()
+    return path, f"Chain{n}"
+
+
+def baseline_ms(relay, n):
+    began = time.perf_counter()
+    procs = [subprocess.Popen([relay], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+             for _ in range(n)]
+    for p in procs:
+        p.wait()
+    return (time.perf_counter() - began) * 1e3
+
+
+def bench_n(domain, n, runs, sdr, relay):
+    sad, name = generate(n, sdr)
+    domain.cli("install", "--sdrroot", sdr, sad)
+    launch_domain, launch_cli, release_cli, base, steps = [], [], [], [], {}
+    for i in range(runs):
+        reply, wall = domain.cli("launch", name, "--name", f"{name}_{i}", "--strategy", "spread")
+        launch_cli.append(wall)
+        launch_domain.append(reply["launch"]["ms"])
+        for s in reply["launch"]["steps"]:
+            steps.setdefault(s["step"], []).append(s["ms"])
+        _, wall = domain.cli("release", f"{name}_{i}")
+        release_cli.append(wall)
+        base.append(baseline_ms(relay, n))
+    return {"components": n, "nodes": domain.nodes,
+            "launch_domain_ms": summary(launch_domain), "launch_cli_ms": summary(launch_cli),
+            "release_cli_ms": summary(release_cli), "baseline_fork_exec_ms": summary(base),
+            "steps_ms_median": {k: sorted(v)[len(v) // 2] for k, v in steps.items()}}
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--bin", required=True)
+    parser.add_argument("--out", required=True)
+    parser.add_argument("--quick", action="store_true")
+    args = parser.parse_args()
+    sizes = [10, 100]
+    runs = 3 if args.quick else 10
+    rsca = os.path.join(args.bin, "rsca")
+    results = []
+    with tempfile.TemporaryDirectory(prefix="rsca-gen-") as sdr, Domain(rsca, nodes=10) as domain:
+        for n in sizes:
+            results.append(bench_n(domain, n, runs, sdr, os.path.join(args.bin, "rsca-relay")))
+    with open(args.out, "w") as f:
+        json.dump({"launch": results}, f, indent=2)
+    print("| components | nodes | launch (domain) median | p95 | launch (CLI) median | "
+          "release (CLI) median | p95 | fork/exec baseline median |")
+    print("| --- | --- | --- | --- | --- | --- | --- | --- |")
+    for r in results:
+        print(f"| {r['components']} | {r['nodes']} | {r['launch_domain_ms']['median']:.1f} ms | "
+              f"{r['launch_domain_ms']['p95']:.1f} ms | {r['launch_cli_ms']['median']:.1f} ms | "
+              f"{r['release_cli_ms']['median']:.1f} ms | {r['release_cli_ms']['p95']:.1f} ms | "
+              f"{r['baseline_fork_exec_ms']['median']:.1f} ms |")
+    for a, b in zip(results, results[1:]):
+        growth = b["launch_domain_ms"]["median"] / a["launch_domain_ms"]["median"]
+        print(f"launch growth {a['components']} -> {b['components']} components: x{growth:.1f} "
+              f"(x{b['components'] / a['components']:.0f} would be linear)")
+    for r in results:
+        print(f"steps (median ms) at {r['components']}: " +
+              ", ".join(f"{k} {v:.1f}" for k, v in r["steps_ms_median"].items()))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

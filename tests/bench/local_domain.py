@@ -1,0 +1,239 @@
+"""A real local rsca domain for the benchmarks, and the helpers they share (domain_bench.py,
+port_bench.py; run by tools/bench, never by ctest).
+
+Domain starts `rsca domain up` (a domain daemon and N node daemons) on a DDS domain id and run
+folder of its own, optionally on another SDR root, and runs the CLI against it. Processes starts
+other programs, each in a process group of its own. Both kill everything they started when they
+go, also on failure: the daemons are taken down gracefully first, then whatever is left of them,
+of the component processes they ran and of the other programs is killed by process group.
+"""
+import json
+import os
+import signal
+import statistics
+import subprocess
+import tempfile
+import time
+
+
+def percentile(values, p):
+    ordered = sorted(values)
+    index = min(len(ordered) - 1, max(0, round(p / 100 * (len(ordered) - 1))))
+    return ordered[index]
+
+
+def summary(values):
+    return {"median": statistics.median(values), "p95": percentile(values, 95),
+            "min": min(values), "max": max(values), "runs": len(values)}
+
+
+def alive(pid):
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    try:
+        with open(f"/proc/{pid}/stat") as f:
+            return f.read().rsplit(")", 1)[1].split()[0] != "Z"
+    except OSError:
+        return False
+
+
+def kill_group(pid, sig=signal.SIGKILL):
+    """Signals the process group led by `pid`: the daemons, the component processes and what
+    Processes starts each lead their own. (A group id is not reused while the group has members,
+    so this never reaches a stranger.)"""
+    try:
+        os.killpg(pid, sig)
+    except (ProcessLookupError, PermissionError):
+        pass
+
+
+def wait_gone(pids, timeout):
+    deadline = time.monotonic() + timeout
+    while any(alive(p) for p in pids) and time.monotonic() < deadline:
+        time.sleep(0.05)  # pacing a poll of processes exiting
+    return not any(alive(p) for p in pids)
+
+
+class Domain:
+    """`rsca domain up --nodes N` on a DDS domain id and run folder of its own. With `sdrroot`,
+    the DMD and the node DCDs (dev/nodes/node1..N) come from that SDR root; `env` adds to the
+    environment of the daemons (and so of the components) and of the CLI, e.g. RSCA_DDS_* settings
+    (docs/architecture.md). `env` is what other programs of the run must use to join the domain."""
+
+    def __init__(self, rsca, nodes, sdrroot=None, env=None, domaind_args=None):
+        self.rsca = rsca
+        # With domaind_args (e.g. ["--registration-timeout-ms", "60000"]), the daemons are started
+        # here as `rsca domain up` starts them (own session, log and pid file in the run folder,
+        # the SDR root's DMD and dev/nodes/nodeI DCDs), rsca-domaind with these arguments more.
+        self.domaind_args = domaind_args
+        self.spawned = []
+        self.run_dir = tempfile.mkdtemp(prefix="rsca-bench-")
+        # DDS domain ids up to 224: with MaxAutoParticipantIndex 600 (cyclonedds.xml) the unicast
+        # discovery ports of a domain id from 228 on run past 65535.
+        self.env = dict(os.environ, RSCA_RUN_DIR=self.run_dir,
+                        RSCA_DDS_DOMAIN=str(150 + os.getpid() % 75), **(env or {}))
+        self.nodes = nodes
+        self.sdrroot = sdrroot
+        self.daemons = {}
+        self.components = set()  # pids of component processes launched, killed at the end
+        self.exe_dir = os.path.dirname(os.path.realpath(rsca))
+
+    def _global(self):
+        return ["--sdrroot", self.sdrroot] if self.sdrroot else []
+
+    def cli(self, *args, check=True, timeout=600):
+        started = time.perf_counter()
+        out = subprocess.run([self.rsca, "--json", *args], env=self.env, capture_output=True,
+                             text=True, timeout=timeout)
+        elapsed = (time.perf_counter() - started) * 1e3
+        if check and out.returncode != 0:
+            raise RuntimeError(f"rsca {' '.join(args)} failed ({out.returncode}): "
+                               f"{out.stderr}{out.stdout}")
+        reply = json.loads(out.stdout) if out.stdout.strip() else {}
+        self._remember_components(reply)
+        return reply, elapsed
+
+    def _remember_components(self, reply):
+        def walk(node):
+            if isinstance(node, dict):
+                for c in node.get("components", []) if isinstance(node.get("components"),
+                                                                   list) else []:
+                    if isinstance(c, dict) and isinstance(c.get("pid"), int) and c["pid"] > 0:
+                        self.components.add(c["pid"])
+                for v in node.values():
+                    walk(v)
+            elif isinstance(node, list):
+                for v in node:
+                    walk(v)
+        walk(reply)
+
+    def _spawn(self, name, args):
+        with open(os.path.join(self.run_dir, f"{name}.log"), "ab") as log:
+            proc = subprocess.Popen(args, env=self.env, stdin=subprocess.DEVNULL, stdout=log,
+                                    stderr=subprocess.STDOUT, start_new_session=True)
+        self.spawned.append(proc)
+        with open(os.path.join(self.run_dir, f"{name}.pid"), "w") as f:
+            f.write(f"{proc.pid}\n")
+
+    def _up_by_hand(self):
+        bin_dir = os.path.dirname(os.path.realpath(self.rsca))
+        sdrroot = self.sdrroot or os.path.join(bin_dir, "../../profiles")
+        os.makedirs(os.path.join(self.run_dir, "logs"), exist_ok=True)
+        self._spawn("domaind", [os.path.join(bin_dir, "rsca-domaind"), "--dmd",
+                                os.path.join(sdrroot, "dom/domain/DomainManager.dmd.xml"),
+                                "--repository", os.path.join(self.run_dir, "repository"),
+                                *self.domaind_args])
+        for i in range(1, self.nodes + 1):
+            self._spawn(f"node{i}", [
+                os.path.join(bin_dir, "rsca-noded"), "--dcd",
+                os.path.join(sdrroot, f"dev/nodes/node{i}/DeviceManager.dcd.xml"), "--log-dir",
+                os.path.join(self.run_dir, "logs"), "--exec-path", bin_dir])
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline:
+            try:
+                reply, _ = self.cli("ls", "nodes", check=False, timeout=30)
+            except ValueError:  # not JSON: the domain daemon is not there yet
+                reply = {}
+            if len(reply.get("nodes", [])) >= self.nodes:
+                return
+            time.sleep(0.2)  # pacing a poll of the domain
+        raise RuntimeError(f"the nodes did not all register within 60 s (see {self.run_dir})")
+
+    def __enter__(self):
+        try:
+            if self.domaind_args:
+                self._up_by_hand()
+            else:
+                subprocess.run([self.rsca, *self._global(), "domain", "up", "--nodes",
+                                str(self.nodes)], env=self.env, check=True,
+                               stdout=subprocess.DEVNULL, timeout=120)
+        except BaseException:
+            self.daemons = self.daemon_pids()
+            self.__exit__(None, None, None)
+            raise
+        self.daemons = self.daemon_pids()
+        return self
+
+    def __exit__(self, *exc):
+        try:
+            subprocess.run([self.rsca, "domain", "down"], env=self.env,
+                           stdout=subprocess.DEVNULL, timeout=60)
+        except (subprocess.SubprocessError, OSError):
+            pass
+        # Whatever survived: the daemons lead their sessions, each component its group.
+        leftovers = [p for p in list(self.daemons.values()) + sorted(self.components)
+                     if alive(p) and self._ours(p)]
+        for pid in leftovers:
+            kill_group(pid)
+        wait_gone(leftovers, 5)
+        for proc in self.spawned:  # reaped: no zombie outlives the benchmark
+            try:
+                proc.wait(timeout=5)
+            except subprocess.TimeoutExpired:
+                kill_group(proc.pid)
+                proc.wait()
+
+    def _ours(self, pid):
+        """Whether `pid` still runs one of the build's programs (and is not a reused pid)."""
+        try:
+            return os.path.dirname(os.path.realpath(f"/proc/{pid}/exe")) == self.exe_dir
+        except OSError:
+            return False
+
+    def daemon_pids(self):
+        pids = {}
+        for name in sorted(os.listdir(self.run_dir)):
+            if name.endswith(".pid"):
+                with open(os.path.join(self.run_dir, name)) as f:
+                    pids[name[:-4]] = int(f.read().split()[0])
+        return pids
+
+
+class Processes:
+    """Programs started for a benchmark, each in a process group of its own; all of them are
+    stopped (SIGTERM, then SIGKILL) when it goes, also on failure."""
+
+    def __init__(self):
+        self.started = []
+
+    def start(self, args, env, log_path):
+        log = open(log_path, "w")
+        try:
+            proc = subprocess.Popen(args, env=env, stdin=subprocess.DEVNULL,
+                                    stdout=subprocess.PIPE, stderr=log, text=True,
+                                    start_new_session=True)
+        finally:
+            log.close()
+        self.started.append(proc)
+        return proc
+
+    def stop(self, procs, timeout=10):
+        """SIGTERM to each, then SIGKILL to what is still there after `timeout`; returns each
+        one's stdout."""
+        for p in procs:
+            if p.poll() is None:
+                kill_group(p.pid, signal.SIGTERM)
+        outputs = []
+        deadline = time.monotonic() + timeout
+        for p in procs:
+            try:
+                out, _ = p.communicate(timeout=max(0.1, deadline - time.monotonic()))
+            except subprocess.TimeoutExpired:
+                kill_group(p.pid)
+                out, _ = p.communicate()
+            outputs.append(out)
+        return outputs
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        running = [p for p in self.started if p.poll() is None]
+        if running:
+            self.stop(running, timeout=5)
+        for p in self.started:  # their groups too: nothing they started may outlive them
+            kill_group(p.pid)

@@ -1,0 +1,308 @@
+#!/usr/bin/env python3
+"""The RSCA paper's three-way comparison (run by tools/bench, never by ctest): the same StopCrash
+control loop (drive toward the wall at 0.3 m/s, the IR range read every 20 ms, stop below 0.6 m)
+run three ways, in real time, each over 20 runs (--quick: 5):
+
+- inprocess: one process, direct calls (tests/bench/rangestop/rangestop_inprocess.cpp): the world
+  stepped in real time on one thread, a sensor thread every period calling the controller, which
+  calls the drive. Delay: from the reading's timestamp to the drive's call.
+- tcp: two processes over loopback TCP with TCP_NODELAY (tests/bench/rangestop/rangestop_tcp.cpp):
+  the robot (world, sensor, drive) sends each reading with its timestamp, the controller answers
+  with a command carrying it back. Delay: from the reading's timestamp to the command's arrival.
+- rsca: a real local domain (rsca-domaind, rsca-noded for node1, a GPP, and rsca-noded for the
+  robot's DCD), RangeStop launched: StopCrash in a process of its own on node1, the IRSensor and
+  the DriveSystem devices in the robot's node daemon, connected over Cyclone DDS. Delay: what the
+  DriveSystem measures (latency_mean_us, latency_p50_us, latency_p99_us, over every command of all
+  runs, including the zero commands StopCrash sends once stopped until it is stopped).
+  Between runs the application is stopped, the Robot given the run's seed and reset (its world
+  re-created, the robot back at its start), and the application started again (StopCrash.start()
+  clears its latch). The CLI is not called while the robot drives toward the wall (every CLI call
+  is a DDS participant whose discovery every process feels): the script sleeps for the expected
+  drive time, then polls the Robot until it rests.
+
+Run i (from 0) uses seed 1 + i in all three ways (the sensor's noise). The stopping distance is the
+exact distance from the sensor to the wall at rest (world.true_range(0); the Robot's
+distance_to_wall). The prediction is sim::stop_tolerance with latency = the sensor period: the
+robot should rest no nearer than threshold - tolerance, give or take the noise (sigma 5 mm).
+Delay percentiles are taken as the DriveSystem takes them (sorted[n/2], sorted[n*99/100]).
+
+Every process started is stopped at the end, also on failure.
+"""
+import argparse
+import json
+import os
+import platform
+import select
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+from local_domain import Domain, Processes
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(os.path.dirname(HERE))
+WAYS = ("inprocess", "tcp", "rsca")
+LAUNCH_ATTEMPTS = 3
+
+
+def p50_p99(values):
+    """As the DriveSystem computes them (devices/robot/robot_device.cpp, record_latency)."""
+    s = sorted(values)
+    return s[len(s) // 2], s[min(len(s) - 1, len(s) * 99 // 100)]
+
+
+def delay_summary(values):
+    p50, p99 = p50_p99(values)
+    return {"mean": statistics.fmean(values), "p50": p50, "p99": p99, "max": max(values),
+            "samples": len(values)}
+
+
+def distance_summary(values):
+    return {"mean": statistics.fmean(values),
+            "sd": statistics.stdev(values) if len(values) > 1 else 0.0,
+            "min": min(values), "max": max(values)}
+
+
+def parse_lines(text, program):
+    lines = [json.loads(line) for line in text.splitlines() if line.strip()]
+    if not lines or "settings" not in lines[0]:
+        raise RuntimeError(f"{program}: no header in its output: {text[:300]!r}")
+    return lines[0], lines[1:]
+
+
+def baseline_result(header, runs):
+    delays = [d for r in runs for d in r["delays_us"]]
+    return {
+        "header": header,
+        "runs": [dict({k: v for k, v in r.items() if k != "delays_us"},
+                      delay_us=delay_summary(r["delays_us"])) for r in runs],
+        "delay_us": delay_summary(delays),
+        "stop_distance_m": distance_summary([r["distance_to_wall"] for r in runs]),
+    }
+
+
+def common_args(args, runs):
+    return ["--runs", str(runs), "--first-seed", "1", "--speed", str(args.speed),
+            "--threshold", str(args.threshold), "--period-ms", str(args.period_ms)]
+
+
+def run_inprocess(args, runs, logs):
+    exe = os.path.join(args.bin, "rsca-bench-rangestop-inprocess")
+    with Processes() as procs:
+        p = procs.start([exe, *common_args(args, runs)], os.environ,
+                        os.path.join(logs, "inprocess.log"))
+        out, _ = p.communicate(timeout=60 * runs + 30)
+        if p.returncode != 0:
+            raise RuntimeError(f"{exe} failed ({p.returncode}), see {logs}/inprocess.log")
+    return baseline_result(*parse_lines(out, exe))
+
+
+def read_line(proc, timeout, what):
+    ready, _, _ = select.select([proc.stdout], [], [], timeout)
+    line = proc.stdout.readline() if ready else ""
+    if not line:
+        raise RuntimeError(f"{what}: nothing on its output within {timeout} s")
+    return json.loads(line)
+
+
+def run_tcp(args, runs, logs):
+    exe = os.path.join(args.bin, "rsca-bench-rangestop-tcp")
+    with Processes() as procs:
+        controller = procs.start([exe, "--role", "controller", *common_args(args, runs)],
+                                 os.environ, os.path.join(logs, "tcp-controller.log"))
+        port = read_line(controller, 10, "the TCP controller")["listening"]
+        robot = procs.start([exe, "--role", "robot", "--port", str(port),
+                             *common_args(args, runs)], os.environ,
+                            os.path.join(logs, "tcp-robot.log"))
+        out, _ = robot.communicate(timeout=60 * runs + 30)
+        if robot.returncode != 0:
+            raise RuntimeError(f"{exe} --role robot failed ({robot.returncode}), "
+                               f"see {logs}/tcp-robot.log")
+        controller.wait(timeout=10)  # it leaves when the robot hangs up
+    return baseline_result(*parse_lines(out, exe))
+
+
+class RobotDomain(Domain):
+    """local_domain.Domain with the robot's node as well: `rsca domain up --nodes 1 --node DCD`
+    (node1, a GPP, and the robot with its Robot, IRSensor and DriveSystem devices)."""
+
+    def __init__(self, rsca, dcd, sdrroot):
+        super().__init__(rsca, nodes=1, sdrroot=sdrroot, env={"RSCA_SDRROOT": sdrroot})
+        self.dcd = dcd
+
+    def __enter__(self):
+        try:
+            subprocess.run([self.rsca, *self._global(), "domain", "up", "--nodes",
+                            str(self.nodes), "--node", self.dcd], env=self.env, check=True,
+                           stdout=subprocess.DEVNULL, timeout=120)
+        except BaseException:
+            self.daemons = self.daemon_pids()
+            self.__exit__(None, None, None)
+            raise
+        self.daemons = self.daemon_pids()
+        return self
+
+
+def props(domain, target, *names, check=True):
+    reply, _ = domain.cli("query", target, *names, check=check)
+    return reply.get("properties", {})
+
+
+def wait_for_rest(domain, args, run):
+    """The Robot slower than 1 mm/s, past where it started, on 3 polls in a row (tools/demo)."""
+    deadline = time.monotonic() + 60
+    still = 0
+    while time.monotonic() < deadline:
+        try:
+            robot = props(domain, "robot:Robot_1", "speed", "distance_to_wall")
+        except (RuntimeError, ValueError):  # a CLI call that failed on a busy host: poll again
+            robot = {}
+        if (robot and abs(robot["speed"]) < 1e-3
+                and robot["distance_to_wall"] < args.wall_distance - 0.1):
+            still += 1
+            if still >= 3:
+                return
+        else:
+            still = 0
+        time.sleep(0.2)  # pacing a poll of the robot's state
+    raise RuntimeError(f"rsca run {run}: the robot did not come to rest within 60 s")
+
+
+def run_rsca(args, runs, logs):
+    rsca = os.path.join(args.bin, "rsca")
+    dcd = os.path.join(args.sdrroot, "dev/nodes/robot/DeviceManager.dcd.xml")
+    # The drive toward the threshold (plus the start and the braking): no CLI call meanwhile.
+    drive_s = max(0.0, (args.wall_distance - args.threshold) / args.speed)
+    results = []
+    with RobotDomain(rsca, dcd, args.sdrroot) as domain:
+        try:
+            domain.cli("configure", "robot:IRSensor_1", f"period_ms={args.period_ms}")
+            domain.cli("install", os.path.join(args.sdrroot,
+                                               "dom/waveforms/RangeStop/RangeStop.sad.xml"))
+            for attempt in range(1, LAUNCH_ATTEMPTS + 1):
+                try:
+                    domain.cli("launch", "RangeStop", "--no-start")
+                    break
+                except RuntimeError as e:  # rolled back by the domain: nothing is left of it
+                    if attempt == LAUNCH_ATTEMPTS:
+                        raise
+                    print(f"launch of RangeStop failed (attempt {attempt}), trying again: {e}",
+                          file=sys.stderr, flush=True)
+                    time.sleep(5)
+            domain.cli("configure", "RangeStop/StopCrash_1", f"speed={args.speed}",
+                       f"threshold={args.threshold}")
+            for run in range(runs):
+                seed = 1 + run
+                domain.cli("configure", "robot:Robot_1", f"seed={seed}")
+                domain.cli("configure", "robot:Robot_1", "reset=true")
+                domain.cli("start", "RangeStop")
+                time.sleep(drive_s)  # the robot drives toward the wall, undisturbed
+                wait_for_rest(domain, args, run)
+                robot = props(domain, "robot:Robot_1", "distance_to_wall", "sim_time", "seed")
+                stop = props(domain, "RangeStop/StopCrash_1", "stopped", "stop_range",
+                             "commands_sent")
+                domain.cli("stop", "RangeStop")
+                if not stop["stopped"]:
+                    raise RuntimeError(f"rsca run {run}: the robot rests but StopCrash never "
+                                       "stopped it")
+                results.append({"way": "rsca", "run": run, "seed": seed,
+                                "distance_to_wall": robot["distance_to_wall"],
+                                "stop_range": stop["stop_range"], "sim_time": robot["sim_time"],
+                                "commands_sent_total": stop["commands_sent"],
+                                "robot_seed": robot["seed"]})
+                print(f"rsca run {run}: rests {robot['distance_to_wall']:.4f} m from the wall",
+                      file=sys.stderr, flush=True)
+            drive = props(domain, "robot:DriveSystem_1")
+        finally:
+            domain.cli("release", "RangeStop", check=False)
+            for log in os.listdir(domain.run_dir):
+                if log.endswith(".log"):
+                    with open(os.path.join(domain.run_dir, log), "rb") as src, \
+                            open(os.path.join(logs, f"rsca-{log}"), "wb") as dst:
+                        dst.write(src.read())
+    return {
+        "runs": results,
+        "delay_us": {"mean": drive["latency_mean_us"], "p50": drive["latency_p50_us"],
+                     "p99": drive["latency_p99_us"], "samples": drive["latency_samples"]},
+        "drive": {k: drive[k] for k in ("commands_received", "safety_stops", "command_timeout_ms")
+                  if k in drive},
+        "stop_distance_m": distance_summary([r["distance_to_wall"] for r in results]),
+    }
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--bin", required=True, help="the build's bin folder")
+    parser.add_argument("--sdrroot", default=os.path.join(ROOT, "profiles"))
+    parser.add_argument("--out", required=True, help="the JSON results file")
+    parser.add_argument("--quick", action="store_true", help="5 runs a way instead of 20")
+    parser.add_argument("--runs", type=int, help="runs a way (overrides --quick)")
+    parser.add_argument("--ways", default=",".join(WAYS), help="a subset of " + ",".join(WAYS))
+    # The experiment's settings: RangeStop's (the SAD, the robot's DCD). The rsca way sets
+    # StopCrash and the IRSensor to them; the wall distance is the DCD's and is not changed.
+    parser.add_argument("--speed", type=float, default=0.3)
+    parser.add_argument("--threshold", type=float, default=0.6)
+    parser.add_argument("--period-ms", type=int, default=20)
+    parser.add_argument("--wall-distance", type=float, default=2.0, help=argparse.SUPPRESS)
+    args = parser.parse_args()
+    args.sdrroot = os.path.abspath(args.sdrroot)
+    runs = args.runs or (5 if args.quick else 20)
+    ways = [w for w in args.ways.split(",") if w]
+    for w in ways:
+        if w not in WAYS:
+            parser.error(f"unknown way {w} (known: {', '.join(WAYS)})")
+
+    logs = tempfile.mkdtemp(prefix="rsca-rangestop-bench-")
+    started = time.time()
+    results = {"settings": {"speed": args.speed, "threshold": args.threshold,
+                            "period_ms": args.period_ms, "wall_distance": args.wall_distance,
+                            "runs": runs, "seeds": [1, runs]},
+               "host": {"cpus": os.cpu_count(), "machine": platform.machine(),
+                        "loadavg_before": os.getloadavg()},
+               "ways": {}}
+    run = {"inprocess": run_inprocess, "tcp": run_tcp, "rsca": run_rsca}
+    for w in ways:
+        print(f"{w}: {runs} runs in real time...", file=sys.stderr, flush=True)
+        t = time.monotonic()
+        results["ways"][w] = run[w](args, runs, logs)
+        results["ways"][w]["wall_clock_s"] = time.monotonic() - t
+    for w in ("inprocess", "tcp"):  # the prediction, from sim::stop_tolerance
+        if w in results["ways"]:
+            header = results["ways"][w]["header"]
+            results["prediction"] = {"stop_tolerance_m": header["predicted_tolerance"],
+                                     "braking_distance_m": header["braking_distance"],
+                                     "latency_s": args.period_ms / 1000,
+                                     "min_rest_distance_m":
+                                         args.threshold - header["predicted_tolerance"]}
+            break
+    results["host"]["loadavg_after"] = os.getloadavg()
+    results["wall_clock_s"] = time.time() - started
+    results["logs"] = logs
+    with open(args.out, "w") as f:
+        json.dump(results, f, indent=2)
+
+    print("| way | runs | delay mean µs | p50 | p99 | stop distance mean m | sd | min | max |")
+    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+    for w in ways:
+        r = results["ways"][w]
+        d, s = r["delay_us"], r["stop_distance_m"]
+        print(f"| {w} | {len(r['runs'])} | {d['mean']:.1f} | {d['p50']:.1f} | {d['p99']:.1f} | "
+              f"{s['mean']:.4f} | {s['sd']:.4f} | {s['min']:.4f} | {s['max']:.4f} |")
+    if "prediction" in results:
+        p = results["prediction"]
+        print()
+        print(f"predicted tolerance (sim::stop_tolerance, latency = {args.period_ms} ms): "
+              f"{1000 * p['stop_tolerance_m']:.1f} mm ({1000 * p['braking_distance_m']:.1f} mm "
+              f"braking): the robot should rest at or beyond {p['min_rest_distance_m']:.4f} m "
+              f"from the wall, give or take the sensor's noise")
+    if "rsca" in results["ways"]:
+        print(f"rsca delay over {results['ways']['rsca']['delay_us']['samples']} commands "
+              f"(all runs, DriveSystem); drive safety stops: "
+              f"{results['ways']['rsca']['drive'].get('safety_stops')}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
