@@ -75,7 +75,8 @@ class Domain:
         # DDS domain ids up to 224: with MaxAutoParticipantIndex 600 (cyclonedds.xml) the unicast
         # discovery ports of a domain id from 228 on run past 65535.
         self.env = dict(os.environ, RSCA_RUN_DIR=self.run_dir,
-                        RSCA_DDS_DOMAIN=str(150 + os.getpid() % 75), **(env or {}))
+                        RSCA_DDS_DOMAIN=str(150 + os.getpid() % 75),
+                        RSCA_DDS_TAG=f"bench-{os.getpid()}", **(env or {}))
         self.nodes = nodes
         self.sdrroot = sdrroot
         self.daemons = {}
