@@ -3,8 +3,10 @@
 #include <atomic>
 #include <condition_variable>
 #include <deque>
+#include <functional>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <thread>
 #include <vector>
 
@@ -167,6 +169,8 @@ struct Endpoint::Impl {
 
   Expected<void> create_entities();
   void receive_loop();
+  // Fails, at once, every pending call for which `failure` gives an error.
+  void fail_calls(const std::function<std::optional<CallError>(const Pending &)> &failure);
   void take_requests();
   void take_replies();
   void take_announcements();
@@ -384,29 +388,36 @@ void Endpoint::Impl::complete(const std::string &id, CallResult<Json> result) {
   promise.set_value(std::move(result));
 }
 
-void Endpoint::Impl::expire_calls() {
-  std::vector<std::pair<std::promise<CallResult<Json>>, control::CallError>> expired;
+void Endpoint::Impl::fail_calls(
+    const std::function<std::optional<CallError>(const Pending &)> &failure) {
+  std::vector<std::pair<std::promise<CallResult<Json>>, CallError>> failed;
   {
     std::lock_guard lock(state_mutex);
-    const auto now = Clock::now();
     for (auto it = pending.begin(); it != pending.end();) {
-      if (it->second.deadline > now) {
+      auto error = failure(it->second);
+      if (!error) {
         ++it;
         continue;
       }
-      const auto &p = it->second;
-      expired.emplace_back(
-          std::move(it->second.promise),
-          p.sent
-              ? CallError{Status::Timeout,
-                          fmt::format("no reply from {} to \"{}\" before the deadline", p.target,
-                                      p.operation)}
-              : CallError{Status::Unavailable, fmt::format("nobody serves address {}", p.target)});
+      failed.emplace_back(std::move(it->second.promise), std::move(*error));
       it = pending.erase(it);
     }
   }
-  for (auto &[promise, error] : expired)
+  for (auto &[promise, error] : failed)
     promise.set_value(tl::unexpected(std::move(error)));
+}
+
+void Endpoint::Impl::expire_calls() {
+  const auto now = Clock::now();
+  fail_calls([now](const Pending &p) -> std::optional<CallError> {
+    if (p.deadline > now)
+      return std::nullopt;
+    if (p.sent)
+      return CallError{
+          Status::Timeout,
+          fmt::format("no reply from {} to \"{}\" before the deadline", p.target, p.operation)};
+    return CallError{Status::Unavailable, fmt::format("nobody serves address {}", p.target)};
+  });
 }
 
 CallResult<dds_entity_t> Endpoint::Impl::writer_for(std::map<std::string, PartitionWriter> &cache,
@@ -551,6 +562,15 @@ void Endpoint::prepare(const std::string &target) {
   if (auto writer = impl_->writer_for(impl_->request_writers, impl_->request_topic.get(), target);
       !writer)
     spdlog::debug("preparing the way to {}: {}", target, writer.error().message);
+}
+
+void Endpoint::abandon(const std::string &target, const std::string &why) {
+  impl_->fail_calls([&](const Impl::Pending &p) -> std::optional<CallError> {
+    if (p.target != target)
+      return std::nullopt;
+    return CallError{Status::Unavailable,
+                     fmt::format("{} to \"{}\": {}", p.target, p.operation, why)};
+  });
 }
 
 void Endpoint::forget(const std::string &target) {

@@ -97,6 +97,9 @@ public:
   // Creates the way to `target` ahead of the first call, so that DDS discovery of an endpoint
   // that is about to appear overlaps with whatever happens before that call.
   void prepare(const std::string &target);
+  // Fails every call to `target` under way, saying `why`: its caller knows the addressee is dead
+  // (its node saw it exit) sooner than DDS would (the addressee's lease).
+  void abandon(const std::string &target, const std::string &why);
   // Drops the way to and from `target` (an endpoint that is gone for good).
   void forget(const std::string &target);
 

@@ -217,7 +217,7 @@ private:
     std::vector<Call> calls;
     // Discovery of each component's endpoint starts now and overlaps with its process start.
     for (auto &c : app_->components) {
-      s_.components->expect(c.address);
+      s_.components->expect(c.address, c.node);
       s_.endpoint->prepare(c.address);
     }
     for (auto &c : app_->components) {

@@ -5,9 +5,27 @@
 
 namespace rsca::domain {
 
-void ComponentRegistry::expect(const std::string &address) {
+void ComponentRegistry::expect(const std::string &address, const std::string &node) {
   std::lock_guard lock(mutex_);
   entries_[address] = Entry{};
+  entries_[address].node = node;
+}
+
+std::vector<std::string> ComponentRegistry::node_gone(const std::string &node,
+                                                      const std::string &why) {
+  std::vector<std::string> gone;
+  {
+    std::lock_guard lock(mutex_);
+    for (auto &[address, e] : entries_) {
+      if (e.node != node || e.exited)
+        continue;
+      e.exited = true;
+      e.why = why;
+      gone.push_back(address);
+    }
+  }
+  changed_.notify_all();
+  return gone;
 }
 
 void ComponentRegistry::announced(const std::string &address, const nlohmann::json &body) {

@@ -19,10 +19,12 @@ class ComponentRegistry {
 public:
   // A launch is about to start a component at this address: from now on its registration and
   // exit count. Exits of addresses nobody expects (released components) are ignored.
-  void expect(const std::string &address);
+  void expect(const std::string &address, const std::string &node);
   void announced(const std::string &address, const nlohmann::json &body);
   void gone(const std::string &address);
   void exited(const std::string &address, const std::string &why);
+  // The node is gone and its components with it: marks them exited, and returns their addresses.
+  std::vector<std::string> node_gone(const std::string &node, const std::string &why);
   // Forgets an address (its component was released), so a later one can reuse it.
   void forget(const std::string &address);
 
@@ -40,6 +42,7 @@ private:
   struct Entry {
     bool registered = false;
     bool exited = false;
+    std::string node;
     std::string why;
     nlohmann::json body;
   };

@@ -3,6 +3,7 @@
 #include <atomic>
 #include <chrono>
 #include <fstream>
+#include <functional>
 #include <future>
 #include <sstream>
 
@@ -217,6 +218,9 @@ struct DomainManager::Impl {
   Json runtime_end_state(const ResolvedEnd &end, const std::string &connection);
   CallResult<Json> destroy_connection(const Json &body);
   CallResult<Json> component_exited(const Json &body);
+  // Marks the running components `which` selects as exited (the caller holds `mutex`).
+  void mark_exited(const std::function<bool(const ComponentInstance &)> &which,
+                   const std::string &why);
   CallResult<Json> connection_problem(const Json &body);
   std::string unique_name(const std::string &wanted) const;
   CallResult<std::string> target_of(const Application &app, const Json &body) const;
@@ -816,21 +820,28 @@ CallResult<Json> DomainManager::Impl::plan_application(const Json &body) {
 CallResult<Json> DomainManager::Impl::component_exited(const Json &body) {
   const std::string address = body.value("address", "");
   const std::string why = body.value("status", "exited");
-  components.exited(address, why);
+  components.exited(address, why); // a launch waiting for it fails at once
+  endpoint->abandon(address, why);
   std::lock_guard lock(mutex);
+  mark_exited([&address](const ComponentInstance &c) { return c.address == address; }, why);
+  return Json::object();
+}
+
+void DomainManager::Impl::mark_exited(const std::function<bool(const ComponentInstance &)> &which,
+                                      const std::string &why) {
   for (auto &[name, app] : applications) {
     if (!app)
       continue;
     for (auto &c : app->components) {
-      if (c.address != address || c.pid == 0)
+      if (c.pid == 0 || c.state == "exited" || !which(c))
         continue;
+      components.exited(c.address, why);
       c.state = "exited";
       spdlog::warn("component {} of application {} exited unexpectedly: {}", c.id, name, why);
       events->publish("component.exited",
                       {{"application", name}, {"component", c.id}, {"node", c.node}, {"why", why}});
     }
   }
-  return Json::object();
 }
 
 // A component saw its writer miss a connection's deadline or lose liveliness.
@@ -879,6 +890,12 @@ void DomainManager::Impl::on_announcement(const control::AnnouncementEvent &even
     events->publish("node.removed",
                     {{"node", it->first}, {"devices", device_ids(it->second.body)}});
     allocator.remove_node(it->first);
+    // Its component processes died with it (they cannot outlive their node); their own leases
+    // are longer than a node's, so their announcements would linger.
+    const auto why = fmt::format("its node {} is gone", it->first);
+    for (const auto &address : components.node_gone(it->first, why))
+      endpoint->abandon(address, why);
+    mark_exited([&node = it->first](const ComponentInstance &c) { return c.node == node; }, why);
     runtime_connections->owner_gone_later([prefix = it->first + ":"](const PortRef &ref) {
       return ref.kind == PortRef::Kind::Device && ref.owner.starts_with(prefix);
     });

@@ -73,7 +73,7 @@ CallResult<Json> GppDevice::execute(const Json &body) {
   ExecRequest request;
   request.executable = find_executable(body.value("entrypoint", ""), body.value("spd_dir", ""));
   request.args = body.value("args", std::vector<std::string>{});
-  request.env = context_.dds.environment();
+  request.env = context_.dds.component_environment();
   // The component dies with this node: it checks that its parent is still this process.
   request.env.emplace_back(kNodePidVariable, std::to_string(::getpid()));
   request.log_file = context_.log_dir / application / (component + ".log");

@@ -219,6 +219,41 @@ TEST_CASE("a component that crashes after launch is reported to the domain",
   domain.require_clean(pids_of(*app));
 }
 
+TEST_CASE("the components of a node that dies are reported exited, with the node as the reason",
+          "[integration][domain][failure]") {
+  TestDomain domain;
+  domain.install("Healthy");
+  auto app = domain.call("app.create", Json{{"application", "Healthy"}});
+  REQUIRE(app.has_value());
+  const std::string node = app->at("components")[0].at("node");
+  int on_node = 0;
+  for (const auto &c : app->at("components"))
+    on_node += c.at("node") == node ? 1 : 0;
+  domain.kill_node(node == "node1" ? 1 : 2);
+  // A component's own lease is long (its node watches it); the node's loss is what tells.
+  // Events: two nodes added, the application created, the node removed, its components exited.
+  auto [rc, out] = domain.cli(
+      {"--json", "events", "--count", std::to_string(4 + on_node), "--wait-ms", "10000"});
+  INFO(out);
+  REQUIRE(rc == 0);
+  std::istringstream lines(out);
+  int exited = 0;
+  for (std::string line; std::getline(lines, line);) {
+    const Json event = Json::parse(line);
+    if (event.at("kind") != "component.exited")
+      continue;
+    CHECK(event.at("details").at("why") == fmt::format("its node {} is gone", node));
+    ++exited;
+  }
+  CHECK(exited == on_node);
+  auto shown = domain.call("app.show", Json{{"app", "Healthy"}});
+  REQUIRE(shown.has_value());
+  for (const auto &c : shown->at("components"))
+    CHECK((c.at("state") == "exited") == (c.at("node") == node));
+  REQUIRE(domain.call("app.release", Json{{"app", "Healthy"}}).has_value());
+  domain.require_clean(pids_of(*app));
+}
+
 TEST_CASE("admission: launches fill the domain, the next is rejected with the reason, a release "
           "makes room again",
           "[integration][domain][allocator]") {
