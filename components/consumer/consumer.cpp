@@ -3,7 +3,7 @@
 // log_every sequences; counts the events arriving on events_in (events_received).
 #include <atomic>
 
-#include "component/runtime.hpp"
+#include "component/export.hpp"
 
 namespace {
 
@@ -51,6 +51,4 @@ private:
 
 } // namespace
 
-int main(int argc, char **argv) {
-  return rsca::component::run<Consumer>(argc, argv);
-}
+RSCA_COMPONENT(Consumer)

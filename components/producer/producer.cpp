@@ -6,7 +6,7 @@
 
 #include <fmt/format.h>
 
-#include "component/runtime.hpp"
+#include "component/export.hpp"
 
 namespace {
 
@@ -80,6 +80,4 @@ private:
 
 } // namespace
 
-int main(int argc, char **argv) {
-  return rsca::component::run<Producer>(argc, argv);
-}
+RSCA_COMPONENT(Producer)

@@ -2,7 +2,7 @@
 // building block of the synthetic applications tools/gen-app writes for tests and benchmarks.
 #include <atomic>
 
-#include "component/runtime.hpp"
+#include "component/export.hpp"
 
 namespace {
 
@@ -27,6 +27,4 @@ private:
 
 } // namespace
 
-int main(int argc, char **argv) {
-  return rsca::component::run<Relay>(argc, argv);
-}
+RSCA_COMPONENT(Relay)

@@ -2,7 +2,7 @@
 // forward at `speed` while the reading is at or above `threshold`, then a stop, latched. Each
 // command carries the time its reading was taken (timestamp_ns), so the drive can measure the
 // sensor-to-command latency through the middleware.
-#include "component/runtime.hpp"
+#include "component/export.hpp"
 
 namespace {
 
@@ -58,6 +58,4 @@ private:
 
 } // namespace
 
-int main(int argc, char **argv) {
-  return rsca::component::run<StopCrash>(argc, argv);
-}
+RSCA_COMPONENT(StopCrash)

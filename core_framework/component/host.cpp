@@ -253,14 +253,18 @@ PortBase *Host::find_port(const std::string &name) const {
 
 void Host::poll_ports() {
   const bool deliver = delivering_.load();
+  for (const auto &port : c().ports_)
+    if (port->direction() == profile::PortDirection::Provides)
+      port->take_all(deliver);
+  // Problems are looked for every kProblemCheck at most, not at every sample (ports.cpp says why).
+  const auto now = std::chrono::steady_clock::now();
+  if (now - last_problem_check_ < kProblemCheck)
+    return;
+  last_problem_check_ = now;
   std::vector<ConnectionProblem> problems;
-  for (const auto &port : c().ports_) {
-    if (port->direction() != profile::PortDirection::Provides)
-      continue;
-    port->take_all(deliver);
+  for (const auto &port : c().ports_)
     for (auto &p : port->take_problems())
       problems.push_back(std::move(p));
-  }
   report_problems(std::move(problems));
 }
 

@@ -95,6 +95,8 @@ private:
   std::atomic<bool> delivering_{false};
   std::map<std::pair<std::string, std::string>, std::uint32_t> unreported_problems_;
   std::chrono::steady_clock::time_point last_problem_report_{};
+  static constexpr std::chrono::milliseconds kProblemCheck{100};
+  std::chrono::steady_clock::time_point last_problem_check_{}; // only the receive thread
 
   std::mutex service_mutex_;
   std::condition_variable service_wake_;

@@ -17,7 +17,9 @@ InProcessComponent::~InProcessComponent() {
 Expected<std::unique_ptr<InProcessComponent>>
 InProcessComponent::open(const Factory &factory, Context context,
                          std::shared_ptr<const profile::ResolvedSoftPkg> softpkg,
-                         std::shared_ptr<dds::Participant> participant) {
+                         std::shared_ptr<dds::Participant> participant,
+                         const std::vector<std::pair<std::string, std::string>> &execparams,
+                         std::function<void()> on_released) {
   const std::string address = context.control_address;
   const std::string where = softpkg->spd_path.string();
   std::unique_ptr<Component> component;
@@ -27,9 +29,9 @@ InProcessComponent::open(const Factory &factory, Context context,
     return make_error({where, 0, 0}, "component", e.what());
   }
   auto host = std::make_unique<detail::Host>(std::move(component), std::move(softpkg));
-  if (auto prepared = host->prepare({}); !prepared)
+  if (auto prepared = host->prepare(execparams); !prepared)
     return tl::unexpected(prepared.error());
-  if (auto opened = host->open(std::move(participant), {}); !opened)
+  if (auto opened = host->open(std::move(participant), std::move(on_released)); !opened)
     return tl::unexpected(opened.error());
   return std::unique_ptr<InProcessComponent>(new InProcessComponent(std::move(host), address));
 }

@@ -4,8 +4,11 @@
 // queries it the same way.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "component/component.hpp"
 #include "component/runtime.hpp"
@@ -20,12 +23,15 @@ class Host;
 
 class InProcessComponent {
 public:
-  // Constructs the component, checks it against its profile (PRF and SCD) and serves it at
-  // `context.control_address` on `participant`.
+  // Constructs the component, checks it against its profile (PRF and SCD), applies `execparams`
+  // and serves it at `context.control_address` on `participant`. `on_released` runs once the
+  // domain has released it (component.release).
   static Expected<std::unique_ptr<InProcessComponent>>
   open(const Factory &factory, Context context,
        std::shared_ptr<const profile::ResolvedSoftPkg> softpkg,
-       std::shared_ptr<dds::Participant> participant);
+       std::shared_ptr<dds::Participant> participant,
+       const std::vector<std::pair<std::string, std::string>> &execparams = {},
+       std::function<void()> on_released = {});
   ~InProcessComponent(); // stops and releases the component, then withdraws it
   InProcessComponent(const InProcessComponent &) = delete;
   InProcessComponent &operator=(const InProcessComponent &) = delete;

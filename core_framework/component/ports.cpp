@@ -30,8 +30,6 @@ struct DataConnection {
   ~DataConnection() {
     if (loop != nullptr && read_condition)
       loop->detach(read_condition.get());
-    if (loop != nullptr && entity)
-      loop->detach(entity.get());
   }
 };
 
@@ -142,11 +140,9 @@ Expected<std::unique_ptr<DataConnection>> open_reader(dds_entity_t participant,
   c->read_condition = std::move(*condition);
   if (auto attached = loop->attach(c->read_condition.get()); !attached)
     return tl::unexpected(attached.error());
-  // The loop also wakes when the writer misses the deadline or loses its liveliness.
-  dds_set_status_mask(c->entity.get(),
-                      DDS_REQUESTED_DEADLINE_MISSED_STATUS | DDS_LIVELINESS_CHANGED_STATUS);
-  if (auto attached = loop->attach(c->entity.get()); !attached)
-    return tl::unexpected(attached.error());
+  // Deadline misses and lost liveliness are looked for by the loop's owner now and then
+  // (take_problems), not waited for: a status check at every sample contends with Cyclone's
+  // receive thread for the reader's locks.
   c->loop = loop;
   return c;
 }
@@ -246,7 +242,6 @@ std::vector<ConnectionProblem> PortBase::take_problems() {
   constexpr std::uint32_t kProblems =
       DDS_REQUESTED_DEADLINE_MISSED_STATUS | DDS_LIVELINESS_CHANGED_STATUS;
   for (const auto &[id, c] : connections_) {
-    // One cheap look at the triggered statuses: this runs at every wake of the receive loop.
     std::uint32_t changed = 0;
     if (dds_get_status_changes(c->entity.get(), &changed) != 0 || (changed & kProblems) == 0)
       continue;
@@ -326,6 +321,10 @@ void ProvidesPort<T>::take_all(bool deliver) {
         }
       }
       dds_return_loan(c->entity.get(), samples, n);
+      // A short batch took all there was: another take would only contend with Cyclone's
+      // receive thread for the reader's lock. What arrives later triggers the loop again.
+      if (static_cast<std::uint32_t>(n) < kTakeBatch)
+        break;
     }
   }
 }

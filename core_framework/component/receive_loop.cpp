@@ -3,8 +3,9 @@
 namespace rsca::component::detail {
 namespace {
 
-// The longest the thread waits before it looks at its stop flag again.
-constexpr dds_duration_t kWakeInterval = DDS_MSECS(500);
+// The longest the thread waits before it polls again: the owner then also looks for connection
+// problems (component/host.cpp), so this bounds how late a deadline miss is seen.
+constexpr dds_duration_t kWakeInterval = DDS_MSECS(100);
 
 } // namespace
 
@@ -51,9 +52,8 @@ void ReceiveLoop::detach(dds_entity_t condition) {
 
 void ReceiveLoop::run() {
   while (!stopping_.load()) {
+    // The guard is set only to stop the loop, which then ends: it is never reset.
     dds_waitset_wait(waitset_.get(), nullptr, 0, kWakeInterval);
-    bool triggered = false;
-    dds_take_guardcondition(guard_.get(), &triggered);
     if (stopping_.load())
       return;
     poll_();

@@ -22,91 +22,9 @@
 
 #include "common/exec_environment.hpp"
 #include "component/host.hpp"
+#include "component/process.hpp"
 
 namespace rsca::component {
-
-namespace {
-
-// ---------------------------------------------------------------------------------------------
-// Exit events: SIGINT/SIGTERM through a signalfd (the signals are blocked in every thread, so no
-// handler runs), and component.release through an eventfd.
-
-class UniqueFd {
-public:
-  explicit UniqueFd(int fd = -1) : fd_(fd) {}
-  ~UniqueFd() {
-    if (fd_ >= 0)
-      ::close(fd_);
-  }
-  UniqueFd(UniqueFd &&other) noexcept : fd_(std::exchange(other.fd_, -1)) {}
-  UniqueFd &operator=(UniqueFd &&) = delete;
-  UniqueFd(const UniqueFd &) = delete;
-  UniqueFd &operator=(const UniqueFd &) = delete;
-  int get() const { return fd_; }
-
-private:
-  int fd_;
-};
-
-class ExitEvents {
-public:
-  enum class Event : std::uint8_t { None, Signal, Released };
-
-  // Blocks SIGINT and SIGTERM in the calling thread and so in every thread it starts later.
-  static tl::expected<ExitEvents, std::string> install() {
-    sigset_t set;
-    sigemptyset(&set);
-    sigaddset(&set, SIGINT);
-    sigaddset(&set, SIGTERM);
-    if (int rc = pthread_sigmask(SIG_BLOCK, &set, nullptr); rc != 0)
-      return tl::unexpected(fmt::format("blocking signals: {}", std::strerror(rc)));
-    UniqueFd signals(signalfd(-1, &set, SFD_CLOEXEC | SFD_NONBLOCK));
-    if (signals.get() < 0)
-      return tl::unexpected(fmt::format("signalfd: {}", std::strerror(errno)));
-    UniqueFd released(eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK));
-    if (released.get() < 0)
-      return tl::unexpected(fmt::format("eventfd: {}", std::strerror(errno)));
-    return ExitEvents(std::move(signals), std::move(released));
-  }
-
-  void notify_released() const {
-    const std::uint64_t one = 1;
-    [[maybe_unused]] auto n = ::write(released_.get(), &one, sizeof one);
-  }
-
-  // Waits at most `timeout` for a signal or a release; `signal` is set for a signal.
-  Event wait(std::chrono::milliseconds timeout, int &signal) const {
-    pollfd fds[2] = {{signals_.get(), POLLIN, 0}, {released_.get(), POLLIN, 0}};
-    if (::poll(fds, 2, static_cast<int>(timeout.count())) <= 0)
-      return Event::None;
-    if ((fds[0].revents & POLLIN) != 0) {
-      signalfd_siginfo info{};
-      if (::read(signals_.get(), &info, sizeof info) == static_cast<ssize_t>(sizeof info)) {
-        signal = static_cast<int>(info.ssi_signo);
-        return Event::Signal;
-      }
-    }
-    if ((fds[1].revents & POLLIN) != 0)
-      return Event::Released;
-    return Event::None;
-  }
-
-private:
-  ExitEvents(UniqueFd signals, UniqueFd released)
-      : signals_(std::move(signals)), released_(std::move(released)) {}
-  UniqueFd signals_;
-  UniqueFd released_;
-};
-
-std::shared_ptr<spdlog::logger> make_logger(const std::string &name) {
-  auto logger =
-      std::make_shared<spdlog::logger>(name, std::make_shared<spdlog::sinks::stderr_sink_mt>());
-  logger->flush_on(spdlog::level::warn);
-  spdlog::set_default_logger(logger); // the framework's own messages carry the instance name too
-  return logger;
-}
-
-} // namespace
 
 // ---------------------------------------------------------------------------------------------
 
@@ -189,21 +107,17 @@ tl::expected<ExecParams, std::string> parse_exec_params(int argc, const char *co
 
 namespace {
 
+using detail::ExitEvents;
+
 // Waits for a signal or the release, then shuts the component down.
 void wait_for_exit(const ExitEvents &events, detail::Host &host, spdlog::logger &log) {
-  using namespace std::chrono_literals;
-  for (;;) {
-    int signal = 0;
-    const auto event = events.wait(1s, signal);
-    if (event == ExitEvents::Event::Signal) {
-      log.info("received {}: shutting down", signal == SIGINT ? "SIGINT" : "SIGTERM");
-      host.shutdown(signal == SIGINT ? "SIGINT" : "SIGTERM");
-      return;
-    }
-    // Closing the host afterwards waits for the release handler and delivers its reply.
-    if (event == ExitEvents::Event::Released)
-      return;
-  }
+  int signal = 0;
+  // After a release, closing the host waits for the release handler and delivers its reply.
+  if (!detail::wait_for_signal_or_release(events, signal))
+    return;
+  const char *name = signal == SIGINT ? "SIGINT" : "SIGTERM";
+  log.info("received {}: shutting down", name);
+  host.shutdown(name);
 }
 
 int run_host(const ExecParams &params, const ExitEvents &events, const Factory &factory,
@@ -255,36 +169,14 @@ int run_host(const ExecParams &params, const ExitEvents &events, const Factory &
 } // namespace
 
 int run_component(int argc, char **argv, const Factory &factory) {
-  // A component does not outlive the node daemon that started it. With the node gone nobody could
-  // escalate a stuck shutdown, so its death kills the component outright; the domain learns of
-  // it from the lost announcements.
-  // The node may die before this line runs, its orphan adopted by another process: the node's pid
-  // in the environment tells them apart.
-  const char *node = std::getenv(kNodePidVariable);
-  const pid_t parent = node != nullptr ? static_cast<pid_t>(std::atol(node)) : getppid();
-  prctl(PR_SET_PDEATHSIG, SIGKILL);
-  if (getppid() != parent)
-    return kExitFailure;               // the node died before the request took effect
-  auto events = ExitEvents::install(); // first: before any thread starts
-  if (!events) {
-    spdlog::error("{}", events.error());
-    return kExitFailure;
-  }
-  auto params = parse_exec_params(argc, argv);
-  if (!params) {
-    spdlog::error("{}\nusage: {} COMPONENT_IDENTIFIER <id> PROFILE_NAME <spd> CONTROL_ADDRESS "
-                  "<address> [NAME_BINDING <name>] [DOMAIN_NAME <domain>] [APPLICATION <id>] "
-                  "[<property id> <value>]...",
-                  params.error(), argc > 0 ? argv[0] : "component");
-    return kExitUsage;
-  }
-  auto logger = make_logger(params->name_binding);
-  try {
-    return run_host(*params, *events, factory, logger);
-  } catch (const std::exception &e) {
-    logger->critical("{}", e.what());
-    return kExitFailure;
-  }
+  return detail::run_process<ExecParams>(
+      argc, argv,
+      "COMPONENT_IDENTIFIER <id> PROFILE_NAME <spd> CONTROL_ADDRESS <address> [NAME_BINDING "
+      "<name>] [DOMAIN_NAME <domain>] [APPLICATION <id>] [<property id> <value>]...",
+      parse_exec_params, [](const ExecParams &p) { return p.name_binding; },
+      [&factory](const ExecParams &p, const ExitEvents &events, auto logger) {
+        return run_host(p, events, factory, std::move(logger));
+      });
 }
 
 } // namespace rsca::component

@@ -48,6 +48,19 @@ tl::expected<ExecParams, std::string> parse_exec_params(int argc, const char *co
 using Factory = std::function<std::unique_ptr<Component>(const Context &)>;
 int run_component(int argc, char **argv, const Factory &factory);
 
+// A shared-library component exports this function (component/export.hpp): it hands out the
+// component's factory.
+inline constexpr const char *kFactorySymbol = "rsca_component_factory";
+using FactoryExport = void (*)(Factory *out);
+
+// The component host (rsca-component-host): one process serving several shared-library
+// components of one application on one device, on one DDS participant. Its exec parameters are
+// those of each component in turn, each group starting with COMPONENT_IDENTIFIER and naming its
+// library with LIBRARY <path> (relative: to the SPD's folder, else the host's own lib folder).
+// It serves every component at its own control address, exactly as a component process would,
+// and returns once all of them are released, or on SIGTERM or SIGINT.
+int run_component_host(int argc, char **argv);
+
 template <typename T>
 int run(int argc, char **argv) {
   static_assert(std::is_base_of_v<Component, T>, "a component derives from Component");

@@ -1,7 +1,10 @@
 #include "domain/application_factory.hpp"
 
 #include <algorithm>
+#include <filesystem>
 #include <future>
+#include <map>
+#include <set>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -213,30 +216,51 @@ private:
     return {};
   }
 
+  // One process per Executable component, and one component host per device for the
+  // application's SharedLibrary components on it; all started at once.
   CallResult<void> execute() {
-    std::vector<Call> calls;
     // Discovery of each component's endpoint starts now and overlaps with its process start.
     for (auto &c : app_->components) {
       s_.components->expect(c.address, c.node);
       s_.endpoint->prepare(c.address);
     }
-    for (auto &c : app_->components) {
+    std::vector<Call> calls;
+    std::vector<std::vector<std::size_t>> started_by; // per call, the components it starts
+    std::map<std::string, std::size_t> host_calls;    // by device
+    for (std::size_t i = 0; i < app_->components.size(); ++i) {
+      const auto &c = app_->components[i];
       auto node = s_.node_address(c.node);
       if (!node)
         return control::call_error(Status::Unavailable, fmt::format("node {} is gone", c.node));
-      calls.push_back({*node, "node.execute", execute_body(c), c.id});
+      if (!is_hosted(c)) {
+        calls.push_back({*node, "node.execute", execute_body(c), c.id});
+        started_by.push_back({i});
+        continue;
+      }
+      auto [host, fresh] = host_calls.try_emplace(c.device, calls.size());
+      if (fresh) {
+        calls.push_back({*node, "node.execute", host_body(c, host_calls.size()),
+                         fmt::format("the component host on {}", c.device)});
+        started_by.emplace_back();
+      }
+      auto &args = calls[host->second].body["args"];
+      for (auto &arg : hosted_args(c))
+        args.push_back(std::move(arg));
+      started_by[host->second].push_back(i);
     }
     auto replies = call_each_of(*s_.endpoint, calls, s_.call_timeout);
     // Record every process that did start, even when another failed, so rollback finds it.
-    for (std::size_t i = 0; i < app_->components.size(); ++i) {
-      if (replies[i] && replies[i]->contains("pid")) {
-        app_->components[i].pid = (*replies[i])["pid"].get<long>();
+    for (std::size_t k = 0; k < calls.size(); ++k) {
+      if (!replies[k] || !replies[k]->contains("pid"))
+        continue;
+      for (auto i : started_by[k]) {
+        app_->components[i].pid = (*replies[k])["pid"].get<long>();
         app_->components[i].state = "executed";
       }
     }
     if (auto ok = first_failure(calls, replies); !ok)
       return ok;
-    detail_ = fmt::format("{} processes", app_->components.size());
+    detail_ = fmt::format("{} processes for {} components", calls.size(), app_->components.size());
     return {};
   }
 
@@ -476,16 +500,24 @@ private:
     return {};
   }
 
-  Json execute_body(const ComponentInstance &c) const {
+  // The exec parameters of a component (component/runtime.hpp).
+  std::vector<std::string> component_args(const ComponentInstance &c) const {
     std::vector<std::string> args = {
         "COMPONENT_IDENTIFIER", c.id,       "NAME_BINDING",    c.usage_name,
         "PROFILE_NAME",         c.spd,      "DOMAIN_NAME",     s_.domain_name,
         "APPLICATION",          app_->name, "CONTROL_ADDRESS", c.address};
     append_execparams(c, args);
-    const auto *placement = placement_of(c.id);
-    if (placement->schedule)
+    if (const auto *placement = placement_of(c.id); placement->schedule)
       append_schedule(*placement->schedule, args);
-    const auto *impl = placement->implementation;
+    return args;
+  }
+
+  bool is_hosted(const ComponentInstance &c) const {
+    return placement_of(c.id)->implementation->code.type == profile::CodeType::SharedLibrary;
+  }
+
+  Json execute_body(const ComponentInstance &c) const {
+    const auto *impl = placement_of(c.id)->implementation;
     const auto spd_dir = std::filesystem::path(c.spd).parent_path();
     return Json{{"application", app_->name},
                 {"component", c.id},
@@ -493,7 +525,26 @@ private:
                 {"entrypoint",
                  impl->code.entrypoint.empty() ? impl->code.file.name : impl->code.entrypoint},
                 {"spd_dir", spd_dir.string()},
-                {"args", args}};
+                {"args", component_args(c)}};
+  }
+
+  // A component host's process; the components it hosts add their exec parameters.
+  Json host_body(const ComponentInstance &first, std::size_t index) const {
+    return Json{{"application", app_->name},
+                {"component", fmt::format("ComponentHost_{}", index)},
+                {"device", first.device},
+                {"entrypoint", "rsca-component-host"},
+                {"spd_dir", ""},
+                {"args", Json::array()}};
+  }
+
+  // A hosted component's exec parameters: its own and the library the host loads, as the SPD
+  // names it (the host resolves it, as a GPP resolves an entry point).
+  std::vector<std::string> hosted_args(const ComponentInstance &c) const {
+    auto args = component_args(c);
+    args.emplace_back("LIBRARY");
+    args.push_back(placement_of(c.id)->implementation->code.file.name);
+    return args;
   }
 
   // What timing admission decided, for the component to run by (component/runtime.hpp).
@@ -585,8 +636,11 @@ private:
       if (std::find(devices.begin(), devices.end(), p.device) == devices.end())
         devices.push_back(p.device);
     ApplicationFactory factory(s_);
-    const std::size_t started = std::count_if(app_->components.begin(), app_->components.end(),
-                                              [](const auto &c) { return c.pid != 0; });
+    std::set<long> pids; // the components of a host share its process
+    for (const auto &c : app_->components)
+      if (c.pid != 0)
+        pids.insert(c.pid);
+    const std::size_t started = pids.size();
     if (joined_channels_) {
       const auto destroyed = s_.channels->leave(app_->name);
       undone.push_back(destroyed.empty() ? "event channel memberships withdrawn"
@@ -687,8 +741,9 @@ CallResult<std::vector<std::string>> ApplicationFactory::release(Application &ap
   }
   // Whatever is still running is terminated by its node; the node reaps every process.
   std::vector<Call> terminations;
+  std::set<long> terminated_pids; // the components of a host share its process
   for (auto &c : app.components) {
-    if (c.pid == 0)
+    if (c.pid == 0 || !terminated_pids.insert(c.pid).second)
       continue;
     auto node = services_.node_address(c.node);
     if (node)

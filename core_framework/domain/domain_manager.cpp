@@ -1,5 +1,6 @@
 #include "domain/domain_manager.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <fstream>
@@ -818,12 +819,19 @@ CallResult<Json> DomainManager::Impl::plan_application(const Json &body) {
 }
 
 CallResult<Json> DomainManager::Impl::component_exited(const Json &body) {
-  const std::string address = body.value("address", "");
+  // Every component the process served: one, or those of a component host.
+  const auto addresses = body.value("addresses", std::vector<std::string>{});
   const std::string why = body.value("status", "exited");
-  components.exited(address, why); // a launch waiting for it fails at once
-  endpoint->abandon(address, why);
+  for (const auto &address : addresses) {
+    components.exited(address, why); // a launch waiting for it fails at once
+    endpoint->abandon(address, why);
+  }
   std::lock_guard lock(mutex);
-  mark_exited([&address](const ComponentInstance &c) { return c.address == address; }, why);
+  mark_exited(
+      [&addresses](const ComponentInstance &c) {
+        return std::find(addresses.begin(), addresses.end(), c.address) != addresses.end();
+      },
+      why);
   return Json::object();
 }
 

@@ -67,6 +67,19 @@ std::filesystem::path GppDevice::find_executable(const std::string &entrypoint,
   return std::filesystem::path(spd_dir) / ep;
 }
 
+namespace {
+
+// Every component a process serves: one, or all those of a component host.
+std::vector<std::string> control_addresses(const std::vector<std::string> &args) {
+  std::vector<std::string> addresses;
+  for (std::size_t i = 0; i + 1 < args.size(); i += 2)
+    if (args[i] == "CONTROL_ADDRESS")
+      addresses.push_back(args[i + 1]);
+  return addresses;
+}
+
+} // namespace
+
 CallResult<Json> GppDevice::execute(const Json &body) {
   const std::string application = body.value("application", "");
   const std::string component = body.value("component", "");
@@ -86,13 +99,7 @@ CallResult<Json> GppDevice::execute(const Json &body) {
     std::lock_guard lock(mutex_);
     owners_[*pid] = {{"application", application},
                      {"component", component},
-                     {"address", [&] {
-                        const auto &args = request.args;
-                        for (std::size_t i = 0; i + 1 < args.size(); ++i)
-                          if (args[i] == "CONTROL_ADDRESS")
-                            return args[i + 1];
-                        return std::string();
-                      }()}};
+                     {"addresses", control_addresses(request.args)}};
   }
   spdlog::info("{}: executed {} as pid {} (log {})", context_.id, request.executable.string(), *pid,
                request.log_file.string());

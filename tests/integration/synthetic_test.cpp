@@ -1,17 +1,23 @@
 // The synthetic applications of tools/gen-app launch on a real domain: every connection matched
 // before start (the connect step waits for it), everything gone after release.
+#include <set>
+
 #include "domain_fixture.hpp"
 
 using namespace rsca::test;
 using namespace std::chrono_literals;
 
-TEST_CASE("synthetic applications (chain, tree, random graph) launch connected and release clean",
+TEST_CASE("synthetic applications (chain, tree, random graph, as processes or in component hosts) "
+          "launch connected and release clean",
           "[integration][synthetic]") {
   TestDomain domain(2);
   const auto shape = GENERATE(std::string("chain"), std::string("tree"), std::string("random"));
+  const bool hosted = GENERATE(false, true);
   const fs::path sdr = domain.run_dir() / "synthetic";
-  ChildProcess gen((kSource / "tools/gen-app").string(),
-                   {"--shape", shape, "--components", "12", "--out", sdr.string()}, {});
+  std::vector<std::string> args{"--shape", shape, "--components", "12", "--out", sdr.string()};
+  if (hosted)
+    args.emplace_back("--shared-library");
+  ChildProcess gen((kSource / "tools/gen-app").string(), args, {});
   auto generated = gen.wait_exit(30s);
   REQUIRE(generated.has_value());
   REQUIRE(WEXITSTATUS(*generated) == 0);
@@ -24,6 +30,14 @@ TEST_CASE("synthetic applications (chain, tree, random graph) launch connected a
   auto app = domain.call("app.show", Json{{"app", name}});
   REQUIRE(app.has_value());
   CHECK(app->at("components").size() == 12);
+  // A process per component, or one component host per device used.
+  std::set<long> processes;
+  std::set<std::string> devices;
+  for (const auto &c : app->at("components")) {
+    processes.insert(c.at("pid").get<long>());
+    devices.insert(c.at("device").get<std::string>());
+  }
+  CHECK(processes.size() == (hosted ? devices.size() : 12));
   // A chain and a tree of 12 have 11 connections; the random graph at least that many.
   CHECK(app->at("connections").size() >= 11);
   auto list = domain.call("connection.list", Json{{"app", name}});

@@ -1,0 +1,190 @@
+// The component host: shared-library components of one application on one device, in one process
+// (component/runtime.hpp, run_component_host).
+#include <dlfcn.h>
+
+#include <algorithm>
+#include <atomic>
+#include <filesystem>
+#include <string_view>
+#include <vector>
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include "component/in_process.hpp"
+#include "component/process.hpp"
+#include "component/runtime.hpp"
+
+namespace rsca::component {
+
+namespace {
+
+namespace fs = std::filesystem;
+using detail::ExitEvents;
+
+struct HostedComponent {
+  ExecParams params;
+  fs::path library; // LIBRARY
+};
+
+// Takes LIBRARY out of the group's other parameters.
+tl::expected<fs::path, std::string> take_library(ExecParams &params) {
+  auto &others = params.others;
+  auto it = std::find_if(others.begin(), others.end(),
+                         [](const auto &pair) { return pair.first == "LIBRARY"; });
+  if (it == others.end())
+    return tl::unexpected(
+        fmt::format("{}: the exec parameter LIBRARY is missing", params.identifier));
+  fs::path library = it->second;
+  others.erase(it);
+  return library;
+}
+
+// One group of exec parameters per component, each starting with COMPONENT_IDENTIFIER.
+tl::expected<std::vector<HostedComponent>, std::string> parse_host_params(int argc,
+                                                                          const char *const *argv) {
+  constexpr std::string_view kStart = "COMPONENT_IDENTIFIER";
+  if (argc < 2 || argv[1] != kStart)
+    return tl::unexpected(fmt::format("the exec parameters start with {}", kStart));
+  std::vector<HostedComponent> hosted;
+  for (int begin = 1; begin < argc;) {
+    int end = begin + 2; // keys stand at every other argument
+    while (end < argc && argv[end] != kStart)
+      end += 2;
+    end = std::min(end, argc);
+    std::vector<const char *> group{argv[0]};
+    group.insert(group.end(), argv + begin, argv + end);
+    auto params = parse_exec_params(static_cast<int>(group.size()), group.data());
+    if (!params)
+      return tl::unexpected(fmt::format("component {}: {}", hosted.size() + 1, params.error()));
+    auto library = take_library(*params);
+    if (!library)
+      return tl::unexpected(library.error());
+    hosted.push_back({std::move(*params), std::move(*library)});
+    begin = end;
+  }
+  return hosted;
+}
+
+// The library as the SPD names it: absolute, or relative to the SPD's folder; one that is not
+// there is looked up by name in the host's own lib folder (where the build puts the example
+// components' libraries) and next to the host.
+fs::path resolve_library(const fs::path &library, const fs::path &spd) {
+  const fs::path named = library.is_absolute() ? library : spd.parent_path() / library;
+  std::error_code ec;
+  if (fs::exists(named, ec))
+    return named;
+  const fs::path exe_dir = fs::read_symlink("/proc/self/exe", ec).parent_path();
+  for (const auto &candidate :
+       {exe_dir / "../lib" / library.filename(), exe_dir / library.filename()})
+    if (fs::exists(candidate, ec))
+      return candidate;
+  return named;
+}
+
+// The library stays loaded for the life of the process (RTLD_NODELETE): its code runs on threads
+// that may outlive a component's release.
+tl::expected<Factory, std::string> load_factory(const fs::path &library) {
+  void *handle = dlopen(library.c_str(), RTLD_NOW | RTLD_LOCAL | RTLD_NODELETE);
+  if (handle == nullptr)
+    return tl::unexpected(fmt::format("cannot load {}: {}", library.string(), dlerror()));
+  auto entry = reinterpret_cast<FactoryExport>(dlsym(handle, kFactorySymbol));
+  if (entry == nullptr)
+    return tl::unexpected(
+        fmt::format("{} exports no {} (declare the component with RSCA_COMPONENT)",
+                    library.string(), kFactorySymbol));
+  Factory factory;
+  entry(&factory);
+  return factory;
+}
+
+// The profiles of every component, read with one loader: the XML reader is loaded once for all
+// of them and unloaded before any component runs.
+tl::expected<std::vector<std::shared_ptr<const profile::ResolvedSoftPkg>>, std::string>
+load_profiles(const std::vector<HostedComponent> &hosted) {
+  profile::ProfileLoader loader;
+  std::vector<std::shared_ptr<const profile::ResolvedSoftPkg>> softpkgs;
+  for (const auto &h : hosted) {
+    auto softpkg = loader.load_softpkg(h.params.profile);
+    if (!softpkg)
+      return tl::unexpected(fmt::format("cannot load the profile {}:\n{}", h.params.profile,
+                                        softpkg.error().to_string()));
+    softpkgs.push_back(*softpkg);
+  }
+  return softpkgs;
+}
+
+Context context_of(const ExecParams &p, spdlog::logger &host_log) {
+  if (p.schedule)
+    host_log.warn("{}: admitted on cpu {}, but a hosted component runs on its host's CPUs",
+                  p.name_binding, p.schedule->cpu);
+  return Context{p.identifier,
+                 p.name_binding,
+                 p.application,
+                 p.domain,
+                 p.profile,
+                 p.control_address,
+                 in_process_logger(p.name_binding),
+                 p.schedule};
+}
+
+int serve_hosted(const std::vector<HostedComponent> &hosted, const ExitEvents &events,
+                 spdlog::logger &log) {
+  auto softpkgs = load_profiles(hosted);
+  if (!softpkgs) {
+    log.error("{}", softpkgs.error());
+    return kExitProfile;
+  }
+  auto participant = dds::Participant::create(dds::DdsSettings::from_environment());
+  if (!participant) {
+    log.error("{}", participant.error().to_string());
+    return kExitFailure;
+  }
+  std::atomic<std::size_t> unreleased{hosted.size()};
+  const auto on_released = [&unreleased, &events] {
+    if (--unreleased == 0)
+      events.notify_released();
+  };
+  std::vector<std::unique_ptr<InProcessComponent>> components;
+  for (std::size_t i = 0; i < hosted.size(); ++i) {
+    const auto &h = hosted[i];
+    auto factory = load_factory(resolve_library(h.library, h.params.profile));
+    if (!factory) {
+      log.error("{}: {}", h.params.identifier, factory.error());
+      return kExitFailure;
+    }
+    auto component = InProcessComponent::open(*factory, context_of(h.params, log), (*softpkgs)[i],
+                                              *participant, h.params.others, on_released);
+    if (!component) {
+      log.error("{}: {}", h.params.identifier, component.error().to_string());
+      return kExitProfile;
+    }
+    components.push_back(std::move(*component));
+  }
+  log.info("hosting {} component(s)", components.size());
+  int signal = 0;
+  if (detail::wait_for_signal_or_release(events, signal))
+    log.info("received {}: shutting down", signal == SIGINT ? "SIGINT" : "SIGTERM");
+  components.clear(); // each is stopped, released and withdrawn
+  log.info("exiting");
+  return kExitOk;
+}
+
+} // namespace
+
+int run_component_host(int argc, char **argv) {
+  return detail::run_process<std::vector<HostedComponent>>(
+      argc, argv,
+      "(COMPONENT_IDENTIFIER <id> PROFILE_NAME <spd> CONTROL_ADDRESS <address> LIBRARY <path> "
+      "[NAME_BINDING <name>] [DOMAIN_NAME <domain>] [APPLICATION <id>] [<property id> "
+      "<value>]...)...",
+      parse_host_params,
+      [](const std::vector<HostedComponent> &hosted) {
+        return fmt::format("host:{}", hosted.front().params.application);
+      },
+      [](const std::vector<HostedComponent> &hosted, const ExitEvents &events, auto logger) {
+        return serve_hosted(hosted, events, *logger);
+      });
+}
+
+} // namespace rsca::component

@@ -1,0 +1,101 @@
+// Shared-library components in component hosts, with real daemons and processes: one host
+// process per application and device, connected to component processes and to each other over
+// the same ports, released or rolled back with nothing left.
+#include <filesystem>
+#include <map>
+
+#include "domain_fixture.hpp"
+
+namespace {
+
+using namespace rsca::test;
+
+// The name of the executable a process runs.
+std::string executable_of(long pid) {
+  std::error_code ec;
+  return fs::read_symlink(fmt::format("/proc/{}/exe", pid), ec).filename().string();
+}
+
+// The pid of each component, by id.
+std::map<std::string, long> pids_by_component(const Json &app) {
+  std::map<std::string, long> pids;
+  for (const auto &c : app.at("components"))
+    pids[c.at("id")] = c.at("pid").get<long>();
+  return pids;
+}
+
+} // namespace
+
+TEST_CASE("shared-library components run in one component host: launched, carrying data, "
+          "configured, released with nothing left",
+          "[integration][host]") {
+  TestDomain domain;
+  auto [rc, out] = domain.cli({"launch", (kSource / "profiles/dom/waveforms/ProducerConsumerHosted/"
+                                                    "ProducerConsumerHosted.sad.xml")
+                                             .string()});
+  INFO(out);
+  REQUIRE(rc == 0);
+  auto app = domain.call("app.show", Json{{"app", "ProducerConsumerHosted"}});
+  REQUIRE(app.has_value());
+  CHECK(app->at("state") == "running");
+  const auto pids = pids_by_component(*app);
+  REQUIRE(pids.size() == 2);
+  // Both are placed on one device, so one host process serves both.
+  CHECK(pids.at("Producer_1") == pids.at("Consumer_1"));
+  CHECK(process_exists(pids.at("Producer_1")));
+  CHECK(executable_of(pids.at("Producer_1")) == "rsca-component-host");
+
+  CHECK(TestDomain::wait_for([&] { return received(domain, "ProducerConsumerHosted") > 20; }));
+  auto [crc, configured] =
+      domain.cli({"configure", "ProducerConsumerHosted/Producer_1", "rate_hz=200"});
+  INFO(configured);
+  CHECK(crc == 0);
+  auto q = domain.call(
+      "app.query",
+      Json{{"app", "ProducerConsumerHosted"}, {"component", "Producer_1"}, {"ids", {"rate_hz"}}});
+  REQUIRE(q.has_value());
+  CHECK(q->at("properties").at("rate_hz").get<double>() == 200.0);
+
+  REQUIRE(domain.call("app.release", Json{{"app", "ProducerConsumerHosted"}}).has_value());
+  domain.require_clean({pids.at("Producer_1")});
+}
+
+TEST_CASE("hosted components and component processes connect to each other",
+          "[integration][host]") {
+  TestDomain domain;
+  domain.install("HostedMixed");
+  auto app = domain.call("app.create", Json{{"application", "HostedMixed"}});
+  INFO((app ? std::string() : app.error().message));
+  REQUIRE(app.has_value());
+  const auto pids = pids_by_component(*app);
+  std::map<std::string, std::string> device;
+  for (const auto &c : app->at("components"))
+    device[c.at("id")] = c.at("device");
+  // The two hosted producers share a host when they share a device; the consumer is a process.
+  CHECK((pids.at("Producer_1") == pids.at("Producer_2")) ==
+        (device.at("Producer_1") == device.at("Producer_2")));
+  CHECK(pids.at("Consumer_1") != pids.at("Producer_1"));
+  CHECK(executable_of(pids.at("Consumer_1")) == "rsca-consumer");
+  CHECK(executable_of(pids.at("Producer_1")) == "rsca-component-host");
+  CHECK(TestDomain::wait_for([&] { return received(domain, "HostedMixed") > 20; }));
+  REQUIRE(domain.call("app.release", Json{{"app", "HostedMixed"}}).has_value());
+  std::vector<long> all;
+  for (const auto &[id, pid] : pids)
+    all.push_back(pid);
+  domain.require_clean(all);
+}
+
+TEST_CASE("a component host that cannot load a library fails the launch, which rolls back "
+          "everything",
+          "[integration][host][failure]") {
+  TestDomain domain;
+  domain.install("MissingLibrary");
+  auto [rc, out] = domain.cli({"launch", "MissingLibrary"});
+  INFO(out);
+  CHECK(rc == 6);
+  CHECK_THAT(out, Catch::Contains("failed at step"));
+  CHECK_THAT(out, Catch::Contains("Consumer_1"));
+  // The producers' processes and the host were started and are gone again, nothing stays
+  // allocated, no application is left.
+  domain.require_clean({});
+}
