@@ -144,14 +144,15 @@ Expected<void> Host::prepare(const std::vector<std::pair<std::string, std::strin
 }
 
 Expected<void> Host::open(std::shared_ptr<dds::Participant> participant,
-                          std::function<void()> on_released) {
+                          std::function<void()> on_released, control::EndpointOptions options) {
   participant_ = std::move(participant);
   on_released_ = std::move(on_released);
   auto loop = ReceiveLoop::start(participant_->get(), [this] { poll_ports(); });
   if (!loop)
     return tl::unexpected(loop.error());
   loop_ = std::move(*loop);
-  auto endpoint = control::Endpoint::open(participant_, c().context().control_address);
+  auto endpoint =
+      control::Endpoint::open(participant_, c().context().control_address, std::move(options));
   if (!endpoint)
     return tl::unexpected(endpoint.error());
   endpoint_ = std::move(*endpoint);

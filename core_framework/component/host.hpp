@@ -42,7 +42,7 @@ public:
   // Starts the receive thread, opens the endpoint, serves the operations and announces.
   // `on_released` runs once the component is released, by component.release or shutdown.
   Expected<void> open(std::shared_ptr<dds::Participant> participant,
-                      std::function<void()> on_released);
+                      std::function<void()> on_released, control::EndpointOptions options = {});
   // Stops (when started) and releases the component and drops its connections. Idempotent.
   void shutdown(std::string_view why);
   // Initializes, configures with `properties` and starts the component: what the domain would

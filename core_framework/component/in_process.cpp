@@ -31,7 +31,10 @@ InProcessComponent::open(const Factory &factory, Context context,
   auto host = std::make_unique<detail::Host>(std::move(component), std::move(softpkg));
   if (auto prepared = host->prepare(execparams); !prepared)
     return tl::unexpected(prepared.error());
-  if (auto opened = host->open(std::move(participant), std::move(on_released)); !opened)
+  // Many components share the process: each gets few threads. Its operations come one at a
+  // time, and one more worker serves a call while another waits (component.await_matched).
+  const control::EndpointOptions options{.workers = 2, .senders = 1, .on_announcement = {}};
+  if (auto opened = host->open(std::move(participant), std::move(on_released), options); !opened)
     return tl::unexpected(opened.error());
   return std::unique_ptr<InProcessComponent>(new InProcessComponent(std::move(host), address));
 }

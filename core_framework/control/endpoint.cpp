@@ -509,7 +509,7 @@ Expected<std::unique_ptr<Endpoint>> Endpoint::open(std::shared_ptr<dds::Particip
   if (auto ok = impl->create_entities(); !ok)
     return tl::unexpected(ok.error());
   impl->handler_pool = std::make_unique<WorkerPool>(std::max<std::size_t>(1, options.workers));
-  impl->send_pool = std::make_unique<WorkerPool>(4);
+  impl->send_pool = std::make_unique<WorkerPool>(std::max<std::size_t>(1, options.senders));
   Impl *raw = impl.get();
   impl->receiver = std::thread([raw] { raw->receive_loop(); });
   return std::unique_ptr<Endpoint>(new Endpoint(std::move(impl)));

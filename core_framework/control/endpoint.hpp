@@ -64,7 +64,8 @@ struct AnnouncementEvent {
 using AnnouncementHandler = std::function<void(const AnnouncementEvent &)>;
 
 struct EndpointOptions {
-  std::size_t workers = 8;
+  std::size_t workers = 8; // threads that run request handlers
+  std::size_t senders = 4; // threads that write requests, so callers never wait on discovery
   // Follows every endpoint's announcements when set: called for each change on the receiving
   // thread, so it must not block. Given at open so that no announcement arrives before it.
   AnnouncementHandler on_announcement;

@@ -2,8 +2,9 @@
 """Launch and teardown at scale on a real local domain (run by tools/bench, never by ctest).
 
 Starts `rsca domain up --nodes 10` on a DDS domain id and run folder of its own, writes chains of
-N Relay components with tools/gen-app (N = 10, 100), and for each N launches and releases the
-chain `runs` times, spread over the 10 nodes:
+N Relay components with tools/gen-app, as processes (N = 10, 100) and as shared libraries in
+component hosts (N = 10, 100, 1000; --quick: 10, 100), and for each launches and releases the
+chain `runs` times (1000: `runs_large`), spread over the 10 nodes:
 - launch: until every component runs and every connection is matched (the domain's connect step
   waits for that before start), as the domain timed it and as the CLI saw it;
 - teardown: `rsca release`, CLI wall clock (an upper bound: it includes the CLI's own start and
@@ -25,11 +26,13 @@ from local_domain import Domain, summary
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 
-def generate(n, out):
+def generate(n, hosted, out):
+    name = f"Chain{n}{'Hosted' if hosted else ''}"
     path = subprocess.run([os.path.join(ROOT, "tools/gen-app"), "--shape", "chain",
-                           "--components", str(n), "--out", out],
+                           "--components", str(n), "--out", out, "--name", name] +
+                          (["--shared-library"] if hosted else []),
                           check=True, capture_output=True, text=True).stdout.strip()
-    return path, f"Chain{n}"
+    return path, name
 
 
 def baseline_ms(relay, n):
@@ -41,8 +44,8 @@ def baseline_ms(relay, n):
     return (time.perf_counter() - began) * 1e3
 
 
-def bench_n(domain, n, runs, sdr, relay):
-    sad, name = generate(n, sdr)
+def bench_n(domain, n, hosted, runs, sdr, relay):
+    sad, name = generate(n, hosted, sdr)
     domain.cli("install", "--sdrroot", sdr, sad)
     launch_domain, launch_cli, release_cli, base, steps = [], [], [], [], {}
     for i in range(runs):
@@ -54,7 +57,7 @@ def bench_n(domain, n, runs, sdr, relay):
         _, wall = domain.cli("release", f"{name}_{i}")
         release_cli.append(wall)
         base.append(baseline_ms(relay, n))
-    return {"components": n, "nodes": domain.nodes,
+    return {"components": n, "kind": "hosted" if hosted else "processes", "nodes": domain.nodes,
             "launch_domain_ms": summary(launch_domain), "launch_cli_ms": summary(launch_cli),
             "release_cli_ms": summary(release_cli), "baseline_fork_exec_ms": summary(base),
             "steps_ms_median": {k: sorted(v)[len(v) // 2] for k, v in steps.items()}}
@@ -66,29 +69,37 @@ def main():
     parser.add_argument("--out", required=True)
     parser.add_argument("--quick", action="store_true")
     args = parser.parse_args()
-    sizes = [10, 100]
+    configs = [(10, False), (100, False), (10, True), (100, True)]
+    if not args.quick:
+        configs.append((1000, True))
     runs = 3 if args.quick else 10
     rsca = os.path.join(args.bin, "rsca")
     results = []
     with tempfile.TemporaryDirectory(prefix="rsca-gen-") as sdr, Domain(rsca, nodes=10) as domain:
-        for n in sizes:
-            results.append(bench_n(domain, n, runs, sdr, os.path.join(args.bin, "rsca-relay")))
+        for n, hosted in configs:
+            print(f"launch of {n} {'hosted components' if hosted else 'processes'}...",
+                  file=sys.stderr)
+            results.append(bench_n(domain, n, hosted, runs if n < 1000 else 3, sdr,
+                                   os.path.join(args.bin, "rsca-relay")))
     with open(args.out, "w") as f:
         json.dump({"launch": results}, f, indent=2)
-    print("| components | nodes | launch (domain) median | p95 | launch (CLI) median | "
+    print("| components | as | nodes | launch (domain) median | p95 | launch (CLI) median | "
           "release (CLI) median | p95 | fork/exec baseline median |")
-    print("| --- | --- | --- | --- | --- | --- | --- | --- |")
+    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- |")
     for r in results:
-        print(f"| {r['components']} | {r['nodes']} | {r['launch_domain_ms']['median']:.1f} ms | "
+        print(f"| {r['components']} | {r['kind']} | {r['nodes']} | "
+              f"{r['launch_domain_ms']['median']:.1f} ms | "
               f"{r['launch_domain_ms']['p95']:.1f} ms | {r['launch_cli_ms']['median']:.1f} ms | "
               f"{r['release_cli_ms']['median']:.1f} ms | {r['release_cli_ms']['p95']:.1f} ms | "
               f"{r['baseline_fork_exec_ms']['median']:.1f} ms |")
     for a, b in zip(results, results[1:]):
+        if a["kind"] != b["kind"]:
+            continue
         growth = b["launch_domain_ms"]["median"] / a["launch_domain_ms"]["median"]
         print(f"launch growth {a['components']} -> {b['components']} components: x{growth:.1f} "
               f"(x{b['components'] / a['components']:.0f} would be linear)")
     for r in results:
-        print(f"steps (median ms) at {r['components']}: " +
+        print(f"steps (median ms) at {r['components']} {r['kind']}: " +
               ", ".join(f"{k} {v:.1f}" for k, v in r["steps_ms_median"].items()))
     return 0
 
