@@ -3,6 +3,7 @@
 #include "allocator/device.hpp"
 
 #include <atomic>
+#include <mutex>
 #include <unistd.h>
 
 #include <fmt/format.h>
@@ -53,6 +54,7 @@ struct DeviceManager::Impl {
   profile::ResolvedNode node;
   std::vector<RunningDevice> devices;
   std::atomic<bool> stopping{false};
+  std::mutex endpoint_mutex; // the endpoint's end against a process exit reported meanwhile
 
   Expected<void> start_devices(const DeviceRegistry &registry);
   Json announcement() const;
@@ -132,6 +134,7 @@ ExecutableDevice *DeviceManager::Impl::executable_device(const std::string &id) 
 }
 
 void DeviceManager::Impl::report_exit(const Json &report) {
+  std::lock_guard lock(endpoint_mutex); // the reaper's thread: the endpoint may be going
   if (stopping.load() || !endpoint)
     return;
   spdlog::warn("process {} exited on its own: {}", report.value("pid", 0L),
@@ -182,8 +185,13 @@ DeviceManager::DeviceManager(std::unique_ptr<Impl> impl) : impl_(std::move(impl)
 DeviceManager::~DeviceManager() {
   impl_->stopping = true;
   impl_->endpoint->withdraw();
+  // The endpoint goes first: closing it waits for the handlers still running, which use the
+  // devices (a node.terminate still escalating while the devices went was a double free).
+  {
+    std::lock_guard lock(impl_->endpoint_mutex);
+    impl_->endpoint.reset();
+  }
   impl_->devices.clear(); // terminates whatever the GPP still runs
-  impl_->endpoint.reset();
 }
 
 const std::string &DeviceManager::node_name() const {
