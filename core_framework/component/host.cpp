@@ -147,7 +147,7 @@ Expected<void> Host::open(std::shared_ptr<dds::Participant> participant,
                           std::function<void()> on_released, control::EndpointOptions options) {
   participant_ = std::move(participant);
   on_released_ = std::move(on_released);
-  auto loop = ReceiveLoop::start(participant_->get(), [this] { poll_ports(); });
+  auto loop = ReceiveLoop::start([this] { poll_ports(); });
   if (!loop)
     return tl::unexpected(loop.error());
   loop_ = std::move(*loop);

@@ -15,21 +15,20 @@ namespace rsca::component {
 
 namespace detail {
 
-// One connection of a port: its topic and its writer or reader. Members are destroyed in reverse
-// order: the read condition, then the reader or writer, then the topic.
+// One connection of a port: its topic and its writer or reader. The reader leaves the receive loop
+// first, then members are destroyed in reverse order: the reader or writer, then the topic.
 struct DataConnection {
   std::string topic_name;
   dds::Entity topic;
-  dds::Entity entity;         // the writer (uses) or reader (provides)
-  dds::Entity read_condition; // provides only: attached to the receive loop
+  dds::Entity entity; // the writer (uses) or reader (provides)
   ReceiveLoop *loop = nullptr;
   std::atomic<std::uint64_t> samples{0};
   std::optional<ContentFilter> filter; // provides only: what is delivered
   std::atomic<std::uint64_t> filtered{0};
 
   ~DataConnection() {
-    if (loop != nullptr && read_condition)
-      loop->detach(read_condition.get());
+    if (loop != nullptr && entity)
+      loop->detach(entity.get());
   }
 };
 
@@ -133,12 +132,7 @@ Expected<std::unique_ptr<DataConnection>> open_reader(dds_entity_t participant,
   if (!reader)
     return tl::unexpected(reader.error());
   c->entity = std::move(*reader);
-  auto condition = dds::checked(dds_create_readcondition(c->entity.get(), DDS_ANY_STATE),
-                                "creating a read condition");
-  if (!condition)
-    return tl::unexpected(condition.error());
-  c->read_condition = std::move(*condition);
-  if (auto attached = loop->attach(c->read_condition.get()); !attached)
+  if (auto attached = loop->attach(c->entity.get()); !attached)
     return tl::unexpected(attached.error());
   // Deadline misses and lost liveliness are looked for by the loop's owner now and then
   // (take_problems), not waited for: a status check at every sample contends with Cyclone's

@@ -1,6 +1,7 @@
 // Private to the component runtime: the one thread of a component that receives on all its
-// provides ports. It waits on a waitset holding one read condition per connection, and on any
-// trigger lets the component take what arrived.
+// provides ports. Each reader's data-available listener only wakes the thread (an eventfd write,
+// which never blocks); the thread then lets the component take what arrived, off Cyclone's own
+// receive thread.
 #pragma once
 
 #include <atomic>
@@ -16,23 +17,26 @@ namespace rsca::component::detail {
 class ReceiveLoop {
 public:
   // Starts the thread; `poll` runs on it after every wake-up.
-  static Expected<std::unique_ptr<ReceiveLoop>> start(dds_entity_t participant,
-                                                      std::function<void()> poll);
+  static Expected<std::unique_ptr<ReceiveLoop>> start(std::function<void()> poll);
   ~ReceiveLoop();
   ReceiveLoop(const ReceiveLoop &) = delete;
   ReceiveLoop &operator=(const ReceiveLoop &) = delete;
 
-  Expected<void> attach(dds_entity_t condition);
-  void detach(dds_entity_t condition);
+  // Wakes the thread whenever `reader` receives data. `detach` returns once no listener call for
+  // the reader is under way.
+  Expected<void> attach(dds_entity_t reader);
+  void detach(dds_entity_t reader);
   // Stops and joins the thread; `poll` is not called afterwards. Idempotent.
   void stop();
 
 private:
-  ReceiveLoop(dds::Entity waitset, dds::Entity guard, std::function<void()> poll);
+  ReceiveLoop(int wake_fd, dds_listener_t *listener, std::function<void()> poll);
+  static void on_data_available(dds_entity_t reader, void *loop);
+  void wake() const;
   void run();
 
-  dds::Entity waitset_;
-  dds::Entity guard_;
+  int wake_fd_;
+  dds_listener_t *listener_;
   std::function<void()> poll_;
   std::atomic<bool> stopping_{false};
   std::thread thread_;
