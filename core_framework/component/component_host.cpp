@@ -22,11 +22,6 @@ namespace {
 namespace fs = std::filesystem;
 using detail::ExitEvents;
 
-struct HostedComponent {
-  ExecParams params;
-  fs::path library; // LIBRARY
-};
-
 // Takes LIBRARY out of the group's other parameters.
 tl::expected<fs::path, std::string> take_library(ExecParams &params) {
   auto &others = params.others;
@@ -38,32 +33,6 @@ tl::expected<fs::path, std::string> take_library(ExecParams &params) {
   fs::path library = it->second;
   others.erase(it);
   return library;
-}
-
-// One group of exec parameters per component, each starting with COMPONENT_IDENTIFIER.
-tl::expected<std::vector<HostedComponent>, std::string> parse_host_params(int argc,
-                                                                          const char *const *argv) {
-  constexpr std::string_view kStart = "COMPONENT_IDENTIFIER";
-  if (argc < 2 || argv[1] != kStart)
-    return tl::unexpected(fmt::format("the exec parameters start with {}", kStart));
-  std::vector<HostedComponent> hosted;
-  for (int begin = 1; begin < argc;) {
-    int end = begin + 2; // keys stand at every other argument
-    while (end < argc && argv[end] != kStart)
-      end += 2;
-    end = std::min(end, argc);
-    std::vector<const char *> group{argv[0]};
-    group.insert(group.end(), argv + begin, argv + end);
-    auto params = parse_exec_params(static_cast<int>(group.size()), group.data());
-    if (!params)
-      return tl::unexpected(fmt::format("component {}: {}", hosted.size() + 1, params.error()));
-    auto library = take_library(*params);
-    if (!library)
-      return tl::unexpected(library.error());
-    hosted.push_back({std::move(*params), std::move(*library)});
-    begin = end;
-  }
-  return hosted;
 }
 
 // The library as the SPD names it: absolute, or relative to the SPD's folder; one that is not
@@ -171,6 +140,31 @@ int serve_hosted(const std::vector<HostedComponent> &hosted, const ExitEvents &e
 }
 
 } // namespace
+
+tl::expected<std::vector<HostedComponent>, std::string> parse_host_params(int argc,
+                                                                          const char *const *argv) {
+  constexpr std::string_view kStart = "COMPONENT_IDENTIFIER";
+  if (argc < 2 || argv[1] != kStart)
+    return tl::unexpected(fmt::format("the exec parameters start with {}", kStart));
+  std::vector<HostedComponent> hosted;
+  for (int begin = 1; begin < argc;) {
+    int end = begin + 2; // keys stand at every other argument
+    while (end < argc && argv[end] != kStart)
+      end += 2;
+    end = std::min(end, argc);
+    std::vector<const char *> group{argv[0]};
+    group.insert(group.end(), argv + begin, argv + end);
+    auto params = parse_exec_params(static_cast<int>(group.size()), group.data());
+    if (!params)
+      return tl::unexpected(fmt::format("component {}: {}", hosted.size() + 1, params.error()));
+    auto library = take_library(*params);
+    if (!library)
+      return tl::unexpected(library.error());
+    hosted.push_back({std::move(*params), std::move(*library)});
+    begin = end;
+  }
+  return hosted;
+}
 
 int run_component_host(int argc, char **argv) {
   return detail::run_process<std::vector<HostedComponent>>(

@@ -23,15 +23,15 @@ Expected<std::unique_ptr<ReceiveLoop>> ReceiveLoop::start(std::function<void()> 
   if (fd < 0)
     return make_error({"receive loop", 0, 0}, "dds",
                       fmt::format("eventfd: {}", std::strerror(errno)));
-  std::unique_ptr<ReceiveLoop> loop(new ReceiveLoop(fd, nullptr, std::move(poll)));
-  loop->listener_ = dds_create_listener(loop.get());
-  dds_lset_data_available(loop->listener_, &ReceiveLoop::on_data_available);
+  std::unique_ptr<ReceiveLoop> loop(new ReceiveLoop(fd, std::move(poll)));
   loop->thread_ = std::thread([raw = loop.get()] { raw->run(); });
   return loop;
 }
 
-ReceiveLoop::ReceiveLoop(int wake_fd, dds_listener_t *listener, std::function<void()> poll)
-    : wake_fd_(wake_fd), listener_(listener), poll_(std::move(poll)) {}
+ReceiveLoop::ReceiveLoop(int wake_fd, std::function<void()> poll)
+    : wake_fd_(wake_fd), listener_(dds_create_listener(this)), poll_(std::move(poll)) {
+  dds_lset_data_available(listener_, &ReceiveLoop::on_data_available);
+}
 
 ReceiveLoop::~ReceiveLoop() {
   stop();

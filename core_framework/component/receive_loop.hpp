@@ -30,7 +30,7 @@ public:
   void stop();
 
 private:
-  ReceiveLoop(int wake_fd, dds_listener_t *listener, std::function<void()> poll);
+  ReceiveLoop(int wake_fd, std::function<void()> poll);
   static void on_data_available(dds_entity_t reader, void *loop);
   void wake() const;
   void run();

@@ -11,6 +11,7 @@
 // entities are gone.
 #pragma once
 
+#include <filesystem>
 #include <functional>
 #include <memory>
 #include <string>
@@ -44,6 +45,17 @@ struct ExecParams {
 
 // The exec parameters of argv[1..], in pairs.
 tl::expected<ExecParams, std::string> parse_exec_params(int argc, const char *const *argv);
+
+// One component of a component host (run_component_host): its exec parameters and its library.
+struct HostedComponent {
+  ExecParams params;
+  std::filesystem::path library; // LIBRARY, as the SPD names it
+};
+
+// A component host's exec parameters: one group per component, each starting with
+// COMPONENT_IDENTIFIER and naming its LIBRARY.
+tl::expected<std::vector<HostedComponent>, std::string> parse_host_params(int argc,
+                                                                          const char *const *argv);
 
 using Factory = std::function<std::unique_ptr<Component>(const Context &)>;
 int run_component(int argc, char **argv, const Factory &factory);

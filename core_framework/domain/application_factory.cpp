@@ -62,6 +62,15 @@ CallResult<void> call_all(control::Endpoint &endpoint, const std::vector<Call> &
   return first_failure(calls, call_each_of(endpoint, calls, timeout));
 }
 
+// The processes an application's components run in: the components of a host share its process.
+std::set<long> process_ids(const Application &app) {
+  std::set<long> pids;
+  for (const auto &c : app.components)
+    if (c.pid != 0)
+      pids.insert(c.pid);
+  return pids;
+}
+
 bool is_execparam_only(const profile::PropertyDefinition &d) {
   const auto &c = profile::common_of(d);
   return c.has_kind(profile::PropertyKind::ExecParam) &&
@@ -636,11 +645,7 @@ private:
       if (std::find(devices.begin(), devices.end(), p.device) == devices.end())
         devices.push_back(p.device);
     ApplicationFactory factory(s_);
-    std::set<long> pids; // the components of a host share its process
-    for (const auto &c : app_->components)
-      if (c.pid != 0)
-        pids.insert(c.pid);
-    const std::size_t started = pids.size();
+    const std::size_t started = process_ids(*app_).size();
     if (joined_channels_) {
       const auto destroyed = s_.channels->leave(app_->name);
       undone.push_back(destroyed.empty() ? "event channel memberships withdrawn"

@@ -7,8 +7,9 @@ namespace rsca::domain {
 
 void ComponentRegistry::expect(const std::string &address, const std::string &node) {
   std::lock_guard lock(mutex_);
-  entries_[address] = Entry{};
-  entries_[address].node = node;
+  Entry entry;
+  entry.node = node;
+  entries_[address] = std::move(entry);
 }
 
 std::vector<std::string> ComponentRegistry::node_gone(const std::string &node,

@@ -84,11 +84,7 @@ TEST_CASE("an event channel carries events to every subscriber, and a filtered o
           "matches",
           "[integration][channels]") {
   TestDomain domain;
-  domain.install("Events");
-  auto app = domain.call("app.create", Json{{"application", "Events"}});
-  INFO((app ? std::string() : app.error().message));
-  REQUIRE(app.has_value());
-  const auto pids = pids_of(*app);
+  const auto pids = pids_of(domain.create("Events"));
 
   // Consumer_1 takes every tick (100 a second); Consumer_2's filter "sequence < 50" lets the first
   // fifty through and no other. (The very first ticks may be written before a reader is matched,

@@ -63,13 +63,10 @@ TEST_CASE("shared-library components run in one component host: launched, carryi
 TEST_CASE("hosted components and component processes connect to each other",
           "[integration][host]") {
   TestDomain domain;
-  domain.install("HostedMixed");
-  auto app = domain.call("app.create", Json{{"application", "HostedMixed"}});
-  INFO((app ? std::string() : app.error().message));
-  REQUIRE(app.has_value());
-  const auto pids = pids_by_component(*app);
+  const Json app = domain.create("HostedMixed");
+  const auto pids = pids_by_component(app);
   std::map<std::string, std::string> device;
-  for (const auto &c : app->at("components"))
+  for (const auto &c : app.at("components"))
     device[c.at("id")] = c.at("device");
   // The two hosted producers share a host when they share a device; the consumer is a process.
   CHECK((pids.at("Producer_1") == pids.at("Producer_2")) ==
@@ -79,10 +76,7 @@ TEST_CASE("hosted components and component processes connect to each other",
   CHECK(executable_of(pids.at("Producer_1")) == "rsca-component-host");
   CHECK(TestDomain::wait_for([&] { return received(domain, "HostedMixed") > 20; }));
   REQUIRE(domain.call("app.release", Json{{"app", "HostedMixed"}}).has_value());
-  std::vector<long> all;
-  for (const auto &[id, pid] : pids)
-    all.push_back(pid);
-  domain.require_clean(all);
+  domain.require_clean(pids_of(app));
 }
 
 TEST_CASE("a component host that cannot load a library fails the launch, which rolls back "

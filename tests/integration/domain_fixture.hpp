@@ -116,6 +116,16 @@ public:
     REQUIRE(rc == 0);
   }
 
+  // Installs an application of the test SDR root and creates it: the application as app.create
+  // gives it.
+  Json create(const std::string &application) {
+    install(application);
+    auto app = call("app.create", Json{{"application", application}});
+    INFO((app ? std::string() : app.error().message));
+    REQUIRE(app.has_value());
+    return *app;
+  }
+
   // Nothing of any application is left: no application, no allocation, no component process.
   void require_clean(const std::vector<long> &pids) {
     auto apps = call("app.list");

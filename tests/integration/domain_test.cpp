@@ -197,11 +197,9 @@ TEST_CASE("a restarted domain daemon sees every node again and keeps what was in
 TEST_CASE("a component that crashes after launch is reported to the domain",
           "[integration][domain][failure]") {
   TestDomain domain;
-  domain.install("Healthy");
-  auto app = domain.call("app.create", Json{{"application", "Healthy"}});
-  REQUIRE(app.has_value());
+  const Json app = domain.create("Healthy");
   long victim = 0;
-  for (const auto &c : app->at("components"))
+  for (const auto &c : app.at("components"))
     if (c.at("id") == "Victim_1")
       victim = c.at("pid").get<long>();
   REQUIRE(victim > 0);
@@ -216,18 +214,16 @@ TEST_CASE("a component that crashes after launch is reported to the domain",
     return false;
   }));
   REQUIRE(domain.call("app.release", Json{{"app", "Healthy"}}).has_value());
-  domain.require_clean(pids_of(*app));
+  domain.require_clean(pids_of(app));
 }
 
 TEST_CASE("the components of a node that dies are reported exited, with the node as the reason",
           "[integration][domain][failure]") {
   TestDomain domain;
-  domain.install("Healthy");
-  auto app = domain.call("app.create", Json{{"application", "Healthy"}});
-  REQUIRE(app.has_value());
-  const std::string node = app->at("components")[0].at("node");
+  const Json app = domain.create("Healthy");
+  const std::string node = app.at("components")[0].at("node");
   int on_node = 0;
-  for (const auto &c : app->at("components"))
+  for (const auto &c : app.at("components"))
     on_node += c.at("node") == node ? 1 : 0;
   domain.kill_node(node == "node1" ? 1 : 2);
   // A component's own lease is long (its node watches it); the node's loss is what tells.
@@ -251,7 +247,7 @@ TEST_CASE("the components of a node that dies are reported exited, with the node
   for (const auto &c : shown->at("components"))
     CHECK((c.at("state") == "exited") == (c.at("node") == node));
   REQUIRE(domain.call("app.release", Json{{"app", "Healthy"}}).has_value());
-  domain.require_clean(pids_of(*app));
+  domain.require_clean(pids_of(app));
 }
 
 TEST_CASE("admission: launches fill the domain, the next is rejected with the reason, a release "

@@ -247,6 +247,48 @@ TEST_CASE("exec parameters come in pairs and name the component", "[component]")
   CHECK(parse_exec_params(5, argv).error() == "the exec parameter CONTROL_ADDRESS is missing");
 }
 
+TEST_CASE("a component host's exec parameters are one group per component, each with its "
+          "library",
+          "[component]") {
+  const char *argv[] = {"rsca-component-host",
+                        "COMPONENT_IDENTIFIER",
+                        "A_1",
+                        "PROFILE_NAME",
+                        "/sdr/A.spd.xml",
+                        "CONTROL_ADDRESS",
+                        "a",
+                        "LIBRARY",
+                        "liba.so",
+                        "rate_hz",
+                        "20",
+                        "COMPONENT_IDENTIFIER",
+                        "B_1",
+                        "PROFILE_NAME",
+                        "/sdr/B.spd.xml",
+                        "CONTROL_ADDRESS",
+                        "b",
+                        "LIBRARY",
+                        "/lib/libb.so"};
+  auto hosted = parse_host_params(19, argv);
+  REQUIRE(hosted.has_value());
+  REQUIRE(hosted->size() == 2);
+  CHECK((*hosted)[0].params.identifier == "A_1");
+  CHECK((*hosted)[0].library == "liba.so");
+  // LIBRARY is the host's; the rest goes to the component.
+  CHECK((*hosted)[0].params.others ==
+        std::vector<std::pair<std::string, std::string>>{{"rate_hz", "20"}});
+  CHECK((*hosted)[1].params.control_address == "b");
+  CHECK((*hosted)[1].library == "/lib/libb.so");
+  CHECK((*hosted)[1].params.others.empty());
+  // Bad input: a clear error naming what is wrong.
+  CHECK(parse_host_params(17, argv).error() == "B_1: the exec parameter LIBRARY is missing");
+  CHECK(parse_host_params(12, argv).error() ==
+        "component 2: exec parameters come in pairs: \"COMPONENT_IDENTIFIER\" has no value");
+  const char *no_start[] = {"rsca-component-host", "PROFILE_NAME", "/sdr/A.spd.xml"};
+  CHECK(parse_host_params(3, no_start).error() ==
+        "the exec parameters start with COMPONENT_IDENTIFIER");
+}
+
 TEST_CASE("the schedule admission decided arrives as exec parameters", "[component]") {
   const char *argv[] = {"rsca-producer",
                         "COMPONENT_IDENTIFIER",

@@ -1,6 +1,7 @@
 // The control plane between real DDS participants in one process, on a DDS domain of its own.
 #include <atomic>
 #include <condition_variable>
+#include <future>
 #include <mutex>
 #include <unistd.h>
 
@@ -22,6 +23,32 @@ std::unique_ptr<Endpoint> open(const std::shared_ptr<dds::Participant> &pp,
   auto endpoint = Endpoint::open(pp, address, options);
   REQUIRE(endpoint.has_value());
   return std::move(*endpoint);
+}
+
+// Holds handlers until opened, so that a test controls when a call is answered.
+class Gate {
+public:
+  control::CallResult<Json> wait() {
+    std::unique_lock lock(m_);
+    cv_.wait(lock, [&] { return open_; });
+    return Json{};
+  }
+  void open() {
+    {
+      std::lock_guard lock(m_);
+      open_ = true;
+    }
+    cv_.notify_all();
+  }
+
+private:
+  std::mutex m_;
+  std::condition_variable cv_;
+  bool open_ = false;
+};
+
+control::CallResult<Json> fast(const Json &, const control::RequestContext &) {
+  return Json{{"ok", true}};
 }
 
 } // namespace
@@ -80,31 +107,41 @@ TEST_CASE("a call to nobody fails when its deadline passes", "[control]") {
 TEST_CASE("a slow handler times out the caller but does not block other calls", "[control]") {
   auto pp = test::participant();
   auto server = open(pp, "test/server");
-  std::mutex m;
-  std::condition_variable cv;
-  bool release = false;
-  server->on("slow",
-             [&](const Json &, const control::RequestContext &) -> control::CallResult<Json> {
-               std::unique_lock lock(m);
-               cv.wait(lock, [&] { return release; });
-               return Json{};
-             });
-  server->on("fast",
-             [](const Json &, const control::RequestContext &) -> control::CallResult<Json> {
-               return Json{{"ok", true}};
-             });
+  Gate gate;
+  server->on("slow", [&](const Json &, const control::RequestContext &) { return gate.wait(); });
+  server->on("fast", fast);
   auto client = open(pp, "test/client");
   auto slow = client->call("test/server", "slow", Json::object(), 300ms);
-  auto fast = client->call_sync("test/server", "fast", Json::object(), 5s);
-  CHECK(fast.has_value());
+  auto fast_reply = client->call_sync("test/server", "fast", Json::object(), 5s);
+  CHECK(fast_reply.has_value());
   auto slow_result = slow.get();
   REQUIRE_FALSE(slow_result.has_value());
   CHECK(slow_result.error().status == Status::Timeout);
-  {
-    std::lock_guard lock(m);
-    release = true;
-  }
-  cv.notify_all();
+  gate.open();
+}
+
+TEST_CASE("calls to an endpoint known to be dead are abandoned at once, with the reason",
+          "[control]") {
+  auto pp = test::participant();
+  auto server = open(pp, "test/server");
+  Gate gate;
+  server->on("hang", [&](const Json &, const control::RequestContext &) { return gate.wait(); });
+  server->on("fast", fast);
+  auto other = open(pp, "test/other");
+  other->on("fast", fast);
+  auto client = open(pp, "test/client");
+  REQUIRE(client->call_sync("test/server", "fast", Json::object(), 5s).has_value());
+  // The deadline is far: only abandon can end this call before the test's end.
+  auto hanging = client->call("test/server", "hang", Json::object(), 1h);
+  client->abandon("test/server", "its node is gone");
+  REQUIRE(hanging.wait_for(10s) == std::future_status::ready);
+  auto result = hanging.get();
+  REQUIRE_FALSE(result.has_value());
+  CHECK(result.error().status == Status::Unavailable);
+  CHECK(result.error().message == "test/server to \"hang\": its node is gone");
+  // Calls to other addresses are untouched.
+  CHECK(client->call_sync("test/other", "fast", Json::object(), 5s).has_value());
+  gate.open();
 }
 
 TEST_CASE("announcements are seen, updated and withdrawn", "[control]") {
