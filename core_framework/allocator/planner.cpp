@@ -269,6 +269,7 @@ public:
       return tl::unexpected(std::move(unplaceable));
     order_components();
     index_affinities();
+    fair_share_ = fair_share();
     steps_.resize(order_.size());
     if (place(0))
       return finish();
@@ -342,6 +343,17 @@ private:
     }
   }
 
+  // How many of the application's components a device takes when spreading: the components
+  // divided evenly among the devices that could take any of them.
+  std::size_t fair_share() const {
+    std::set<std::string> devices;
+    for (const auto &list : candidates_)
+      for (const auto &candidate : list)
+        devices.insert(candidate.device);
+    const std::size_t n = request_.components.size();
+    return devices.empty() ? n : (n + devices.size() - 1) / devices.size();
+  }
+
   // The weight of `instance`'s placed partners per node they are on.
   std::map<std::string, double> affinity_by_node(const std::string &instance,
                                                  bool heavy_only) const {
@@ -359,17 +371,24 @@ private:
   }
 
   // The candidates of component `i` in the order the strategy prefers them.
+  // Both strategies prefer the node of placed partners (connections: the data stays in one host,
+  // and in one component host when both are shared libraries). Spreading, a device is preferred
+  // so only until it has its fair share of the application, unless the pair is heavy.
   std::vector<Candidate> ranked(std::size_t i) const {
     const auto &c = request_.components[i];
     const bool pack = options_.strategy == Strategy::Pack;
     std::vector<std::tuple<double, double, std::size_t>> keyed;
     const auto &list = candidates_[i];
-    const auto affinity = affinity_by_node(c.instance, !pack);
+    const auto affinity = affinity_by_node(c.instance, /*heavy_only=*/false);
+    const auto heavy = pack ? affinity : affinity_by_node(c.instance, /*heavy_only=*/true);
     for (std::size_t k = 0; k < list.size(); ++k) {
       const auto &s = *list[k].state;
-      auto a = affinity.empty() ? affinity.end() : affinity.find(s.device.node);
+      auto placed = placed_on_.find(list[k].device);
+      const bool full = !pack && placed != placed_on_.end() && placed->second >= fair_share_;
+      const auto &weights = full ? heavy : affinity;
+      auto a = weights.find(s.device.node);
       const double load = load_of(s);
-      keyed.emplace_back(a == affinity.end() ? 0.0 : -a->second, pack ? -load : load, k);
+      keyed.emplace_back(a == weights.end() ? 0.0 : -a->second, pack ? -load : load, k);
     }
     std::stable_sort(keyed.begin(), keyed.end());
     std::vector<Candidate> out;
@@ -516,12 +535,14 @@ private:
         if (opens_group)
           group_node_[c.collocation] = step->placement.node;
         node_of_[c.instance] = step->placement.node;
+        ++placed_on_[step->placement.device];
         apply(*step, +1);
         steps_[k] = std::move(*step);
         if (place(k + 1))
           return true;
         apply(steps_[k], -1);
         node_of_.erase(c.instance);
+        --placed_on_[steps_[k].placement.device];
         if (opens_group)
           group_node_.erase(c.collocation);
         if (budget_exhausted_)
@@ -648,7 +669,9 @@ private:
   std::vector<std::size_t> order_;
   std::vector<Step> steps_; // by search position
   std::map<std::string, std::vector<std::pair<std::string, double>>> partners_;
-  std::map<std::string, std::string> node_of_;    // placed instance -> node
+  std::map<std::string, std::string> node_of_;   // placed instance -> node
+  std::map<std::string, std::size_t> placed_on_; // device -> components of this plan on it
+  std::size_t fair_share_ = 0;
   std::map<std::string, std::string> group_node_; // hostcollocation -> node
   std::vector<UsedDevice> application_devices_;
   std::size_t tries_ = 0;

@@ -39,7 +39,7 @@ using DomainState = std::map<std::string, DeviceState>; // by device id: determi
 
 enum class Strategy : std::uint8_t {
   Pack,   // fewest devices: fill the most loaded device that fits
-  Spread, // balance load: the least loaded device that fits
+  Spread, // balance load: the least loaded device that fits, partners together up to a fair share
 };
 std::string_view to_string(Strategy strategy);
 std::optional<Strategy> parse_strategy(std::string_view text);

@@ -97,8 +97,22 @@ Context context_of(const ExecParams &p, spdlog::logger &host_log) {
                  p.schedule};
 }
 
-int serve_hosted(const std::vector<HostedComponent> &hosted, const ExitEvents &events,
-                 spdlog::logger &log) {
+// The host's one control endpoint, serving every component's address too. Its workers run the
+// batches of calls the domain sends for all the host's components at once.
+Expected<std::shared_ptr<control::Endpoint>>
+open_endpoint(const HostParams &host, std::shared_ptr<dds::Participant> participant) {
+  control::EndpointOptions options{
+      .workers = 4, .senders = 2, .on_announcement = {}, .aliases = {}};
+  for (const auto &h : host.components)
+    options.aliases.push_back(h.params.control_address);
+  auto endpoint = control::Endpoint::open(std::move(participant), host.control_address, options);
+  if (!endpoint)
+    return tl::unexpected(endpoint.error());
+  return std::shared_ptr<control::Endpoint>(std::move(*endpoint));
+}
+
+int serve_hosted(const HostParams &host, const ExitEvents &events, spdlog::logger &log) {
+  const auto &hosted = host.components;
   auto softpkgs = load_profiles(hosted);
   if (!softpkgs) {
     log.error("{}", softpkgs.error());
@@ -107,6 +121,11 @@ int serve_hosted(const std::vector<HostedComponent> &hosted, const ExitEvents &e
   auto participant = dds::Participant::create(dds::DdsSettings::from_environment());
   if (!participant) {
     log.error("{}", participant.error().to_string());
+    return kExitFailure;
+  }
+  auto endpoint = open_endpoint(host, *participant);
+  if (!endpoint) {
+    log.error("{}", endpoint.error().to_string());
     return kExitFailure;
   }
   std::atomic<std::size_t> unreleased{hosted.size()};
@@ -122,8 +141,9 @@ int serve_hosted(const std::vector<HostedComponent> &hosted, const ExitEvents &e
       log.error("{}: {}", h.params.identifier, factory.error());
       return kExitFailure;
     }
-    auto component = InProcessComponent::open(*factory, context_of(h.params, log), (*softpkgs)[i],
-                                              *participant, h.params.others, on_released);
+    auto component =
+        InProcessComponent::open(*factory, context_of(h.params, log), (*softpkgs)[i], *participant,
+                                 h.params.others, on_released, *endpoint);
     if (!component) {
       log.error("{}: {}", h.params.identifier, component.error().to_string());
       return kExitProfile;
@@ -135,19 +155,25 @@ int serve_hosted(const std::vector<HostedComponent> &hosted, const ExitEvents &e
   if (detail::wait_for_signal_or_release(events, signal))
     log.info("received {}: shutting down", signal == SIGINT ? "SIGINT" : "SIGTERM");
   components.clear(); // each is stopped, released and withdrawn
+  endpoint->reset();
   log.info("exiting");
   return kExitOk;
 }
 
 } // namespace
 
-tl::expected<std::vector<HostedComponent>, std::string> parse_host_params(int argc,
-                                                                          const char *const *argv) {
+tl::expected<HostParams, std::string> parse_host_params(int argc, const char *const *argv) {
+  constexpr std::string_view kAddress = "CONTROL_ADDRESS";
   constexpr std::string_view kStart = "COMPONENT_IDENTIFIER";
-  if (argc < 2 || argv[1] != kStart)
-    return tl::unexpected(fmt::format("the exec parameters start with {}", kStart));
-  std::vector<HostedComponent> hosted;
-  for (int begin = 1; begin < argc;) {
+  if (argc < 3 || argv[1] != kAddress)
+    return tl::unexpected(
+        fmt::format("the exec parameters start with {} <the host's address>", kAddress));
+  if (argc < 4 || argv[3] != kStart)
+    return tl::unexpected(
+        fmt::format("the host's address is followed by components, each starting with {}", kStart));
+  HostParams host{argv[2], {}};
+  auto &hosted = host.components;
+  for (int begin = 3; begin < argc;) {
     int end = begin + 2; // keys stand at every other argument
     while (end < argc && argv[end] != kStart)
       end += 2;
@@ -163,21 +189,21 @@ tl::expected<std::vector<HostedComponent>, std::string> parse_host_params(int ar
     hosted.push_back({std::move(*params), std::move(*library)});
     begin = end;
   }
-  return hosted;
+  return host;
 }
 
 int run_component_host(int argc, char **argv) {
-  return detail::run_process<std::vector<HostedComponent>>(
+  return detail::run_process<HostParams>(
       argc, argv,
-      "(COMPONENT_IDENTIFIER <id> PROFILE_NAME <spd> CONTROL_ADDRESS <address> LIBRARY <path> "
-      "[NAME_BINDING <name>] [DOMAIN_NAME <domain>] [APPLICATION <id>] [<property id> "
-      "<value>]...)...",
+      "CONTROL_ADDRESS <address> (COMPONENT_IDENTIFIER <id> PROFILE_NAME <spd> CONTROL_ADDRESS "
+      "<address> LIBRARY <path> [NAME_BINDING <name>] [DOMAIN_NAME <domain>] [APPLICATION <id>] "
+      "[<property id> <value>]...)...",
       parse_host_params,
-      [](const std::vector<HostedComponent> &hosted) {
-        return fmt::format("host:{}", hosted.front().params.application);
+      [](const HostParams &host) {
+        return fmt::format("host:{}", host.components.front().params.application);
       },
-      [](const std::vector<HostedComponent> &hosted, const ExitEvents &events, auto logger) {
-        return serve_hosted(hosted, events, *logger);
+      [](const HostParams &host, const ExitEvents &events, auto logger) {
+        return serve_hosted(host, events, *logger);
       });
 }
 

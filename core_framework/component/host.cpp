@@ -144,18 +144,22 @@ Expected<void> Host::prepare(const std::vector<std::pair<std::string, std::strin
 }
 
 Expected<void> Host::open(std::shared_ptr<dds::Participant> participant,
+                          std::shared_ptr<control::Endpoint> endpoint,
                           std::function<void()> on_released, control::EndpointOptions options) {
   participant_ = std::move(participant);
   on_released_ = std::move(on_released);
+  address_ = c().context().control_address;
   auto loop = ReceiveLoop::start([this] { poll_ports(); });
   if (!loop)
     return tl::unexpected(loop.error());
   loop_ = std::move(*loop);
-  auto endpoint =
-      control::Endpoint::open(participant_, c().context().control_address, std::move(options));
-  if (!endpoint)
-    return tl::unexpected(endpoint.error());
-  endpoint_ = std::move(*endpoint);
+  if (!endpoint) {
+    auto own = control::Endpoint::open(participant_, address_, std::move(options));
+    if (!own)
+      return tl::unexpected(own.error());
+    endpoint = std::move(*own);
+  }
+  endpoint_ = std::move(endpoint);
   serve("component.initialize", &Host::op_initialize);
   serve("component.configure", &Host::op_configure);
   serve("component.query", &Host::op_query);
@@ -167,13 +171,14 @@ Expected<void> Host::open(std::shared_ptr<dds::Participant> participant,
   serve("component.await_matched", &Host::op_await_matched);
   serve("component.release", &Host::op_release);
   std::lock_guard lock(lifecycle_);
-  return endpoint_->announce("component", announcement());
+  return endpoint_->announce(address_, "component", announcement());
 }
 
 void Host::close() {
   if (endpoint_) {
-    endpoint_->withdraw();
-    endpoint_.reset(); // waits for running handlers
+    endpoint_->withdraw(address_);
+    endpoint_->stop_serving(address_); // waits for running handlers
+    endpoint_.reset();
   }
   stop_service();
   if (loop_)
@@ -186,7 +191,7 @@ void Host::close() {
 // Runs `op` for `operation`: exceptions become errors.
 void Host::serve(const std::string &operation, Operation op) {
   endpoint_->on(
-      operation,
+      address_, operation,
       [this, op](const Json &body, const control::RequestContext &context) -> CallResult<Json> {
         log().debug("{} from {}", context.operation, context.sender);
         try {
@@ -241,7 +246,7 @@ void Host::set_state(State state) {
   log().info("{}", to_string(state));
   if (state == State::Released || !endpoint_)
     return;
-  if (auto ok = endpoint_->announce("component", announcement()); !ok)
+  if (auto ok = endpoint_->announce(address_, "component", announcement()); !ok)
     log().warn("updating the announcement failed: {}", ok.error().to_string());
 }
 

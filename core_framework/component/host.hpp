@@ -39,9 +39,12 @@ public:
   // Checks the bindings against the PRF and the ports against the SCD, then applies the PRF
   // defaults and the execparams (DEBUG_LEVEL sets the log level).
   Expected<void> prepare(const std::vector<std::pair<std::string, std::string>> &execparams);
-  // Starts the receive thread, opens the endpoint, serves the operations and announces.
-  // `on_released` runs once the component is released, by component.release or shutdown.
+  // Starts the receive thread, serves the operations at the component's control address and
+  // announces it there: on `endpoint` when given (its host's, which has the address among its
+  // aliases), else on an endpoint of its own opened with `options`. `on_released` runs once the
+  // component is released, by component.release or shutdown.
   Expected<void> open(std::shared_ptr<dds::Participant> participant,
+                      std::shared_ptr<control::Endpoint> endpoint,
                       std::function<void()> on_released, control::EndpointOptions options = {});
   // Stops (when started) and releases the component and drops its connections. Idempotent.
   void shutdown(std::string_view why);
@@ -88,7 +91,8 @@ private:
   std::shared_ptr<const profile::ResolvedSoftPkg> softpkg_;
   std::shared_ptr<dds::Participant> participant_;
   std::unique_ptr<ReceiveLoop> loop_;
-  std::unique_ptr<control::Endpoint> endpoint_;
+  std::shared_ptr<control::Endpoint> endpoint_;
+  std::string address_; // the component's control address
   std::function<void()> on_released_;
 
   std::mutex lifecycle_; // one lifecycle operation at a time

@@ -19,7 +19,8 @@ InProcessComponent::open(const Factory &factory, Context context,
                          std::shared_ptr<const profile::ResolvedSoftPkg> softpkg,
                          std::shared_ptr<dds::Participant> participant,
                          const std::vector<std::pair<std::string, std::string>> &execparams,
-                         std::function<void()> on_released) {
+                         std::function<void()> on_released,
+                         std::shared_ptr<control::Endpoint> endpoint) {
   const std::string address = context.control_address;
   const std::string where = softpkg->spd_path.string();
   std::unique_ptr<Component> component;
@@ -31,10 +32,13 @@ InProcessComponent::open(const Factory &factory, Context context,
   auto host = std::make_unique<detail::Host>(std::move(component), std::move(softpkg));
   if (auto prepared = host->prepare(execparams); !prepared)
     return tl::unexpected(prepared.error());
-  // Many components share the process: each gets few threads. Its operations come one at a
-  // time, and one more worker serves a call while another waits (component.await_matched).
-  const control::EndpointOptions options{.workers = 2, .senders = 1, .on_announcement = {}};
-  if (auto opened = host->open(std::move(participant), std::move(on_released), options); !opened)
+  // A device in its node gets an endpoint of its own with few threads: its operations come one
+  // at a time, and one more worker serves a call while another waits (component.await_matched).
+  const control::EndpointOptions options{
+      .workers = 2, .senders = 1, .on_announcement = {}, .aliases = {}};
+  if (auto opened =
+          host->open(std::move(participant), std::move(endpoint), std::move(on_released), options);
+      !opened)
     return tl::unexpected(opened.error());
   return std::unique_ptr<InProcessComponent>(new InProcessComponent(std::move(host), address));
 }

@@ -155,7 +155,8 @@ int run_host(const ExecParams &params, const ExitEvents &events, const Factory &
     logger->error("{}", participant.error().to_string());
     return kExitFailure;
   }
-  if (auto opened = host.open(*participant, [&events] { events.notify_released(); }); !opened) {
+  if (auto opened = host.open(*participant, nullptr, [&events] { events.notify_released(); });
+      !opened) {
     logger->error("{}", opened.error().to_string());
     return kExitFailure;
   }

@@ -52,10 +52,14 @@ struct HostedComponent {
   std::filesystem::path library; // LIBRARY, as the SPD names it
 };
 
-// A component host's exec parameters: one group per component, each starting with
-// COMPONENT_IDENTIFIER and naming its LIBRARY.
-tl::expected<std::vector<HostedComponent>, std::string> parse_host_params(int argc,
-                                                                          const char *const *argv);
+struct HostParams {
+  std::string control_address; // the host's own: it serves its components' addresses too
+  std::vector<HostedComponent> components;
+};
+
+// A component host's exec parameters: CONTROL_ADDRESS <the host's>, then one group per
+// component, each starting with COMPONENT_IDENTIFIER and naming its LIBRARY.
+tl::expected<HostParams, std::string> parse_host_params(int argc, const char *const *argv);
 
 using Factory = std::function<std::unique_ptr<Component>(const Context &)>;
 int run_component(int argc, char **argv, const Factory &factory);

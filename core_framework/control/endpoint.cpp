@@ -110,11 +110,29 @@ dds::Qos announcement_qos() {
   return qos;
 }
 
-dds::Qos partition_qos(const std::string &partition) {
+dds::Qos partition_qos(const std::vector<std::string> &partitions) {
   auto qos = dds::make_qos();
-  const char *names[] = {partition.c_str()};
-  dds_qset_partition(qos.get(), 1, names);
+  std::vector<const char *> names;
+  for (const auto &p : partitions)
+    names.push_back(p.c_str());
+  dds_qset_partition(qos.get(), static_cast<std::uint32_t>(names.size()), names.data());
   return qos;
+}
+
+constexpr const char *kBatch = "endpoint.batch";
+
+Json reply_json(const CallResult<Json> &result) {
+  if (result)
+    return Json{{"status", 0}, {"body", *result}};
+  return Json{{"status", static_cast<std::int32_t>(result.error().status)},
+              {"error", result.error().message}};
+}
+
+CallResult<Json> result_of(const Json &reply) {
+  const auto status = static_cast<Status>(reply.value("status", 3));
+  if (status != Status::Ok)
+    return call_error(status, reply.value("error", std::string("no reason given")));
+  return reply.value("body", Json::object());
 }
 
 // A writer into one partition, with the publisher that carries the partition.
@@ -156,9 +174,12 @@ struct Endpoint::Impl {
 
   std::mutex writers_mutex;
   std::map<std::string, PartitionWriter> request_writers, reply_writers;
+  std::map<std::string, std::string> routes; // target → the endpoint that serves it
 
   std::mutex state_mutex;
-  std::map<std::string, Handler> handlers;
+  std::map<std::pair<std::string, std::string>, Handler> handlers; // (address or "", operation)
+  std::map<std::string, int> running;                              // handlers running, by address
+  std::condition_variable handler_done;
   std::map<std::string, Pending> pending;
   std::uint64_t next_id = 0;
 
@@ -176,6 +197,11 @@ struct Endpoint::Impl {
   void take_announcements();
   void expire_calls();
   void serve(RequestContext context, Json body);
+  CallResult<Json> dispatch(const RequestContext &context, const Json &body);
+  CallResult<Json> run_batch(const RequestContext &context, const Json &body);
+  std::string route_of(const std::string &target);
+  Expected<void> announce(const std::string &as, const std::string &kind, const Json &body);
+  void withdraw(const std::string &as);
   void send_request(std::string id, std::string target, std::string operation, std::string body);
   void complete(const std::string &id, CallResult<Json> result);
   // The writer into `partition`, created when there is none yet.
@@ -199,7 +225,9 @@ Expected<void> Endpoint::Impl::create_entities() {
   };
   auto qos = control_qos();
   auto aqos = announcement_qos();
-  auto own_partition = partition_qos(address);
+  std::vector<std::string> partitions{address};
+  partitions.insert(partitions.end(), options.aliases.begin(), options.aliases.end());
+  auto own_partition = partition_qos(partitions);
   Expected<void> ok =
       make(dds_create_topic(pp, &rsca_ctl_Request_desc, kRequestTopic, qos.get(), nullptr),
            "creating the request topic", request_topic)
@@ -282,7 +310,9 @@ void Endpoint::Impl::take_requests() {
       if (!infos[i].valid_data)
         continue;
       const auto *r = static_cast<const rsca_ctl_Request *>(samples[i]);
-      RequestContext context{str(r->id), str(r->sender), str(r->operation)};
+      RequestContext context{str(r->id), str(r->sender), str(r->operation), str(r->target)};
+      if (context.target.empty())
+        context.target = address;
       Json body = parse_body(r->body);
       handler_pool->post([this, context = std::move(context), body = std::move(body)]() mutable {
         serve(std::move(context), std::move(body));
@@ -292,19 +322,52 @@ void Endpoint::Impl::take_requests() {
   }
 }
 
-void Endpoint::Impl::serve(RequestContext context, Json body) {
+// Runs the handler for the request's address and operation. stop_serving waits for it.
+CallResult<Json> Endpoint::Impl::dispatch(const RequestContext &context, const Json &body) {
   Handler handler;
   {
     std::lock_guard lock(state_mutex);
-    auto it = handlers.find(context.operation);
-    if (it != handlers.end())
-      handler = it->second;
+    auto it = handlers.find({context.target, context.operation});
+    if (it == handlers.end())
+      it = handlers.find({std::string(), context.operation});
+    if (it == handlers.end())
+      return call_error(Status::BadRequest, fmt::format("{} does not serve operation \"{}\"",
+                                                        context.target, context.operation));
+    handler = it->second;
+    ++running[context.target];
   }
+  auto result = handler(body, context);
+  {
+    std::lock_guard lock(state_mutex);
+    if (--running[context.target] == 0)
+      running.erase(context.target);
+  }
+  handler_done.notify_all();
+  return result;
+}
+
+// The calls of one batch, one after another; a result each.
+CallResult<Json> Endpoint::Impl::run_batch(const RequestContext &context, const Json &body) {
+  auto calls = body.find("calls");
+  if (calls == body.end() || !calls->is_array())
+    return call_error(Status::BadRequest, "a batch needs \"calls\", an array");
+  Json results = Json::array();
+  for (const auto &c : *calls) {
+    RequestContext item{context.id, context.sender, c.value("operation", ""),
+                        c.value("target", "")};
+    const Json item_body = c.value("body", Json::object());
+    results.push_back(reply_json(item.operation == kBatch
+                                     ? call_error(Status::BadRequest, "batches do not nest")
+                                     : dispatch(item, item_body)));
+  }
+  return Json{{"results", std::move(results)}};
+}
+
+void Endpoint::Impl::serve(RequestContext context, Json body) {
   CallResult<Json> result =
       body.is_discarded() ? call_error(Status::BadRequest, "the request body is not valid JSON")
-      : handler           ? handler(body, context)
-                : call_error(Status::BadRequest, fmt::format("{} does not serve operation \"{}\"",
-                                                             address, context.operation));
+      : context.operation == kBatch ? run_batch(context, body)
+                                    : dispatch(context, body);
   const std::string reply_body = result ? result->dump() : std::string();
   const std::string error = result ? std::string() : result.error().message;
   rsca_ctl_Reply reply{};
@@ -426,7 +489,7 @@ CallResult<dds_entity_t> Endpoint::Impl::writer_for(std::map<std::string, Partit
   std::lock_guard lock(writers_mutex);
   if (auto it = cache.find(partition); it != cache.end())
     return it->second.writer.get();
-  auto pqos = partition_qos(partition);
+  auto pqos = partition_qos({partition});
   auto publisher = dds::checked(dds_create_publisher(participant->get(), pqos.get(), nullptr),
                                 "creating a publisher");
   if (!publisher)
@@ -475,7 +538,7 @@ void Endpoint::Impl::send_request(std::string id, std::string target, std::strin
       return; // expired before it could be sent
     deadline = it->second.deadline;
   }
-  auto writer = writer_to(request_writers, request_topic.get(), target, deadline);
+  auto writer = writer_to(request_writers, request_topic.get(), route_of(target), deadline);
   if (!writer) {
     complete(id, tl::unexpected(writer.error()));
     return;
@@ -483,6 +546,7 @@ void Endpoint::Impl::send_request(std::string id, std::string target, std::strin
   rsca_ctl_Request request{};
   request.id = id.data();
   request.sender = address.data();
+  request.target = target.data();
   request.operation = operation.data();
   request.body = body.data();
   if (dds_return_t rc = dds_write(*writer, &request); rc < 0) {
@@ -495,11 +559,57 @@ void Endpoint::Impl::send_request(std::string id, std::string target, std::strin
     it->second.sent = true;
 }
 
+std::string Endpoint::Impl::route_of(const std::string &target) {
+  std::lock_guard lock(writers_mutex);
+  auto it = routes.find(target);
+  return it != routes.end() ? it->second : target;
+}
+
+Expected<void> Endpoint::Impl::announce(const std::string &as, const std::string &kind,
+                                        const Json &body) {
+  std::lock_guard lock(writers_mutex);
+  if (!announcement_writer) {
+    auto qos = announcement_qos();
+    auto w = dds::checked(
+        dds_create_writer(participant->get(), announcement_topic.get(), qos.get(), nullptr),
+        "creating the announcement writer");
+    if (!w)
+      return tl::unexpected(w.error());
+    announcement_writer = std::move(*w);
+  }
+  const std::string text = body.dump();
+  rsca_ctl_Announcement a{};
+  a.address = const_cast<char *>(as.c_str());
+  a.kind = const_cast<char *>(kind.c_str());
+  a.body = const_cast<char *>(text.c_str());
+  if (dds_return_t rc = dds_write(announcement_writer.get(), &a); rc < 0)
+    return tl::unexpected(dds::dds_error(rc, "announcing"));
+  return {};
+}
+
+void Endpoint::Impl::withdraw(const std::string &as) {
+  std::lock_guard lock(writers_mutex);
+  if (!announcement_writer)
+    return;
+  rsca_ctl_Announcement a{};
+  a.address = const_cast<char *>(as.c_str());
+  a.kind = const_cast<char *>("");
+  a.body = const_cast<char *>("");
+  dds_dispose(announcement_writer.get(), &a);
+}
+
 Endpoint::Endpoint(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 
 Expected<std::unique_ptr<Endpoint>> Endpoint::open(std::shared_ptr<dds::Participant> participant,
                                                    std::string address, EndpointOptions options) {
-  if (address.empty() || address.find_first_of("*?[]\\") != std::string::npos)
+  auto invalid = [](const std::string &a) {
+    return a.empty() || a.find_first_of("*?[]\\") != std::string::npos;
+  };
+  for (const auto &a : options.aliases)
+    if (invalid(a))
+      return make_error({"control", 0, 0}, "address",
+                        fmt::format("\"{}\" is not a valid endpoint address", a));
+  if (invalid(address))
     return make_error({"control", 0, 0}, "address",
                       fmt::format("\"{}\" is not a valid endpoint address", address));
   auto impl = std::make_unique<Impl>();
@@ -536,7 +646,63 @@ const std::string &Endpoint::address() const {
 
 void Endpoint::on(const std::string &operation, Handler handler) {
   std::lock_guard lock(impl_->state_mutex);
-  impl_->handlers[operation] = std::move(handler);
+  impl_->handlers[{std::string(), operation}] = std::move(handler);
+}
+
+void Endpoint::on(const std::string &address, const std::string &operation, Handler handler) {
+  std::lock_guard lock(impl_->state_mutex);
+  impl_->handlers[{address, operation}] = std::move(handler);
+}
+
+void Endpoint::stop_serving(const std::string &address) {
+  std::unique_lock lock(impl_->state_mutex);
+  std::erase_if(impl_->handlers, [&](const auto &entry) { return entry.first.first == address; });
+  impl_->handler_done.wait(lock, [&] { return !impl_->running.contains(address); });
+}
+
+std::vector<CallResult<Json>> Endpoint::call_all(const std::vector<Call> &calls,
+                                                 std::chrono::milliseconds timeout) {
+  std::map<std::string, std::vector<std::size_t>> routed; // by the endpoint that serves them
+  for (std::size_t i = 0; i < calls.size(); ++i)
+    if (auto via = impl_->route_of(calls[i].target); via != calls[i].target)
+      routed[via].push_back(i);
+  std::vector<std::future<CallResult<Json>>> single(calls.size());
+  std::vector<std::pair<std::vector<std::size_t>, std::future<CallResult<Json>>>> batches;
+  for (auto &[via, indexes] : routed) {
+    if (indexes.size() < 2)
+      continue;
+    Json items = Json::array();
+    for (auto i : indexes)
+      items.push_back({{"target", calls[i].target},
+                       {"operation", calls[i].operation},
+                       {"body", calls[i].body}});
+    batches.emplace_back(indexes, call(via, kBatch, Json{{"calls", std::move(items)}}, timeout));
+  }
+  for (std::size_t i = 0; i < calls.size(); ++i) {
+    auto it = routed.find(impl_->route_of(calls[i].target));
+    if (it == routed.end() || it->second.size() < 2)
+      single[i] = call(calls[i].target, calls[i].operation, calls[i].body, timeout);
+  }
+  std::vector<CallResult<Json>> results(calls.size(), call_error(Status::Failed, "not made"));
+  for (auto &[indexes, future] : batches) {
+    auto reply = future.get();
+    const Json none = Json::array();
+    const Json &items = reply ? reply->value("results", none) : none;
+    for (std::size_t k = 0; k < indexes.size(); ++k)
+      results[indexes[k]] = !reply ? CallResult<Json>(tl::unexpected(reply.error()))
+                            : k < items.size()
+                                ? result_of(items[k])
+                                : call_error(Status::Failed, "the batch reply is short");
+  }
+  for (std::size_t i = 0; i < calls.size(); ++i)
+    if (single[i].valid())
+      results[i] = single[i].get();
+  return results;
+}
+
+void Endpoint::route(const std::string &target, const std::string &via) {
+  std::lock_guard lock(impl_->writers_mutex);
+  impl_->routes[target] = via;
 }
 
 std::future<CallResult<Json>> Endpoint::call(const std::string &target,
@@ -559,7 +725,8 @@ std::future<CallResult<Json>> Endpoint::call(const std::string &target,
 }
 
 void Endpoint::prepare(const std::string &target) {
-  if (auto writer = impl_->writer_for(impl_->request_writers, impl_->request_topic.get(), target);
+  if (auto writer = impl_->writer_for(impl_->request_writers, impl_->request_topic.get(),
+                                      impl_->route_of(target));
       !writer)
     spdlog::debug("preparing the way to {}: {}", target, writer.error().message);
 }
@@ -577,36 +744,24 @@ void Endpoint::forget(const std::string &target) {
   std::lock_guard lock(impl_->writers_mutex);
   impl_->request_writers.erase(target);
   impl_->reply_writers.erase(target);
+  impl_->routes.erase(target);
 }
 
 Expected<void> Endpoint::announce(const std::string &kind, const Json &body) {
-  if (!impl_->announcement_writer) {
-    auto qos = announcement_qos();
-    auto w = dds::checked(dds_create_writer(impl_->participant->get(),
-                                            impl_->announcement_topic.get(), qos.get(), nullptr),
-                          "creating the announcement writer");
-    if (!w)
-      return tl::unexpected(w.error());
-    impl_->announcement_writer = std::move(*w);
-  }
-  const std::string text = body.dump();
-  rsca_ctl_Announcement a{};
-  a.address = impl_->address.data();
-  a.kind = const_cast<char *>(kind.c_str());
-  a.body = const_cast<char *>(text.c_str());
-  if (dds_return_t rc = dds_write(impl_->announcement_writer.get(), &a); rc < 0)
-    return tl::unexpected(dds::dds_error(rc, "announcing"));
-  return {};
+  return impl_->announce(impl_->address, kind, body);
 }
 
 void Endpoint::withdraw() {
-  if (!impl_->announcement_writer)
-    return;
-  rsca_ctl_Announcement a{};
-  a.address = impl_->address.data();
-  a.kind = const_cast<char *>("");
-  a.body = const_cast<char *>("");
-  dds_dispose(impl_->announcement_writer.get(), &a);
+  impl_->withdraw(impl_->address);
+}
+
+Expected<void> Endpoint::announce(const std::string &alias, const std::string &kind,
+                                  const Json &body) {
+  return impl_->announce(alias, kind, body);
+}
+
+void Endpoint::withdraw(const std::string &alias) {
+  impl_->withdraw(alias);
 }
 
 } // namespace rsca::control

@@ -3,6 +3,12 @@
 // of that name, so only the addressed process receives them; replies go back into the sender's
 // partition. Every call has a deadline. Handlers run on worker threads, never on the thread that
 // takes samples, so a handler may itself call other endpoints and wait.
+//
+// One endpoint may serve more addresses than its own (aliases): a component host serves each of
+// its components at the component's address. A caller that knows which endpoint serves an
+// address (route) writes to that endpoint's partition, and call_all sends all calls for the
+// addresses of one endpoint as one request: a host of a hundred components costs one DDS reader,
+// one writer per caller and one round trip per step of a launch, not a hundred.
 #pragma once
 
 #include <chrono>
@@ -10,6 +16,7 @@
 #include <future>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 #include <tl/expected.hpp>
@@ -49,6 +56,7 @@ struct RequestContext {
   std::string id;
   std::string sender;
   std::string operation;
+  std::string target; // the address called: the endpoint's own or one of its aliases
 };
 
 using Handler = std::function<CallResult<Json>(const Json &body, const RequestContext &context)>;
@@ -69,6 +77,15 @@ struct EndpointOptions {
   // Follows every endpoint's announcements when set: called for each change on the receiving
   // thread, so it must not block. Given at open so that no announcement arrives before it.
   AnnouncementHandler on_announcement;
+  // More addresses this endpoint serves, fixed at open (a DDS partition each).
+  std::vector<std::string> aliases;
+};
+
+// One call of many made at once (Endpoint::call_all).
+struct Call {
+  std::string target;
+  std::string operation;
+  Json body;
 };
 
 class Endpoint {
@@ -85,8 +102,14 @@ public:
 
   const std::string &address() const;
 
-  // Serves `operation`; a later registration replaces an earlier one.
+  // Serves `operation` at every address of the endpoint; a later registration replaces an
+  // earlier one.
   void on(const std::string &operation, Handler handler);
+  // Serves `operation` at `address` (its own or an alias) only, before any handler of
+  // on(operation).
+  void on(const std::string &address, const std::string &operation, Handler handler);
+  // Drops the handlers of `address` and returns once none of them is running any more.
+  void stop_serving(const std::string &address);
 
   std::future<CallResult<Json>> call(const std::string &target, const std::string &operation,
                                      Json body, std::chrono::milliseconds timeout);
@@ -94,6 +117,14 @@ public:
                              std::chrono::milliseconds timeout) {
     return call(target, operation, std::move(body), timeout).get();
   }
+  // Makes every call at once and waits for all; each result in the order of the calls. Calls to
+  // addresses routed through the same endpoint travel as one request ("endpoint.batch"), whose
+  // handlers run one after another.
+  std::vector<CallResult<Json>> call_all(const std::vector<Call> &calls,
+                                         std::chrono::milliseconds timeout);
+
+  // Calls to `target` go to `via`, the endpoint that serves it as an alias.
+  void route(const std::string &target, const std::string &via);
 
   // Creates the way to `target` ahead of the first call, so that DDS discovery of an endpoint
   // that is about to appear overlaps with whatever happens before that call.
@@ -101,12 +132,15 @@ public:
   // Fails every call to `target` under way, saying `why`: its caller knows the addressee is dead
   // (its node saw it exit) sooner than DDS would (the addressee's lease).
   void abandon(const std::string &target, const std::string &why);
-  // Drops the way to and from `target` (an endpoint that is gone for good).
+  // Drops the way to and from `target` (an endpoint that is gone for good), and its route.
   void forget(const std::string &target);
 
   // Publishes (or updates) this endpoint's announcement; `withdraw` removes it.
   Expected<void> announce(const std::string &kind, const Json &body);
   void withdraw();
+  // The same for one of its aliases.
+  Expected<void> announce(const std::string &alias, const std::string &kind, const Json &body);
+  void withdraw(const std::string &alias);
 
   struct Impl;
 

@@ -23,6 +23,7 @@ struct ComponentInstance {
   std::string device;
   std::string implementation;
   std::string address; // its control endpoint
+  std::string host;    // the address of the component host that serves it, if it is hosted
   std::string spd;     // the SPD it runs from
   long pid = 0;
   std::string state; // "executed", "registered", "running", "stopped", "exited"

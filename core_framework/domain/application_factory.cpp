@@ -33,18 +33,15 @@ struct Call {
 };
 
 // Makes every call at once and waits for all of them; each result in the order of the calls.
+// The components of one host get theirs in one request (control::Endpoint::call_all).
 std::vector<CallResult<Json>> call_each_of(control::Endpoint &endpoint,
                                            const std::vector<Call> &calls,
                                            std::chrono::milliseconds timeout) {
-  std::vector<std::future<CallResult<Json>>> futures;
-  futures.reserve(calls.size());
+  std::vector<control::Call> made;
+  made.reserve(calls.size());
   for (const auto &c : calls)
-    futures.push_back(endpoint.call(c.target, c.operation, c.body, timeout));
-  std::vector<CallResult<Json>> results;
-  results.reserve(futures.size());
-  for (auto &f : futures)
-    results.push_back(f.get());
-  return results;
+    made.push_back({c.target, c.operation, c.body});
+  return endpoint.call_all(made, timeout);
 }
 
 // The first failure among `results`, prefixed with its call's `what`.
@@ -231,6 +228,8 @@ private:
     // Discovery of each component's endpoint starts now and overlaps with its process start.
     for (auto &c : app_->components) {
       s_.components->expect(c.address, c.node);
+      if (!c.host.empty())
+        s_.endpoint->route(c.address, c.host);
       s_.endpoint->prepare(c.address);
     }
     std::vector<Call> calls;
@@ -248,7 +247,7 @@ private:
       }
       auto [host, fresh] = host_calls.try_emplace(c.device, calls.size());
       if (fresh) {
-        calls.push_back({*node, "node.execute", host_body(c, host_calls.size()),
+        calls.push_back({*node, "node.execute", host_body(c),
                          fmt::format("the component host on {}", c.device)});
         started_by.emplace_back();
       }
@@ -346,13 +345,20 @@ private:
       app_->connections.push_back(std::move(ci));
     }
     // Readers first, so the first samples written find them.
+    auto began = Clock::now();
     if (auto ok = call_all(*s_.endpoint, provides_side, s_.call_timeout); !ok)
       return ok;
+    const double readers_ms = ms_since(began);
+    began = Clock::now();
     if (auto ok = call_all(*s_.endpoint, uses_side, s_.call_timeout); !ok)
       return ok;
+    const double writers_ms = ms_since(began);
+    began = Clock::now();
     if (auto ok = await_matched(); !ok)
       return ok;
-    detail_ = fmt::format("{} connections", app_->connections.size());
+    detail_ =
+        fmt::format("{} connections (readers {:.0f} ms, writers {:.0f} ms, matched {:.0f} ms)",
+                    app_->connections.size(), readers_ms, writers_ms, ms_since(began));
     return {};
   }
 
@@ -521,9 +527,7 @@ private:
     return args;
   }
 
-  bool is_hosted(const ComponentInstance &c) const {
-    return placement_of(c.id)->implementation->code.type == profile::CodeType::SharedLibrary;
-  }
+  static bool is_hosted(const ComponentInstance &c) { return !c.host.empty(); }
 
   Json execute_body(const ComponentInstance &c) const {
     const auto *impl = placement_of(c.id)->implementation;
@@ -537,14 +541,15 @@ private:
                 {"args", component_args(c)}};
   }
 
-  // A component host's process; the components it hosts add their exec parameters.
-  Json host_body(const ComponentInstance &first, std::size_t index) const {
+  // A component host's process at its own address; the components it hosts add their exec
+  // parameters.
+  Json host_body(const ComponentInstance &first) const {
     return Json{{"application", app_->name},
-                {"component", fmt::format("ComponentHost_{}", index)},
+                {"component", fmt::format("ComponentHost_{}", first.device)},
                 {"device", first.device},
                 {"entrypoint", "rsca-component-host"},
                 {"spd_dir", ""},
-                {"args", Json::array()}};
+                {"args", Json::array({"CONTROL_ADDRESS", first.host})}};
   }
 
   // A hosted component's exec parameters: its own and the library the host loads, as the SPD
@@ -604,6 +609,8 @@ private:
       c.implementation = p.implementation->id;
       c.address =
           fmt::format("{}/component/{}.{}/{}", s_.domain_name, app_->name, launch_, p.instance);
+      if (p.implementation->code.type == profile::CodeType::SharedLibrary)
+        c.host = fmt::format("{}/host/{}.{}/{}", s_.domain_name, app_->name, launch_, p.device);
       c.spd = request_.profile->softpkg_of(*placement)->spd_path.string();
       c.start_order = ci->start_order.value_or(UINT32_MAX);
       c.assembly_controller = sad.assembly_controller == ci->id;
@@ -681,7 +688,8 @@ CallResult<std::shared_ptr<Application>> ApplicationFactory::create(const Launch
 }
 
 CallResult<void> ApplicationFactory::start(Application &app) {
-  // In start order (the assembly controller first among equals); each group of one order at once.
+  // In start order (the assembly controller first among equals, on its own); the components of
+  // one start order at once.
   std::vector<ComponentInstance *> order;
   for (auto &c : app.components)
     order.push_back(&c);
@@ -690,13 +698,18 @@ CallResult<void> ApplicationFactory::start(Application &app) {
       return a->start_order < b->start_order;
     return a->assembly_controller && !b->assembly_controller;
   });
-  for (auto *c : order) {
-    auto ok = services_.endpoint->call_sync(c->address, "component.start", Json::object(),
-                                            services_.call_timeout);
-    if (!ok)
-      return control::call_error(ok.error().status,
-                                 fmt::format("{}: {}", c->id, ok.error().message));
-    c->state = "running";
+  for (auto group = order.begin(); group != order.end();) {
+    auto end = std::next(group);
+    if (!(*group)->assembly_controller)
+      end = std::find_if(end, order.end(),
+                         [&](const auto *c) { return c->start_order != (*group)->start_order; });
+    std::vector<Call> calls;
+    for (auto it = group; it != end; ++it)
+      calls.push_back({(*it)->address, "component.start", Json::object(), (*it)->id});
+    if (auto ok = call_all(*services_.endpoint, calls, services_.call_timeout); !ok)
+      return ok;
+    for (; group != end; ++group)
+      (*group)->state = "running";
   }
   app.state = ApplicationState::Running;
   return {};
@@ -758,6 +771,8 @@ CallResult<std::vector<std::string>> ApplicationFactory::release(Application &ap
   for (auto &c : app.components) {
     services_.components->forget(c.address);
     services_.endpoint->forget(c.address);
+    if (!c.host.empty())
+      services_.endpoint->forget(c.host);
     c.state = "released";
     c.pid = 0;
   }

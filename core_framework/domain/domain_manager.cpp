@@ -1016,7 +1016,9 @@ DomainManager::create(std::shared_ptr<dds::Participant> participant, DomainOptio
   auto endpoint = control::Endpoint::open(
       participant, address_of(impl->options.name),
       {.workers = 16,
-       .on_announcement = [raw](const control::AnnouncementEvent &e) { raw->on_announcement(e); }});
+       .senders = 4,
+       .on_announcement = [raw](const control::AnnouncementEvent &e) { raw->on_announcement(e); },
+       .aliases = {}});
   if (!endpoint)
     return tl::unexpected(endpoint.error());
   impl->endpoint = std::move(*endpoint);

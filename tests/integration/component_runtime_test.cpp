@@ -84,7 +84,9 @@ public:
     auto endpoint = control::Endpoint::open(
         participant_, "rsca/cli/test-" + std::to_string(::getpid()),
         {.workers = 2,
-         .on_announcement = [events = announcements_](const auto &e) { events->on_event(e); }});
+         .senders = 4,
+         .on_announcement = [events = announcements_](const auto &e) { events->on_event(e); },
+         .aliases = {}});
     REQUIRE(endpoint.has_value());
     endpoint_ = std::move(*endpoint);
   }

@@ -247,10 +247,12 @@ TEST_CASE("exec parameters come in pairs and name the component", "[component]")
   CHECK(parse_exec_params(5, argv).error() == "the exec parameter CONTROL_ADDRESS is missing");
 }
 
-TEST_CASE("a component host's exec parameters are one group per component, each with its "
-          "library",
+TEST_CASE("a component host's exec parameters are its address, then one group per component, "
+          "each with its library",
           "[component]") {
   const char *argv[] = {"rsca-component-host",
+                        "CONTROL_ADDRESS",
+                        "host",
                         "COMPONENT_IDENTIFIER",
                         "A_1",
                         "PROFILE_NAME",
@@ -269,24 +271,29 @@ TEST_CASE("a component host's exec parameters are one group per component, each 
                         "b",
                         "LIBRARY",
                         "/lib/libb.so"};
-  auto hosted = parse_host_params(19, argv);
-  REQUIRE(hosted.has_value());
-  REQUIRE(hosted->size() == 2);
-  CHECK((*hosted)[0].params.identifier == "A_1");
-  CHECK((*hosted)[0].library == "liba.so");
+  auto host = parse_host_params(21, argv);
+  REQUIRE(host.has_value());
+  CHECK(host->control_address == "host");
+  const auto &hosted = host->components;
+  REQUIRE(hosted.size() == 2);
+  CHECK(hosted[0].params.identifier == "A_1");
+  CHECK(hosted[0].params.control_address == "a");
+  CHECK(hosted[0].library == "liba.so");
   // LIBRARY is the host's; the rest goes to the component.
-  CHECK((*hosted)[0].params.others ==
+  CHECK(hosted[0].params.others ==
         std::vector<std::pair<std::string, std::string>>{{"rate_hz", "20"}});
-  CHECK((*hosted)[1].params.control_address == "b");
-  CHECK((*hosted)[1].library == "/lib/libb.so");
-  CHECK((*hosted)[1].params.others.empty());
+  CHECK(hosted[1].params.control_address == "b");
+  CHECK(hosted[1].library == "/lib/libb.so");
+  CHECK(hosted[1].params.others.empty());
   // Bad input: a clear error naming what is wrong.
-  CHECK(parse_host_params(17, argv).error() == "B_1: the exec parameter LIBRARY is missing");
-  CHECK(parse_host_params(12, argv).error() ==
+  CHECK(parse_host_params(19, argv).error() == "B_1: the exec parameter LIBRARY is missing");
+  CHECK(parse_host_params(14, argv).error() ==
         "component 2: exec parameters come in pairs: \"COMPONENT_IDENTIFIER\" has no value");
-  const char *no_start[] = {"rsca-component-host", "PROFILE_NAME", "/sdr/A.spd.xml"};
-  CHECK(parse_host_params(3, no_start).error() ==
-        "the exec parameters start with COMPONENT_IDENTIFIER");
+  CHECK(parse_host_params(3, argv).error() ==
+        "the host's address is followed by components, each starting with COMPONENT_IDENTIFIER");
+  const char *no_address[] = {"rsca-component-host", "COMPONENT_IDENTIFIER", "A_1"};
+  CHECK(parse_host_params(3, no_address).error() ==
+        "the exec parameters start with CONTROL_ADDRESS <the host's address>");
 }
 
 TEST_CASE("the schedule admission decided arrives as exec parameters", "[component]") {

@@ -3,7 +3,9 @@
 #include <condition_variable>
 #include <future>
 #include <mutex>
+#include <string>
 #include <unistd.h>
+#include <vector>
 
 #include <catch2/catch.hpp>
 
@@ -150,11 +152,15 @@ TEST_CASE("announcements are seen, updated and withdrawn", "[control]") {
   std::condition_variable cv;
   std::vector<control::AnnouncementEvent> events;
   auto watcher = open(pp, "test/watcher",
-                      {.workers = 1, .on_announcement = [&](const control::AnnouncementEvent &e) {
-                         std::lock_guard lock(m);
-                         events.push_back(e);
-                         cv.notify_all();
-                       }});
+                      {.workers = 1,
+                       .senders = 4,
+                       .on_announcement =
+                           [&](const control::AnnouncementEvent &e) {
+                             std::lock_guard lock(m);
+                             events.push_back(e);
+                             cv.notify_all();
+                           },
+                       .aliases = {}});
   auto wait_for = [&](auto predicate) {
     std::unique_lock lock(m);
     return cv.wait_for(lock, 5s, [&] { return predicate(events); });
@@ -194,4 +200,84 @@ TEST_CASE("the way to an endpoint can be prepared before it exists and forgotten
   reply = client->call_sync("test/later", "ping", Json::object(), 5s);
   REQUIRE(reply.has_value());
   CHECK(reply->at("pong") == true);
+}
+
+TEST_CASE(
+    "an endpoint serves its aliases, and call_all sends the calls routed to it as one request",
+    "[control]") {
+  auto pp = test::participant();
+  control::EndpointOptions options;
+  options.aliases = {"test/host/a", "test/host/b"};
+  auto host = open(pp, "test/host", options);
+  std::mutex m;
+  std::vector<std::string> request_ids;
+  for (const std::string name : {"a", "b"})
+    host->on("test/host/" + name, "who",
+             [&, name](const Json &, const control::RequestContext &ctx) {
+               std::lock_guard lock(m);
+               request_ids.push_back(ctx.id);
+               return control::CallResult<Json>(Json{{"me", name}, {"target", ctx.target}});
+             });
+  auto client = open(pp, "test/client");
+
+  // Straight to an alias's partition, with no route known.
+  auto direct = client->call_sync("test/host/b", "who", Json::object(), 5s);
+  REQUIRE(direct.has_value());
+  CHECK(direct->at("me") == "b");
+  CHECK(direct->at("target") == "test/host/b");
+
+  // Routed: three calls to one host travel as one request; each gets its own result.
+  client->route("test/host/a", "test/host");
+  client->route("test/host/b", "test/host");
+  client->route("test/host/c", "test/host");
+  request_ids.clear();
+  auto results = client->call_all({{"test/host/a", "who", Json::object()},
+                                   {"test/host/b", "who", Json::object()},
+                                   {"test/host/a", "nope", Json::object()},
+                                   {"test/host/c", "who", Json::object()}},
+                                  5s);
+  REQUIRE(results.size() == 4);
+  REQUIRE(results[0].has_value());
+  CHECK(results[0]->at("me") == "a");
+  REQUIRE(results[1].has_value());
+  CHECK(results[1]->at("me") == "b");
+  REQUIRE_FALSE(results[2].has_value());
+  CHECK(results[2].error().status == Status::BadRequest);
+  CHECK_THAT(results[2].error().message, Catch::Contains("does not serve operation \"nope\""));
+  REQUIRE_FALSE(results[3].has_value()); // routed to a host that does not serve it
+  CHECK_THAT(results[3].error().message, Catch::Contains("test/host/c does not serve"));
+  REQUIRE(request_ids.size() == 2);
+  CHECK(request_ids[0] == request_ids[1]);
+
+  // A single routed call goes on its own, through the host's partition.
+  auto single = client->call_all({{"test/host/a", "who", Json::object()}}, 5s);
+  REQUIRE(single.size() == 1);
+  REQUIRE(single[0].has_value());
+  CHECK(single[0]->at("target") == "test/host/a");
+}
+
+TEST_CASE("stop_serving waits for the address's running handler, then the address is not served",
+          "[control]") {
+  auto pp = test::participant();
+  control::EndpointOptions options;
+  options.aliases = {"test/host/a"};
+  auto host = open(pp, "test/host", options);
+  Gate gate;
+  std::promise<void> entered;
+  host->on("test/host/a", "hold", [&](const Json &, const control::RequestContext &) {
+    entered.set_value();
+    return gate.wait();
+  });
+  host->on("test/host/a", "who", fast);
+  auto client = open(pp, "test/client");
+  auto held = client->call("test/host/a", "hold", Json::object(), 10s);
+  entered.get_future().wait();
+  auto stopped = std::async(std::launch::async, [&] { host->stop_serving("test/host/a"); });
+  CHECK(stopped.wait_for(100ms) == std::future_status::timeout); // the handler still runs
+  gate.open();
+  stopped.get();
+  CHECK(held.get().has_value());
+  auto after = client->call_sync("test/host/a", "who", Json::object(), 5s);
+  REQUIRE_FALSE(after.has_value());
+  CHECK(after.error().status == Status::BadRequest);
 }

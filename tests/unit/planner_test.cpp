@@ -5,6 +5,8 @@
 #include "allocator/resource_allocator.hpp"
 #include "planner_state.hpp"
 
+#include <set>
+
 #include <catch2/catch.hpp>
 
 #include <chrono>
@@ -13,6 +15,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -831,6 +834,26 @@ TEST_CASE("planner: strategies, affinity and determinism", "[planner]") {
     CHECK(device_of(require_plan(make_plan(state, pair, spread)), "b") == "n2:GPP");
     pair.affinities[0].weight = 10.0;
     CHECK(device_of(require_plan(make_plan(state, pair, spread)), "b") == "n1:GPP");
+  }
+
+  SECTION("spread: a chain lands as runs of neighbours, a fair share per device") {
+    // Six in a chain on three devices: two each, neighbours together (2 connections cross
+    // devices, not 5 as alternating would give).
+    const auto three = domain({gpp("n1:GPP", "n1"), gpp("n2:GPP", "n2"), gpp("n3:GPP", "n3")});
+    auto light = softpkg("light", {ImplSpec("cpp").utilization(0.01)});
+    std::vector<ComponentRequest> chain;
+    for (const char *id : {"c1", "c2", "c3", "c4", "c5", "c6"})
+      chain.push_back(component(id, light));
+    PlanRequest request = request_of(chain);
+    for (std::size_t k = 1; k < chain.size(); ++k)
+      request.affinities.push_back({chain[k - 1].instance, chain[k].instance, 1.0});
+    const Plan plan = require_plan(make_plan(three, request, with(Strategy::Spread)));
+    CHECK(device_of(plan, "c1") == device_of(plan, "c2"));
+    CHECK(device_of(plan, "c3") == device_of(plan, "c4"));
+    CHECK(device_of(plan, "c5") == device_of(plan, "c6"));
+    const std::set<std::string> used{device_of(plan, "c1"), device_of(plan, "c3"),
+                                     device_of(plan, "c5")};
+    CHECK(used.size() == 3);
   }
 
   SECTION("the same input gives the same plan") {

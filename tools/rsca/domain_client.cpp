@@ -23,8 +23,8 @@ Expected<DomainClient> DomainClient::connect(const GlobalOptions &global) {
   static std::atomic<int> counter{0};
   const std::string address =
       fmt::format("{}/cli/{}-{}-{}", global.domain, host, getpid(), ++counter);
-  auto endpoint =
-      control::Endpoint::open(*participant, address, {.workers = 1, .on_announcement = {}});
+  auto endpoint = control::Endpoint::open(
+      *participant, address, {.workers = 1, .senders = 4, .on_announcement = {}, .aliases = {}});
   if (!endpoint)
     return tl::unexpected(endpoint.error());
   DomainClient client;
