@@ -429,11 +429,13 @@ CallResult<Json> Host::op_connect(const Json &body) {
   std::lock_guard lock(lifecycle_);
   if (c().state() == State::Released)
     return control::call_error(Status::Unavailable, "the component is released");
+  const bool local = body.value("local", false); // the other end is in this process
   if (auto ok = port->connect(participant_->get(), loop_.get(), *connection, *topic, qos->get(),
-                              std::move(filter));
+                              std::move(filter), local);
       !ok)
     return control::call_error(Status::Failed, first_message(ok.error()));
-  log().info("port {}: connection {} on topic \"{}\"{}", *port_name, *connection, *topic,
+  log().info("port {}: connection {} on {}topic \"{}\"{}", *port_name, *connection,
+             local ? "in-host " : "", *topic,
              filter_text.empty() ? "" : fmt::format(" with filter \"{}\"", filter_text));
   return Json::object();
 }

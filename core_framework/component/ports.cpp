@@ -1,6 +1,8 @@
 #include "component/ports.hpp"
 
+#include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <mutex>
 
 #include <fmt/format.h>
@@ -8,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "component/local_topics.hpp"
 #include "component/port_wire.hpp"
 #include "component/receive_loop.hpp"
 
@@ -15,8 +18,9 @@ namespace rsca::component {
 
 namespace detail {
 
-// One connection of a port: its topic and its writer or reader. The reader leaves the receive loop
-// first, then members are destroyed in reverse order: the reader or writer, then the topic.
+// One connection of a port: its topic and its writer or reader, or its in-host topic. The reader
+// leaves the receive loop (or its inbox the topic) first, then members are destroyed in reverse
+// order: the reader or writer, then the topic.
 struct DataConnection {
   std::string topic_name;
   dds::Entity topic;
@@ -26,10 +30,24 @@ struct DataConnection {
   std::optional<ContentFilter> filter; // provides only: what is delivered
   std::atomic<std::uint64_t> filtered{0};
 
+  // In-host: the topic, and a reader's inbox and requested deadline, which it checks itself.
+  std::shared_ptr<LocalTopic> local;
+  std::shared_ptr<LocalInbox> inbox;
+  std::chrono::nanoseconds deadline{0};
+  std::optional<std::chrono::steady_clock::time_point> last_arrival; // the receive thread's
+  std::int64_t deadline_periods_counted = 0;                         // the receive thread's
+  std::atomic<std::uint32_t> deadline_missed{0};
+
   ~DataConnection() {
     if (loop != nullptr && entity)
       loop->detach(entity.get());
+    if (local && inbox)
+      local->remove_reader(inbox.get());
+    else if (local)
+      local->remove_writer();
   }
+
+  bool in_host() const { return local != nullptr; }
 };
 
 } // namespace detail
@@ -141,7 +159,40 @@ Expected<std::unique_ptr<DataConnection>> open_reader(dds_entity_t participant,
   return c;
 }
 
-std::int32_t matched_count(dds_entity_t entity, profile::PortDirection direction) {
+// A reader's history depth (0: keep all) and requested deadline (0: none), for in-host delivery.
+std::size_t history_depth(const dds_qos_t *qos) {
+  dds_history_kind_t kind = DDS_HISTORY_KEEP_LAST;
+  std::int32_t depth = 1;
+  if (qos != nullptr)
+    dds_qget_history(qos, &kind, &depth);
+  return kind == DDS_HISTORY_KEEP_ALL ? 0 : static_cast<std::size_t>(std::max(1, depth));
+}
+
+std::chrono::nanoseconds requested_deadline(const dds_qos_t *qos) {
+  dds_duration_t deadline = DDS_INFINITY;
+  if (qos == nullptr || !dds_qget_deadline(qos, &deadline) || deadline == DDS_INFINITY)
+    return std::chrono::nanoseconds{0};
+  return std::chrono::nanoseconds{deadline};
+}
+
+// The deadline periods an in-host reader has gone without a sample since the last call, counted
+// as DDS counts a requested deadline: once a sample has arrived, each period without one.
+std::uint32_t local_deadline_misses(DataConnection &c) {
+  if (c.deadline.count() <= 0 || !c.last_arrival)
+    return 0;
+  const auto periods = (std::chrono::steady_clock::now() - *c.last_arrival) / c.deadline;
+  const auto missed = periods - c.deadline_periods_counted;
+  if (missed <= 0)
+    return 0;
+  c.deadline_periods_counted = periods;
+  c.deadline_missed.fetch_add(static_cast<std::uint32_t>(missed), std::memory_order_relaxed);
+  return static_cast<std::uint32_t>(missed);
+}
+
+std::int32_t matched_count(const DataConnection &c, profile::PortDirection direction) {
+  if (c.in_host())
+    return direction == profile::PortDirection::Uses ? c.local->readers() : c.local->writers();
+  const dds_entity_t entity = c.entity.get();
   if (direction == profile::PortDirection::Uses) {
     dds_publication_matched_status_t status{};
     return dds_get_publication_matched_status(entity, &status) == 0
@@ -155,7 +206,10 @@ std::int32_t matched_count(dds_entity_t entity, profile::PortDirection direction
 }
 
 // How often the writer (uses) or the reader's writers (provides) missed the connection's deadline.
-std::uint32_t deadline_misses(dds_entity_t entity, profile::PortDirection direction) {
+std::uint32_t deadline_misses(const DataConnection &c, profile::PortDirection direction) {
+  if (c.in_host())
+    return c.deadline_missed.load(std::memory_order_relaxed);
+  const dds_entity_t entity = c.entity.get();
   if (direction == profile::PortDirection::Uses) {
     dds_offered_deadline_missed_status_t status{};
     return dds_get_offered_deadline_missed_status(entity, &status) == 0 ? status.total_count : 0;
@@ -180,10 +234,19 @@ std::size_t PortBase::connection_count() const {
 
 Expected<void> PortBase::connect(dds_entity_t participant, detail::ReceiveLoop *loop,
                                  const std::string &connection, const std::string &topic,
-                                 const dds_qos_t *qos, std::optional<ContentFilter> filter) {
+                                 const dds_qos_t *qos, std::optional<ContentFilter> filter,
+                                 bool local) {
   auto c = std::make_unique<DataConnection>();
   c->topic_name = topic;
   c->filter = std::move(filter);
+  if (local) {
+    auto opened = open_local(loop, std::move(c), qos);
+    if (!opened)
+      return tl::unexpected(opened.error());
+    std::unique_lock lock(mutex_);
+    connections_[connection] = std::move(*opened);
+    return {};
+  }
   auto created = dds::checked(
       dds_create_topic(participant, port::wire::descriptor(type_), topic.c_str(), nullptr, nullptr),
       fmt::format("creating topic \"{}\"", topic));
@@ -198,6 +261,25 @@ Expected<void> PortBase::connect(dds_entity_t participant, detail::ReceiveLoop *
   std::unique_lock lock(mutex_);
   connections_[connection] = std::move(*opened); // an earlier one of that id goes
   return {};
+}
+
+Expected<std::unique_ptr<DataConnection>> PortBase::open_local(detail::ReceiveLoop *loop,
+                                                               std::unique_ptr<DataConnection> c,
+                                                               const dds_qos_t *qos) const {
+  auto topic = detail::LocalTopics::instance().join(c->topic_name, type_);
+  if (!topic)
+    return make_error({"port", 0, 0}, "port", topic.error());
+  c->local = std::move(*topic);
+  if (direction_ == profile::PortDirection::Uses) {
+    c->local->add_writer();
+    return c;
+  }
+  if (loop == nullptr)
+    return make_error({"port", 0, 0}, "port", "no receive loop for a provides port");
+  c->inbox = std::make_shared<detail::LocalInbox>(*loop, history_depth(qos));
+  c->deadline = requested_deadline(qos);
+  c->local->add_reader(c->inbox);
+  return c;
 }
 
 bool PortBase::disconnect(const std::string &connection) {
@@ -215,8 +297,8 @@ std::vector<ConnectionStatus> PortBase::status() const {
   std::vector<ConnectionStatus> out;
   out.reserve(connections_.size());
   for (const auto &[id, c] : connections_)
-    out.push_back({id, c->topic_name, matched_count(c->entity.get(), direction_), c->samples.load(),
-                   c->filtered.load(), deadline_misses(c->entity.get(), direction_)});
+    out.push_back({id, c->topic_name, matched_count(*c, direction_), c->samples.load(),
+                   c->filtered.load(), deadline_misses(*c, direction_)});
   return out;
 }
 
@@ -225,7 +307,7 @@ std::optional<std::int32_t> PortBase::matched(const std::string &connection) con
   auto it = connections_.find(connection);
   if (it == connections_.end())
     return std::nullopt;
-  return matched_count(it->second->entity.get(), direction_);
+  return matched_count(*it->second, direction_);
 }
 
 std::vector<ConnectionProblem> PortBase::take_problems() {
@@ -236,6 +318,11 @@ std::vector<ConnectionProblem> PortBase::take_problems() {
   constexpr std::uint32_t kProblems =
       DDS_REQUESTED_DEADLINE_MISSED_STATUS | DDS_LIVELINESS_CHANGED_STATUS;
   for (const auto &[id, c] : connections_) {
+    if (c->in_host()) {
+      if (auto missed = local_deadline_misses(*c); missed > 0)
+        out.push_back({id, "deadline missed", missed});
+      continue;
+    }
     std::uint32_t changed = 0;
     if (dds_get_status_changes(c->entity.get(), &changed) != 0 || (changed & kProblems) == 0)
       continue;
@@ -259,11 +346,21 @@ void PortBase::quiesce() {
   std::unique_lock lock(mutex_);
 }
 
-WriteResult PortBase::write_wire(const void *sample) {
+WriteResult PortBase::write_wire(const void *sample,
+                                 const std::function<std::shared_ptr<const void>()> &copy) {
   std::shared_lock lock(mutex_);
   std::size_t written = 0;
   std::string error;
+  std::shared_ptr<const void> shared; // one copy for every in-host reader
   for (const auto &[id, c] : connections_) {
+    if (c->in_host()) {
+      if (!shared)
+        shared = copy();
+      c->local->publish(shared);
+      c->samples.fetch_add(1, std::memory_order_relaxed);
+      ++written;
+      continue;
+    }
     const dds_return_t rc = dds_write(c->entity.get(), sample);
     if (rc < 0) {
       if (error.empty())
@@ -282,44 +379,70 @@ WriteResult PortBase::write_wire(const void *sample) {
 template <typename T>
 WriteResult UsesPort<T>::write(const T &value) {
   const auto sample = port::wire::to_wire(value);
-  return write_wire(&sample);
+  return write_wire(&sample, [&value] { return std::make_shared<const T>(value); });
 }
 
 template <typename T>
 void ProvidesPort<T>::take_all(bool deliver) {
-  using Wire = typename port::wire::Traits<T>::C;
   std::shared_lock lock(mutex_);
   for (const auto &[id, c] : connections_) {
-    for (;;) {
-      void *samples[kTakeBatch] = {nullptr};
-      dds_sample_info_t infos[kTakeBatch];
-      const dds_return_t n = dds_take(c->entity.get(), samples, infos, kTakeBatch, kTakeBatch);
-      if (n <= 0)
-        break;
-      for (dds_return_t i = 0; i < n; ++i) {
-        if (!infos[i].valid_data)
-          continue;
-        c->samples.fetch_add(1, std::memory_order_relaxed);
-        if (!deliver || !callback_)
-          continue;
-        port::wire::from_wire(*static_cast<const Wire *>(samples[i]), scratch_);
-        if (c->filter &&
-            !c->filter->matches([this](std::string_view f) { return field_of(scratch_, f); })) {
-          c->filtered.fetch_add(1, std::memory_order_relaxed);
-          continue;
-        }
-        try {
-          callback_(scratch_);
-        } catch (const std::exception &e) {
-          spdlog::error("port {}: the sample callback failed: {}", name(), e.what());
-        }
-      }
-      dds_return_loan(c->entity.get(), samples, n);
-      // A short batch took all there was: another take would only contend with Cyclone's
-      // receive thread for the reader's lock. What arrives later triggers the loop again.
-      if (static_cast<std::uint32_t>(n) < kTakeBatch)
-        break;
+    if (c->in_host())
+      take_local(*c, deliver);
+    else
+      take_dds(*c, deliver);
+  }
+}
+
+template <typename T>
+void ProvidesPort<T>::take_dds(DataConnection &c, bool deliver) {
+  using Wire = typename port::wire::Traits<T>::C;
+  for (;;) {
+    void *samples[kTakeBatch] = {nullptr};
+    dds_sample_info_t infos[kTakeBatch];
+    const dds_return_t n = dds_take(c.entity.get(), samples, infos, kTakeBatch, kTakeBatch);
+    if (n <= 0)
+      return;
+    for (dds_return_t i = 0; i < n; ++i) {
+      if (!infos[i].valid_data)
+        continue;
+      c.samples.fetch_add(1, std::memory_order_relaxed);
+      if (!deliver || !callback_)
+        continue;
+      port::wire::from_wire(*static_cast<const Wire *>(samples[i]), scratch_);
+      this->deliver(c, scratch_);
     }
+    dds_return_loan(c.entity.get(), samples, n);
+    // A short batch took all there was: another take would only contend with Cyclone's
+    // receive thread for the reader's lock. What arrives later triggers the loop again.
+    if (static_cast<std::uint32_t>(n) < kTakeBatch)
+      return;
+  }
+}
+
+template <typename T>
+void ProvidesPort<T>::take_local(DataConnection &c, bool deliver) {
+  auto arrived = c.inbox->take();
+  if (arrived.empty())
+    return;
+  c.last_arrival = std::chrono::steady_clock::now();
+  c.deadline_periods_counted = 0;
+  c.samples.fetch_add(arrived.size(), std::memory_order_relaxed);
+  if (!deliver || !callback_)
+    return;
+  for (const auto &sample : arrived)
+    this->deliver(c, *static_cast<const T *>(sample.get()));
+}
+
+template <typename T>
+void ProvidesPort<T>::deliver(DataConnection &c, const T &value) {
+  if (c.filter && !c.filter->matches([&value](std::string_view f) { return field_of(value, f); })) {
+    c.filtered.fetch_add(1, std::memory_order_relaxed);
+    return;
+  }
+  try {
+    callback_(value);
+  } catch (const std::exception &e) {
+    spdlog::error("port {}: the sample callback failed: {}", name(), e.what());
   }
 }
 

@@ -1,6 +1,8 @@
 // Data ports of a component. A uses port writes, a provides port receives; each has zero or more
 // connections, made and removed by the domain (component.connect/disconnect). A connection is a
-// DDS writer (uses) or reader (provides) on the topic the domain names, with the QoS it gives.
+// DDS writer (uses) or reader (provides) on the topic the domain names, with the QoS it gives;
+// between two components of one component host it is an in-host connection instead, which
+// bypasses DDS (component/local_topics.hpp) with the same API and QoS semantics.
 // Writing to an unconnected uses port does nothing; with several connections a write goes to
 // each. A provides port's callback runs on the component's receive thread.
 #pragma once
@@ -62,10 +64,12 @@ public:
   std::size_t connection_count() const;
 
   // For the runtime. `connect` replaces a connection of the same id. A provides port's reader
-  // is attached to `loop`, which must outlive the connection.
+  // is attached to `loop`, which must outlive the connection. `local`: the other end is in this
+  // process, and the connection bypasses DDS.
   Expected<void> connect(dds_entity_t participant, detail::ReceiveLoop *loop,
                          const std::string &connection, const std::string &topic,
-                         const dds_qos_t *qos, std::optional<ContentFilter> filter = std::nullopt);
+                         const dds_qos_t *qos, std::optional<ContentFilter> filter = std::nullopt,
+                         bool local = false);
   bool disconnect(const std::string &connection);
   void disconnect_all();
   std::vector<ConnectionStatus> status() const;
@@ -81,12 +85,19 @@ public:
   void quiesce();
 
 protected:
-  WriteResult write_wire(const void *sample);
+  // Writes `sample` (the wire form) to every DDS connection, and what `copy` makes (once, when
+  // the port has an in-host connection) to every in-host one.
+  WriteResult write_wire(const void *sample,
+                         const std::function<std::shared_ptr<const void>()> &copy);
 
   mutable std::shared_mutex mutex_; // shared: writing, taking; exclusive: (dis)connecting
   std::map<std::string, std::unique_ptr<detail::DataConnection>> connections_;
 
 private:
+  Expected<std::unique_ptr<detail::DataConnection>>
+  open_local(detail::ReceiveLoop *loop, std::unique_ptr<detail::DataConnection> c,
+             const dds_qos_t *qos) const;
+
   std::string name_;
   profile::PortDirection direction_;
   port::PortType type_;
@@ -114,8 +125,13 @@ public:
   void take_all(bool deliver) override;
 
 private:
+  void take_dds(detail::DataConnection &c, bool deliver);
+  void take_local(detail::DataConnection &c, bool deliver);
+  // Hands `value` to the callback unless the connection's filter drops it.
+  void deliver(detail::DataConnection &c, const T &value);
+
   Callback callback_;
-  T scratch_; // receives every sample: its buffers grow once and are reused
+  T scratch_; // receives every DDS sample: its buffers grow once and are reused
 };
 
 extern template class UsesPort<port::Samples>;

@@ -26,13 +26,14 @@ public:
   // the reader is under way.
   Expected<void> attach(dds_entity_t reader);
   void detach(dds_entity_t reader);
+  // Wakes the thread: what an in-host connection delivered is waiting (never blocks).
+  void wake() const;
   // Stops and joins the thread; `poll` is not called afterwards. Idempotent.
   void stop();
 
 private:
   ReceiveLoop(int wake_fd, std::function<void()> poll);
   static void on_data_available(dds_entity_t reader, void *loop);
-  void wake() const;
   void run();
 
   int wake_fd_;

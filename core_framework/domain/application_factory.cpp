@@ -490,8 +490,19 @@ private:
                  {"topic", ci.topic},
                  {"repid", ci.repid},
                  {"qos", ci.qos},
-                 {"filter", std::string_view(direction) == "provides" ? ci.filter : ""}},
+                 {"filter", std::string_view(direction) == "provides" ? ci.filter : ""},
+                 {"local", in_one_host(ci)}},
             fmt::format("{} ({})", ci.id, end.name())};
+  }
+
+  // Both ends are components of one component host: the connection bypasses DDS.
+  bool in_one_host(const ConnectionInstance &ci) const {
+    if (ci.uses.component.empty() || ci.provides.component.empty())
+      return false;
+    const auto *uses = app_->find_component(ci.uses.component);
+    const auto *provides = app_->find_component(ci.provides.component);
+    return uses != nullptr && provides != nullptr && !uses->host.empty() &&
+           uses->host == provides->host;
   }
 
   std::string repid_of(const profile::Connection &c) const {
