@@ -516,7 +516,8 @@ CallResult<Json> Host::op_status(const Json &) {
                              {"matched", s.matched},
                              {"samples", s.samples},
                              {"filtered", s.filtered},
-                             {"deadline_missed", s.deadline_missed}});
+                             {"deadline_missed", s.deadline_missed},
+                             {"in_host", s.in_host}});
     ports.push_back({{"name", port->name()},
                      {"direction", direction_name(port->direction())},
                      {"connections", std::move(connections)}});

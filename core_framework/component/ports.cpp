@@ -30,13 +30,15 @@ struct DataConnection {
   std::optional<ContentFilter> filter; // provides only: what is delivered
   std::atomic<std::uint64_t> filtered{0};
 
-  // In-host: the topic, and a reader's inbox and requested deadline, which it checks itself.
+  // In-host: the topic, a reader's inbox, and the deadline, which each end checks itself as DDS
+  // would (requested by the reader, offered by the writer).
   std::shared_ptr<LocalTopic> local;
   std::shared_ptr<LocalInbox> inbox;
   std::chrono::nanoseconds deadline{0};
   std::optional<std::chrono::steady_clock::time_point> last_arrival; // the receive thread's
   std::int64_t deadline_periods_counted = 0;                         // the receive thread's
   std::atomic<std::uint32_t> deadline_missed{0};
+  std::atomic<std::int64_t> last_write_ns{0}; // a writer's, on the steady clock; 0: none yet
 
   ~DataConnection() {
     if (loop != nullptr && entity)
@@ -159,7 +161,7 @@ Expected<std::unique_ptr<DataConnection>> open_reader(dds_entity_t participant,
   return c;
 }
 
-// A reader's history depth (0: keep all) and requested deadline (0: none), for in-host delivery.
+// A reader's history depth (0: keep all), and the deadline (0: none), for in-host connections.
 std::size_t history_depth(const dds_qos_t *qos) {
   dds_history_kind_t kind = DDS_HISTORY_KEEP_LAST;
   std::int32_t depth = 1;
@@ -205,8 +207,36 @@ std::int32_t matched_count(const DataConnection &c, profile::PortDirection direc
              : 0;
 }
 
+std::int64_t steady_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
+// Whole deadline periods from `since_ns` to `now_ns`.
+std::uint32_t periods_between(std::int64_t since_ns, std::int64_t now_ns,
+                              std::chrono::nanoseconds deadline) {
+  if (since_ns == 0 || deadline.count() <= 0 || now_ns <= since_ns)
+    return 0;
+  return static_cast<std::uint32_t>((now_ns - since_ns) / deadline.count());
+}
+
+// An in-host writer's offered deadline: the periods each gap between writes spanned.
+void note_local_write(DataConnection &c) {
+  if (c.deadline.count() <= 0)
+    return;
+  const std::int64_t now = steady_ns();
+  const std::int64_t before = c.last_write_ns.exchange(now, std::memory_order_relaxed);
+  if (auto missed = periods_between(before, now, c.deadline); missed > 0)
+    c.deadline_missed.fetch_add(missed, std::memory_order_relaxed);
+}
+
 // How often the writer (uses) or the reader's writers (provides) missed the connection's deadline.
 std::uint32_t deadline_misses(const DataConnection &c, profile::PortDirection direction) {
+  if (c.in_host() && direction == profile::PortDirection::Uses) // and the current gap
+    return c.deadline_missed.load(std::memory_order_relaxed) +
+           periods_between(c.last_write_ns.load(std::memory_order_relaxed), steady_ns(),
+                           c.deadline);
   if (c.in_host())
     return c.deadline_missed.load(std::memory_order_relaxed);
   const dds_entity_t entity = c.entity.get();
@@ -270,6 +300,7 @@ Expected<std::unique_ptr<DataConnection>> PortBase::open_local(detail::ReceiveLo
   if (!topic)
     return make_error({"port", 0, 0}, "port", topic.error());
   c->local = std::move(*topic);
+  c->deadline = requested_deadline(qos);
   if (direction_ == profile::PortDirection::Uses) {
     c->local->add_writer();
     return c;
@@ -277,7 +308,6 @@ Expected<std::unique_ptr<DataConnection>> PortBase::open_local(detail::ReceiveLo
   if (loop == nullptr)
     return make_error({"port", 0, 0}, "port", "no receive loop for a provides port");
   c->inbox = std::make_shared<detail::LocalInbox>(*loop, history_depth(qos));
-  c->deadline = requested_deadline(qos);
   c->local->add_reader(c->inbox);
   return c;
 }
@@ -298,7 +328,7 @@ std::vector<ConnectionStatus> PortBase::status() const {
   out.reserve(connections_.size());
   for (const auto &[id, c] : connections_)
     out.push_back({id, c->topic_name, matched_count(*c, direction_), c->samples.load(),
-                   c->filtered.load(), deadline_misses(*c, direction_)});
+                   c->filtered.load(), deadline_misses(*c, direction_), c->in_host()});
   return out;
 }
 
@@ -357,6 +387,7 @@ WriteResult PortBase::write_wire(const void *sample,
       if (!shared)
         shared = copy();
       c->local->publish(shared);
+      note_local_write(*c);
       c->samples.fetch_add(1, std::memory_order_relaxed);
       ++written;
       continue;

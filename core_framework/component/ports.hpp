@@ -38,6 +38,7 @@ struct ConnectionStatus {
   std::uint64_t samples = 0;         // written (uses) or received (provides)
   std::uint64_t filtered = 0;        // provides: received but not delivered (the content filter)
   std::uint32_t deadline_missed = 0; // the connection's deadline, missed (offered or requested)
+  bool in_host = false;              // both ends in one process: no DDS entities
 };
 
 // A QoS problem of a provides port's connection since it was last reported: the writer missed

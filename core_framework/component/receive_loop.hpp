@@ -34,6 +34,8 @@ public:
 private:
   ReceiveLoop(int wake_fd, std::function<void()> poll);
   static void on_data_available(dds_entity_t reader, void *loop);
+  bool take_wake() const;
+  bool spin_for_wake() const;
   void run();
 
   int wake_fd_;

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <functional>
 #include <future>
+#include <set>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -86,7 +87,8 @@ Json end_state(const std::map<std::string, Json> &status_of, const std::string &
         return Json{{"matched", c.value("matched", 0)},
                     {"samples", c.value("samples", 0)},
                     {"filtered", c.value("filtered", 0)},
-                    {"deadline_missed", c.value("deadline_missed", 0)}};
+                    {"deadline_missed", c.value("deadline_missed", 0)},
+                    {"in_host", c.value("in_host", false)}};
   }
   return nullptr;
 }
@@ -622,21 +624,21 @@ CallResult<Json> DomainManager::Impl::list_connections(const Json &body) {
     return control::call_error(Status::NotFound, fmt::format("no application {} runs", only));
   Json list = Json::array();
   for (const auto &app : apps) {
-    std::map<std::string, std::future<CallResult<Json>>> statuses;
-    auto ask = [&](const std::string &address) {
-      if (!address.empty() && statuses.count(address) == 0)
-        statuses.emplace(address, endpoint->call(address, "component.status", Json::object(),
-                                                 options.call_timeout));
-    };
+    std::set<std::string> addresses;
     for (const auto &c : app->components)
-      ask(c.address);
+      addresses.insert(c.address);
     for (const auto &c : app->connections)
       for (const auto *end : {&c.uses, &c.provides})
-        ask(end->address); // device ends
+        if (!end->address.empty())
+          addresses.insert(end->address); // device ends
+    std::vector<control::Call> calls;
+    for (const auto &address : addresses)
+      calls.push_back({address, "component.status", Json::object()});
+    const auto statuses = endpoint->call_all(calls, options.call_timeout);
     std::map<std::string, Json> status_of;
-    for (auto &[address, f] : statuses)
-      if (auto s = f.get())
-        status_of[address] = *s;
+    for (std::size_t i = 0; i < calls.size(); ++i)
+      if (statuses[i])
+        status_of[calls[i].target] = *statuses[i];
     for (const auto &c : app->connections)
       list.push_back(connection_json(*app, c, status_of));
   }

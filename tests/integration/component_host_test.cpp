@@ -16,6 +16,20 @@ std::string executable_of(long pid) {
   return fs::read_symlink(fmt::format("/proc/{}/exe", pid), ec).filename().string();
 }
 
+// Whether each connection of the application is in-host, by id, from both ends' live state.
+std::map<std::string, bool> in_host_by_connection(TestDomain &domain, const std::string &app) {
+  auto list = domain.call("connection.list", Json{{"app", app}});
+  REQUIRE(list.has_value());
+  std::map<std::string, bool> in_host;
+  for (const auto &c : list->at("connections")) {
+    const bool uses = c.at("uses_state").value("in_host", false);
+    const bool provides = c.at("provides_state").value("in_host", false);
+    CHECK(uses == provides);
+    in_host[c.at("id")] = uses && provides;
+  }
+  return in_host;
+}
+
 // The pid of each component, by id.
 std::map<std::string, long> pids_by_component(const Json &app) {
   std::map<std::string, long> pids;
@@ -46,6 +60,9 @@ TEST_CASE("shared-library components run in one component host: launched, carryi
   CHECK(executable_of(pids.at("Producer_1")) == "rsca-component-host");
 
   CHECK(TestDomain::wait_for([&] { return received(domain, "ProducerConsumerHosted") > 20; }));
+  // Two components of one host: the data bypasses DDS.
+  CHECK(in_host_by_connection(domain, "ProducerConsumerHosted") ==
+        std::map<std::string, bool>{{"samples", true}});
   auto [crc, configured] =
       domain.cli({"configure", "ProducerConsumerHosted/Producer_1", "rate_hz=200"});
   INFO(configured);
@@ -75,6 +92,11 @@ TEST_CASE("hosted components and component processes connect to each other",
   CHECK(executable_of(pids.at("Consumer_1")) == "rsca-consumer");
   CHECK(executable_of(pids.at("Producer_1")) == "rsca-component-host");
   CHECK(TestDomain::wait_for([&] { return received(domain, "HostedMixed") > 20; }));
+  // Between a host and a process every connection is a DDS one.
+  for (const auto &[id, in_host] : in_host_by_connection(domain, "HostedMixed")) {
+    INFO(id);
+    CHECK_FALSE(in_host);
+  }
   REQUIRE(domain.call("app.release", Json{{"app", "HostedMixed"}}).has_value());
   domain.require_clean(pids_of(app));
 }

@@ -324,15 +324,18 @@ TEST_CASE("the domain publishes what happens to it, and rsca events follows it",
 
 TEST_CASE("a deadline the writer stops meeting is reported as a domain event",
           "[integration][domain][events]") {
+  // Over DDS between two processes, and in-host between two components of one component host.
+  const std::string name =
+      GENERATE(as<std::string>{}, "ProducerConsumer", "ProducerConsumerHosted");
+  INFO(name);
   TestDomain domain;
   auto [rc, out] = domain.cli(
-      {"launch",
-       (kSource / "profiles/dom/waveforms/ProducerConsumer/ProducerConsumer.sad.xml").string()});
+      {"launch", (kSource / "profiles/dom/waveforms" / name / (name + ".sad.xml")).string()});
   REQUIRE(rc == 0);
-  auto app = domain.call("app.show", Json{{"app", "ProducerConsumer"}});
+  auto app = domain.call("app.show", Json{{"app", name}});
   REQUIRE(app.has_value());
   // The connection asks for a sample every 100 ms at least; at 2 Hz the producer misses it.
-  REQUIRE(domain.cli({"configure", "ProducerConsumer/Producer_1", "rate_hz=2"}).first == 0);
+  REQUIRE(domain.cli({"configure", name + "/Producer_1", "rate_hz=2"}).first == 0);
   Json problem;
   CHECK(TestDomain::wait_for([&] {
     auto [erc, events] = domain.cli({"--json", "events", "--wait-ms", "300"});
@@ -345,17 +348,18 @@ TEST_CASE("a deadline the writer stops meeting is reported as a domain event",
     return !problem.is_null();
   }));
   INFO(problem.dump());
-  CHECK(problem.value("application", "") == "ProducerConsumer");
+  CHECK(problem.value("application", "") == name);
   CHECK(problem.value("component", "") == "Consumer_1");
   CHECK(problem.value("connection", "") == "samples");
   CHECK(problem.value("problem", "") == "deadline missed");
   CHECK(problem.value("count", 0) > 0);
   // Both ends count the misses in the connection's live state.
-  auto list = domain.call("connection.list", Json{{"app", "ProducerConsumer"}});
+  auto list = domain.call("connection.list", Json{{"app", name}});
   REQUIRE(list.has_value());
   const Json &samples = list->at("connections")[0];
   CHECK(samples.at("uses_state").at("deadline_missed").get<int>() > 0);
   CHECK(samples.at("provides_state").at("deadline_missed").get<int>() > 0);
-  REQUIRE(domain.call("app.release", Json{{"app", "ProducerConsumer"}}).has_value());
+  CHECK(samples.at("provides_state").at("in_host") == (name == "ProducerConsumerHosted"));
+  REQUIRE(domain.call("app.release", Json{{"app", name}}).has_value());
   domain.require_clean(pids_of(*app));
 }

@@ -66,9 +66,10 @@ std::string end_state(const Json &state) {
   if (state.is_null())
     return "-";
   const int missed = state.value("deadline_missed", 0);
-  return fmt::format("{} matched, {} samples{}", state.value("matched", 0),
+  return fmt::format("{} matched, {} samples{}{}", state.value("matched", 0),
                      state.value("samples", 0),
-                     missed == 0 ? "" : fmt::format(", {} deadlines missed", missed));
+                     missed == 0 ? "" : fmt::format(", {} deadlines missed", missed),
+                     state.value("in_host", false) ? " (in-host)" : "");
 }
 
 void print_connections(const Json &r) {
