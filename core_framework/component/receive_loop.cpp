@@ -1,11 +1,13 @@
 #include "component/receive_loop.hpp"
 
 #include <poll.h>
+#include <sched.h>
 #include <sys/eventfd.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <chrono>
+#include <cstdlib>
 #include <cstring>
 
 #include <fmt/format.h>
@@ -16,7 +18,20 @@ namespace {
 // The longest the thread waits before it polls again: the owner then also looks for connection
 // problems (component/host.cpp), so this bounds how late a deadline miss is seen.
 constexpr int kWakeIntervalMs = 100;
-constexpr std::chrono::microseconds kSpin{50};
+
+// How long the thread looks for more data before it sleeps: RSCA_RECEIVE_SPIN_US, 50 by default;
+// 0 never spins (for a robot that counts every milliwatt more than every microsecond).
+std::chrono::microseconds spin_time() {
+  static const std::chrono::microseconds spin = [] {
+    const char *text = std::getenv("RSCA_RECEIVE_SPIN_US");
+    if (text == nullptr || *text == '\0')
+      return std::chrono::microseconds{50};
+    char *end = nullptr;
+    const long value = std::strtol(text, &end, 10);
+    return std::chrono::microseconds{*end == '\0' && value >= 0 ? value : 50};
+  }();
+  return spin;
+}
 
 } // namespace
 
@@ -73,14 +88,18 @@ bool ReceiveLoop::take_wake() const {
   return ::read(wake_fd_, &count, sizeof count) > 0;
 }
 
-// After data, the thread looks for more for kSpin before it sleeps: a reply in a ping-pong or the
-// next sample of a burst then finds it awake. Waking a sleeping thread costs 20-40 us on a
+// After data, the thread looks for more for spin_time() before it sleeps: a reply in a ping-pong or
+// the next sample of a burst then finds it awake. Waking a sleeping thread costs 20-40 us on a
 // virtual machine whose other CPU has gone idle; looking costs a read of the eventfd.
 bool ReceiveLoop::spin_for_wake() const {
-  const auto until = std::chrono::steady_clock::now() + kSpin;
-  while (std::chrono::steady_clock::now() < until)
+  const auto until = std::chrono::steady_clock::now() + spin_time();
+  while (std::chrono::steady_clock::now() < until) {
     if (take_wake())
       return true;
+    // Whatever else is runnable on this CPU goes first: Cyclone's receive thread, which must run
+    // before a reply over DDS can arrive, or the other end of an in-host ping-pong.
+    sched_yield();
+  }
   return false;
 }
 
