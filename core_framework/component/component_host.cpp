@@ -83,10 +83,7 @@ load_profiles(const std::vector<HostedComponent> &hosted) {
   return softpkgs;
 }
 
-Context context_of(const ExecParams &p, spdlog::logger &host_log) {
-  if (p.schedule)
-    host_log.warn("{}: admitted on cpu {}, but a hosted component runs on its host's CPUs",
-                  p.name_binding, p.schedule->cpu);
+Context context_of(const ExecParams &p) {
   return Context{p.identifier,
                  p.name_binding,
                  p.application,
@@ -142,7 +139,7 @@ int serve_hosted(const HostParams &host, const ExitEvents &events, spdlog::logge
       return kExitFailure;
     }
     auto component =
-        InProcessComponent::open(*factory, context_of(h.params, log), (*softpkgs)[i], *participant,
+        InProcessComponent::open(*factory, context_of(h.params), (*softpkgs)[i], *participant,
                                  h.params.others, on_released, *endpoint);
     if (!component) {
       log.error("{}: {}", h.params.identifier, component.error().to_string());

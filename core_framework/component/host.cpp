@@ -4,8 +4,12 @@
 #include <tuple>
 
 #include <fmt/format.h>
+#include <pthread.h>
+#include <sched.h>
 #include <spdlog/spdlog.h>
 #include <unistd.h>
+
+#include <cstring>
 
 #include "dds/port_qos.hpp"
 
@@ -153,6 +157,7 @@ Expected<void> Host::open(std::shared_ptr<dds::Participant> participant,
   if (!loop)
     return tl::unexpected(loop.error());
   loop_ = std::move(*loop);
+  configure_thread(loop_->thread(), "rx:");
   if (!endpoint) {
     auto own = control::Endpoint::open(participant_, address_, std::move(options));
     if (!own)
@@ -304,6 +309,24 @@ void Host::start_service() {
     service_stopping_ = false;
   }
   service_thread_ = std::thread([this] { service_loop(); });
+  configure_thread(service_thread_, "svc:");
+}
+
+// Names the component's own threads after it, and runs them on the CPU admission chose for a
+// periodic component: in a component host the process's other threads are shared, these are
+// the component's.
+void Host::configure_thread(std::thread &thread, std::string_view prefix) {
+  const std::string name = fmt::format("{}{}", prefix, c().name()).substr(0, 15);
+  pthread_setname_np(thread.native_handle(), name.c_str());
+  const auto &schedule = c().context().schedule;
+  if (!schedule)
+    return;
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  CPU_SET(schedule->cpu, &set);
+  if (int rc = pthread_setaffinity_np(thread.native_handle(), sizeof(set), &set); rc != 0)
+    log().warn("cannot run thread {} on cpu {} as admitted: {}", name, schedule->cpu,
+               std::strerror(rc));
 }
 
 void Host::stop_service() {

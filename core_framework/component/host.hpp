@@ -68,6 +68,7 @@ private:
   void poll_ports();
   // Tells the domain of connection problems, at most once a second (only the receive thread).
   void report_problems(std::vector<ConnectionProblem> problems);
+  void configure_thread(std::thread &thread, std::string_view prefix);
   void start_service();
   void stop_service();
   void service_loop();

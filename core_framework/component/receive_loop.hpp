@@ -30,6 +30,8 @@ public:
   void wake() const;
   // Stops and joins the thread; `poll` is not called afterwards. Idempotent.
   void stop();
+  // Its thread, for its owner to name and place.
+  std::thread &thread() { return thread_; }
 
 private:
   ReceiveLoop(int wake_fd, std::function<void()> poll);

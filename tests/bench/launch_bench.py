@@ -21,7 +21,7 @@ import sys
 import tempfile
 import time
 
-from local_domain import Domain, summary
+from local_domain import Domain, cpu_ticks, memory_kb, summary
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
@@ -44,10 +44,28 @@ def baseline_ms(relay, n):
     return (time.perf_counter() - began) * 1e3
 
 
+def host_footprint(domain, app):
+    """The component hosts of a running application: how many, components per host, RSS per host
+    and their CPU use over 2 s of idling (all hosts together, % of one core)."""
+    shown, _ = domain.cli("show", app)
+    components = shown.get("components", [])
+    pids = sorted({c["pid"] for c in components if c.get("pid")})
+    if not pids:
+        return None
+    rss = [memory_kb(p)["rss_kb"] for p in pids]
+    before = sum(cpu_ticks(p) for p in pids)
+    time.sleep(2.0)  # the interval CPU use is measured over
+    ticks = sum(cpu_ticks(p) for p in pids) - before
+    return {"hosts": len(pids), "components_per_host": len(components) / len(pids),
+            "rss_kb_per_host": sorted(rss)[len(rss) // 2],
+            "cpu_percent_idle": 100.0 * ticks / os.sysconf("SC_CLK_TCK") / 2.0}
+
+
 def bench_n(domain, n, hosted, runs, sdr, relay):
     sad, name = generate(n, hosted, sdr)
     domain.cli("install", "--sdrroot", sdr, sad)
     launch_domain, launch_cli, release_cli, base, steps, failures = [], [], [], [], {}, []
+    footprint = None
     for i in range(runs):
         reply, wall = domain.cli("launch", name, "--name", f"{name}_{i}", "--strategy", "spread",
                                  check=False)
@@ -59,6 +77,8 @@ def bench_n(domain, n, hosted, runs, sdr, relay):
         launch_domain.append(reply["launch"]["ms"])
         for s in reply["launch"]["steps"]:
             steps.setdefault(s["step"], []).append(s["ms"])
+        if hosted and footprint is None:
+            footprint = host_footprint(domain, f"{name}_{i}")
         _, wall = domain.cli("release", f"{name}_{i}")
         release_cli.append(wall)
         base.append(baseline_ms(relay, n))
@@ -69,7 +89,8 @@ def bench_n(domain, n, hosted, runs, sdr, relay):
             "failures": failures,
             "launch_domain_ms": summary(launch_domain), "launch_cli_ms": summary(launch_cli),
             "release_cli_ms": summary(release_cli), "baseline_fork_exec_ms": summary(base),
-            "steps_ms_median": {k: sorted(v)[len(v) // 2] for k, v in steps.items()}}
+            "steps_ms_median": {k: sorted(v)[len(v) // 2] for k, v in steps.items()},
+            "host_footprint": footprint}
 
 
 def main():
@@ -112,6 +133,18 @@ def main():
         growth = b["launch_domain_ms"]["median"] / a["launch_domain_ms"]["median"]
         print(f"launch growth {a['components']} -> {b['components']} components: x{growth:.1f} "
               f"(x{b['components'] / a['components']:.0f} would be linear)")
+    hosted = [r for r in results if r.get("host_footprint")]
+    for r in hosted:
+        f = r["host_footprint"]
+        print(f"component hosts at {r['components']} hosted: {f['hosts']} hosts of "
+              f"{f['components_per_host']:.0f} components, {f['rss_kb_per_host'] / 1024:.1f} MB RSS "
+              f"each, {f['cpu_percent_idle']:.1f} % of a core idle (all hosts)")
+    if len(hosted) >= 2:
+        a, b = hosted[0]["host_footprint"], hosted[-1]["host_footprint"]
+        if b["components_per_host"] > a["components_per_host"]:
+            per = (b["rss_kb_per_host"] - a["rss_kb_per_host"]) / (
+                b["components_per_host"] - a["components_per_host"])
+            print(f"per hosted component: {per:.0f} KB RSS")
     for r in results:
         if r["failures"]:
             print(f"{len(r['failures'])} launch(es) of {r['components']} {r['kind']} failed")

@@ -27,6 +27,23 @@ def summary(values):
             "min": min(values), "max": max(values), "runs": len(values)}
 
 
+def memory_kb(pid):
+    fields = {}
+    with open(f"/proc/{pid}/smaps_rollup") as f:
+        for line in f:
+            parts = line.split()
+            if len(parts) >= 2 and parts[0].endswith(":") and parts[1].isdigit():
+                fields[parts[0][:-1]] = int(parts[1])
+    return {"rss_kb": fields["Rss"], "pss_kb": fields["Pss"],
+            "private_kb": fields.get("Private_Clean", 0) + fields.get("Private_Dirty", 0)}
+
+
+def cpu_ticks(pid):
+    with open(f"/proc/{pid}/stat") as f:
+        fields = f.read().rsplit(")", 1)[1].split()
+    return int(fields[11]) + int(fields[12])  # utime + stime
+
+
 def alive(pid):
     try:
         os.kill(pid, 0)

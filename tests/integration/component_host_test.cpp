@@ -2,6 +2,7 @@
 // process per application and device, connected to component processes and to each other over
 // the same ports, released or rolled back with nothing left.
 #include <filesystem>
+#include <fstream>
 #include <map>
 
 #include "domain_fixture.hpp"
@@ -28,6 +29,23 @@ std::map<std::string, bool> in_host_by_connection(TestDomain &domain, const std:
     in_host[c.at("id")] = uses && provides;
   }
   return in_host;
+}
+
+// The threads of a process by name, each with the CPUs it may run on (Cpus_allowed_list).
+std::map<std::string, std::string> threads_of(long pid) {
+  std::map<std::string, std::string> threads;
+  for (const auto &task : fs::directory_iterator(fmt::format("/proc/{}/task", pid))) {
+    std::ifstream status(task.path() / "status");
+    std::string line, name, allowed;
+    while (std::getline(status, line)) {
+      if (line.rfind("Name:", 0) == 0)
+        name = line.substr(line.find_first_not_of(" \t", 5));
+      if (line.rfind("Cpus_allowed_list:", 0) == 0)
+        allowed = line.substr(line.find_first_not_of(" \t", 18));
+    }
+    threads[name] = allowed;
+  }
+  return threads;
 }
 
 // The pid of each component, by id.
@@ -60,6 +78,18 @@ TEST_CASE("shared-library components run in one component host: launched, carryi
   CHECK(executable_of(pids.at("Producer_1")) == "rsca-component-host");
 
   CHECK(TestDomain::wait_for([&] { return received(domain, "ProducerConsumerHosted") > 20; }));
+  // Producer_1 is periodic: its own threads run on the CPU admission chose, the host's do not.
+  for (const auto &c : app->at("components"))
+    if (c.at("id") == "Producer_1") {
+      const std::string cpu = std::to_string(c.at("schedule").at("cpu").get<int>());
+      const auto threads = threads_of(pids.at("Producer_1"));
+      REQUIRE(threads.contains("rx:Producer_1"));
+      REQUIRE(threads.contains("svc:Producer_1"));
+      CHECK(threads.at("rx:Producer_1") == cpu);
+      CHECK(threads.at("svc:Producer_1") == cpu);
+      REQUIRE(threads.contains("rx:Consumer_1"));
+      CHECK(threads.at("rx:Consumer_1") != cpu);
+    }
   // Two components of one host: the data bypasses DDS.
   CHECK(in_host_by_connection(domain, "ProducerConsumerHosted") ==
         std::map<std::string, bool>{{"samples", true}});
