@@ -18,7 +18,7 @@ void LocalInbox::push(LocalSample sample) {
     }
     queue_.push_back(std::move(sample));
   }
-  loop_.wake();
+  loop_.wake_in_host();
 }
 
 std::deque<LocalSample> LocalInbox::take() {

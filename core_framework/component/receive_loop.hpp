@@ -26,8 +26,8 @@ public:
   // the reader is under way.
   Expected<void> attach(dds_entity_t reader);
   void detach(dds_entity_t reader);
-  // Wakes the thread: what an in-host connection delivered is waiting (never blocks).
-  void wake() const;
+  // Wakes the thread (never blocks): an in-host connection delivered something.
+  void wake_in_host() const;
   // Stops and joins the thread; `poll` is not called afterwards. Idempotent.
   void stop();
   // Its thread, for its owner to name and place.
@@ -36,6 +36,7 @@ public:
 private:
   ReceiveLoop(int wake_fd, std::function<void()> poll);
   static void on_data_available(dds_entity_t reader, void *loop);
+  void wake() const;
   bool take_wake() const;
   bool spin_for_wake() const;
   void run();
@@ -44,6 +45,7 @@ private:
   dds_listener_t *listener_;
   std::function<void()> poll_;
   std::atomic<bool> stopping_{false};
+  mutable std::atomic<bool> in_host_data_{false};
   std::thread thread_;
 };
 

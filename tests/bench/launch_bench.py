@@ -4,7 +4,7 @@
 Starts `rsca domain up --nodes 10` on a DDS domain id and run folder of its own, writes chains of
 N Relay components with tools/gen-app, as processes (N = 10, 100) and as shared libraries in
 component hosts (N = 10, 100, 1000), and for each launches and releases the chain 10 times
-(--quick: 3; 1000: 3), spread over the 10 nodes:
+(1000: 3; --quick: 2, and 100 processes once), spread over the 10 nodes:
 - launch: until every component runs and every connection is matched (the domain's connect step
   waits for that before start), as the domain timed it and as the CLI saw it;
 - teardown: `rsca release`, CLI wall clock (an upper bound: it includes the CLI's own start and
@@ -100,7 +100,7 @@ def main():
     parser.add_argument("--quick", action="store_true")
     args = parser.parse_args()
     configs = [(10, False), (100, False), (10, True), (100, True), (1000, True)]
-    runs = 3 if args.quick else 10
+    runs = 2 if args.quick else 10
     rsca = os.path.join(args.bin, "rsca")
     results = []
     # A domain of its own for each configuration: one whose launches overload the host (its
@@ -110,7 +110,10 @@ def main():
             print(f"launch of {n} {'hosted components' if hosted else 'processes'}...",
                   file=sys.stderr)
             with Domain(rsca, nodes=10) as domain:
-                results.append(bench_n(domain, n, hosted, runs if n < 1000 else 3, sdr,
+                n_runs = min(runs, 3) if n >= 1000 else runs
+                if args.quick and n >= 100 and not hosted:
+                    n_runs = 1  # it fails on this machine (see docs/architecture.md)
+                results.append(bench_n(domain, n, hosted, n_runs, sdr,
                                        os.path.join(args.bin, "rsca-relay")))
     with open(args.out, "w") as f:
         json.dump({"launch": results}, f, indent=2)

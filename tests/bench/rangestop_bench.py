@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """The RSCA paper's three-way comparison (run by tools/bench, never by ctest): the same StopCrash
 control loop (drive toward the wall at 0.3 m/s, the IR range read every 20 ms, stop below 0.6 m)
-run three ways, in real time, each over 20 runs (--quick: 5):
+run three ways, in real time, each over 20 runs (--quick: 1):
 
 - inprocess: one process, direct calls (tests/bench/rangestop/rangestop_inprocess.cpp): the world
   stepped in real time on one thread, a sensor thread every period calling the controller, which
@@ -243,7 +243,7 @@ def main():
     parser.add_argument("--bin", required=True, help="the build's bin folder")
     parser.add_argument("--sdrroot", default=os.path.join(ROOT, "profiles"))
     parser.add_argument("--out", required=True, help="the JSON results file")
-    parser.add_argument("--quick", action="store_true", help="5 runs a way instead of 20")
+    parser.add_argument("--quick", action="store_true", help="1 run a way instead of 20")
     parser.add_argument("--runs", type=int, help="runs a way (overrides --quick)")
     parser.add_argument("--ways", default=",".join(WAYS), help="a subset of " + ",".join(WAYS))
     # The experiment's settings: RangeStop's (the SAD, the robot's DCD). The rsca way sets
@@ -254,7 +254,7 @@ def main():
     parser.add_argument("--wall-distance", type=float, default=2.0, help=argparse.SUPPRESS)
     args = parser.parse_args()
     args.sdrroot = os.path.abspath(args.sdrroot)
-    runs = args.runs or (5 if args.quick else 20)
+    runs = args.runs or (1 if args.quick else 20)
     ways = [w for w in args.ways.split(",") if w]
     for w in ways:
         if w not in WAYS:
