@@ -279,6 +279,15 @@ void Host::poll_ports() {
   report_problems(std::move(problems));
 }
 
+// The receive thread wakes now and then only while a connection has problems to look for: a
+// host of a thousand components would otherwise wake ten thousand times a second for nothing.
+void Host::watch_connections() {
+  if (!loop_)
+    return;
+  loop_->set_watching(std::any_of(c().ports_.begin(), c().ports_.end(),
+                                  [](const auto &port) { return port->watched(); }));
+}
+
 void Host::report_problems(std::vector<ConnectionProblem> problems) {
   for (const auto &p : problems)
     unreported_problems_[{p.connection, p.problem}] += p.count;
@@ -457,6 +466,7 @@ CallResult<Json> Host::op_connect(const Json &body) {
                               std::move(filter), local);
       !ok)
     return control::call_error(Status::Failed, first_message(ok.error()));
+  watch_connections();
   log().info("port {}: connection {} on {}topic \"{}\"{}", *port_name, *connection,
              local ? "in-host " : "", *topic,
              filter_text.empty() ? "" : fmt::format(" with filter \"{}\"", filter_text));
@@ -477,6 +487,7 @@ CallResult<Json> Host::op_disconnect(const Json &body) {
   if (!port->disconnect(*connection))
     return control::call_error(Status::NotFound, fmt::format("port \"{}\" has no connection \"{}\"",
                                                              *port_name, *connection));
+  watch_connections();
   log().info("port {}: connection {} removed", *port_name, *connection);
   return Json::object();
 }

@@ -66,6 +66,7 @@ private:
   void set_state(State state);
   PortBase *find_port(const std::string &name) const;
   void poll_ports();
+  void watch_connections();
   // Tells the domain of connection problems, at most once a second (only the receive thread).
   void report_problems(std::vector<ConnectionProblem> problems);
   void configure_thread(std::thread &thread, std::string_view prefix);

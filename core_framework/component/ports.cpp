@@ -39,6 +39,7 @@ struct DataConnection {
   std::int64_t deadline_periods_counted = 0;                         // the receive thread's
   std::atomic<std::uint32_t> deadline_missed{0};
   std::atomic<std::int64_t> last_write_ns{0}; // a writer's, on the steady clock; 0: none yet
+  bool watched = false; // a reader with a deadline or a liveliness lease: problems to look for
 
   ~DataConnection() {
     if (loop != nullptr && entity)
@@ -191,6 +192,15 @@ std::uint32_t local_deadline_misses(DataConnection &c) {
   return static_cast<std::uint32_t>(missed);
 }
 
+// Whether a reader with this QoS can have problems to report (take_problems).
+bool has_problems_to_watch(const dds_qos_t *qos) {
+  dds_liveliness_kind_t kind = DDS_LIVELINESS_AUTOMATIC;
+  dds_duration_t lease = DDS_INFINITY;
+  if (qos != nullptr)
+    dds_qget_liveliness(qos, &kind, &lease);
+  return requested_deadline(qos).count() > 0 || lease != DDS_INFINITY;
+}
+
 std::int32_t matched_count(const DataConnection &c, profile::PortDirection direction) {
   if (c.in_host())
     return direction == profile::PortDirection::Uses ? c.local->readers() : c.local->writers();
@@ -269,6 +279,7 @@ Expected<void> PortBase::connect(dds_entity_t participant, detail::ReceiveLoop *
   auto c = std::make_unique<DataConnection>();
   c->topic_name = topic;
   c->filter = std::move(filter);
+  c->watched = direction_ == profile::PortDirection::Provides && has_problems_to_watch(qos);
   if (local) {
     auto opened = open_local(loop, std::move(c), qos);
     if (!opened)
@@ -368,6 +379,12 @@ std::vector<ConnectionProblem> PortBase::take_problems() {
           {id, "liveliness lost", static_cast<std::uint32_t>(liveliness.not_alive_count_change)});
   }
   return out;
+}
+
+bool PortBase::watched() const {
+  std::shared_lock lock(mutex_);
+  return std::any_of(connections_.begin(), connections_.end(),
+                     [](const auto &entry) { return entry.second->watched; });
 }
 
 void PortBase::take_all(bool) {}

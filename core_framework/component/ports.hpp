@@ -79,6 +79,9 @@ public:
   std::optional<std::int32_t> matched(const std::string &connection) const;
   // Provides ports: the QoS problems of each connection since the last call.
   std::vector<ConnectionProblem> take_problems();
+  // Whether a connection has problems to look for: a provides port's connection with a deadline
+  // or a liveliness lease.
+  bool watched() const;
   // Takes what every connection received; hands it to the callback when `deliver`.
   virtual void take_all(bool deliver);
   // Returns once no callback of this port is running (one that starts later sees the caller's

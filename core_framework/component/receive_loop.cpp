@@ -15,8 +15,8 @@
 namespace rsca::component::detail {
 namespace {
 
-// The longest the thread waits before it polls again: the owner then also looks for connection
-// problems (component/host.cpp), so this bounds how late a deadline miss is seen.
+// The longest the thread waits before it polls again while watching: the owner then also looks
+// for connection problems (component/host.cpp), so this bounds how late a deadline miss is seen.
 constexpr int kWakeIntervalMs = 100;
 
 // How long the thread looks for more data before it sleeps: RSCA_RECEIVE_SPIN_US, 50 by default;
@@ -70,6 +70,11 @@ Expected<void> ReceiveLoop::attach(dds_entity_t reader) {
   return {};
 }
 
+void ReceiveLoop::set_watching(bool watching) {
+  watching_ = watching;
+  wake(); // takes up the new period at once
+}
+
 void ReceiveLoop::detach(dds_entity_t reader) {
   dds_set_listener(reader, nullptr);
 }
@@ -115,7 +120,7 @@ void ReceiveLoop::run() {
   while (!stopping_.load()) {
     if (!(spin && spin_for_wake())) {
       pollfd fd{wake_fd_, POLLIN, 0};
-      if (::poll(&fd, 1, kWakeIntervalMs) > 0)
+      if (::poll(&fd, 1, watching_.load() ? kWakeIntervalMs : -1) > 0)
         take_wake();
     }
     spin = in_host_data_.exchange(false, std::memory_order_acq_rel);

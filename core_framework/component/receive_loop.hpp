@@ -30,6 +30,9 @@ public:
   void wake_in_host() const;
   // Stops and joins the thread; `poll` is not called afterwards. Idempotent.
   void stop();
+  // With `watching`, the thread also wakes every 100 ms when nothing arrives, for its owner to
+  // look for connection problems; without, it sleeps until data comes.
+  void set_watching(bool watching);
   // Its thread, for its owner to name and place.
   std::thread &thread() { return thread_; }
 
@@ -46,6 +49,7 @@ private:
   std::function<void()> poll_;
   std::atomic<bool> stopping_{false};
   mutable std::atomic<bool> in_host_data_{false};
+  std::atomic<bool> watching_{false};
   std::thread thread_;
 };
 
