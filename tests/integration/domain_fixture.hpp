@@ -201,6 +201,14 @@ public:
     }));
   }
 
+  // Stops a node daemon as its service manager would (SIGTERM); how it exited.
+  std::optional<int> stop_node(int index, std::chrono::milliseconds limit = 10s) {
+    nodes_[index - 1]->signal(SIGTERM);
+    auto status = nodes_[index - 1]->wait_exit(limit);
+    nodes_[index - 1].reset();
+    return status;
+  }
+
   void kill_node(int index) {
     nodes_[index - 1]->signal(SIGKILL);
     nodes_[index - 1]->wait_exit(5s);

@@ -1,6 +1,10 @@
 // rsca-test-faulty: a component that fails on purpose, as its "fault" exec parameter says, so
 // that integration tests can see the domain roll a launch back. Test-only; never installed.
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <chrono>
+#include <csignal>
 #include <cstdlib>
 #include <cstring>
 #include <string>
@@ -16,14 +20,34 @@ using rsca::component::Result;
 
 // The fault is read from the command line before the runtime starts, because "never_register"
 // must act before the component could announce itself.
-std::string fault_from(int argc, char **argv) {
+std::string param_from(int argc, char **argv, const char *key, const char *otherwise) {
   for (int i = 1; i + 1 < argc; ++i)
-    if (std::strcmp(argv[i], "fault") == 0)
+    if (std::strcmp(argv[i], key) == 0)
       return argv[i + 1];
-  return "none";
+  return otherwise;
 }
 
 std::string g_fault = "none";
+// "mark_signals": the file it creates once its handlers are in place (<marker>.ready), and on
+// the first SIGINT or SIGTERM (<marker>); then it dies of it, or ignores the signal with
+// "on_signal ignore".
+std::string g_marker;
+bool g_exit_on_signal = true;
+
+void touch(const char *path) {
+  const int fd = ::open(path, O_CREAT | O_WRONLY | O_CLOEXEC, 0644);
+  if (fd >= 0)
+    ::close(fd);
+}
+
+// Leaves a mark that the signal came (only async-signal-safe calls).
+void mark_signal(int signal) {
+  touch(g_marker.c_str());
+  if (!g_exit_on_signal)
+    return;
+  std::signal(signal, SIG_DFL); // dies of it, as a process without handlers would
+  std::raise(signal);
+}
 
 class Faulty final : public Component {
 public:
@@ -54,7 +78,16 @@ private:
 } // namespace
 
 int main(int argc, char **argv) {
-  g_fault = fault_from(argc, argv);
+  g_fault = param_from(argc, argv, "fault", "none");
+  if (g_fault == "mark_signals") { // with "on_signal ignore", only SIGKILL ends it
+    g_marker = param_from(argc, argv, "marker", "/dev/null");
+    g_exit_on_signal = param_from(argc, argv, "on_signal", "exit") != "ignore";
+    std::signal(SIGINT, mark_signal);
+    std::signal(SIGTERM, mark_signal);
+    touch((g_marker + ".ready").c_str());
+    for (;;)
+      ::pause();
+  }
   if (g_fault == "never_register")
     for (;;)
       std::this_thread::sleep_for(std::chrono::hours(1)); // the fault itself: never register
