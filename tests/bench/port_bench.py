@@ -283,7 +283,7 @@ class Schedule:
         self.latency_rate_hz = 100.0
         self.step_rates_hz = [250.0 * 2 ** k for k in range(10)]  # 250 .. 128000
         self.step_ms = 200 if quick else 1000
-        self.gap_ms = 200 if quick else 300
+        self.gap_ms = 100 if quick else 300
 
     def step_counts(self):
         # As the publishers compute them (C++: static_cast<uint64_t>(r * ms / 1000.0 + 0.5)).
