@@ -1,16 +1,12 @@
 #include "component/receive_loop.hpp"
 
-#include <poll.h>
+#include <linux/futex.h>
 #include <sched.h>
-#include <sys/eventfd.h>
+#include <sys/syscall.h>
 #include <unistd.h>
 
-#include <cerrno>
 #include <chrono>
 #include <cstdlib>
-#include <cstring>
-
-#include <fmt/format.h>
 
 namespace rsca::component::detail {
 namespace {
@@ -36,24 +32,19 @@ std::chrono::microseconds spin_time() {
 } // namespace
 
 Expected<std::unique_ptr<ReceiveLoop>> ReceiveLoop::start(std::function<void()> poll) {
-  const int fd = eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK);
-  if (fd < 0)
-    return make_error({"receive loop", 0, 0}, "dds",
-                      fmt::format("eventfd: {}", std::strerror(errno)));
-  std::unique_ptr<ReceiveLoop> loop(new ReceiveLoop(fd, std::move(poll)));
+  std::unique_ptr<ReceiveLoop> loop(new ReceiveLoop(std::move(poll)));
   loop->thread_ = std::thread([raw = loop.get()] { raw->run(); });
   return loop;
 }
 
-ReceiveLoop::ReceiveLoop(int wake_fd, std::function<void()> poll)
-    : wake_fd_(wake_fd), listener_(dds_create_listener(this)), poll_(std::move(poll)) {
+ReceiveLoop::ReceiveLoop(std::function<void()> poll)
+    : listener_(dds_create_listener(this)), poll_(std::move(poll)) {
   dds_lset_data_available(listener_, &ReceiveLoop::on_data_available);
 }
 
 ReceiveLoop::~ReceiveLoop() {
   stop();
   dds_delete_listener(listener_);
-  ::close(wake_fd_);
 }
 
 void ReceiveLoop::stop() {
@@ -83,14 +74,27 @@ void ReceiveLoop::on_data_available(dds_entity_t, void *loop) {
   static_cast<const ReceiveLoop *>(loop)->wake();
 }
 
+// The flag first, then a futex wake only if the thread sleeps (or is about to): sequentially
+// consistent, so either the sleeper sees the flag before it waits or the waker sees the sleeper.
 void ReceiveLoop::wake() const {
-  const std::uint64_t one = 1;
-  [[maybe_unused]] auto n = ::write(wake_fd_, &one, sizeof one);
+  woken_.store(1);
+  if (sleeping_.load() != 0)
+    ::syscall(SYS_futex, &woken_, FUTEX_WAKE_PRIVATE, 1, nullptr, nullptr, 0);
 }
 
 bool ReceiveLoop::take_wake() const {
-  std::uint64_t count = 0;
-  return ::read(wake_fd_, &count, sizeof count) > 0;
+  return woken_.exchange(0) != 0;
+}
+
+void ReceiveLoop::sleep_until_woken(int timeout_ms) const {
+  sleeping_.store(1);
+  if (woken_.load() == 0) {
+    timespec timeout{timeout_ms / 1000, (timeout_ms % 1000) * 1'000'000L};
+    // Returns at once if woken_ is no longer 0 (the wake came in between).
+    ::syscall(SYS_futex, &woken_, FUTEX_WAIT_PRIVATE, 0, timeout_ms < 0 ? nullptr : &timeout,
+              nullptr, 0);
+  }
+  sleeping_.store(0);
 }
 
 void ReceiveLoop::wake_in_host() const {
@@ -101,7 +105,7 @@ void ReceiveLoop::wake_in_host() const {
 // After in-host data, the thread looks for more for spin_time() before it sleeps: a reply in an
 // in-host ping-pong or the next sample of a burst then finds it awake. Waking a sleeping thread
 // costs 20-40 us on a virtual machine whose other CPU has gone idle; looking costs a read of the
-// eventfd. Not after DDS data: there the spinning threads of many subscribers would take the CPU
+// flag. Not after DDS data: there the spinning threads of many subscribers would take the CPU
 // Cyclone needs to deliver (measured: fan-out to 10 processes lost half its rate).
 bool ReceiveLoop::spin_for_wake() const {
   const auto until = std::chrono::steady_clock::now() + spin_time();
@@ -118,10 +122,9 @@ bool ReceiveLoop::spin_for_wake() const {
 void ReceiveLoop::run() {
   bool spin = false; // the last round had in-host data
   while (!stopping_.load()) {
-    if (!(spin && spin_for_wake())) {
-      pollfd fd{wake_fd_, POLLIN, 0};
-      if (::poll(&fd, 1, watching_.load() ? kWakeIntervalMs : -1) > 0)
-        take_wake();
+    if (!(spin && spin_for_wake()) && !take_wake()) {
+      sleep_until_woken(watching_.load() ? kWakeIntervalMs : -1);
+      take_wake();
     }
     spin = in_host_data_.exchange(false, std::memory_order_acq_rel);
     if (stopping_.load())

@@ -1,7 +1,7 @@
 // Private to the component runtime: the one thread of a component that receives on all its
-// provides ports. Each reader's data-available listener only wakes the thread (an eventfd write,
-// which never blocks); the thread then lets the component take what arrived, off Cyclone's own
-// receive thread.
+// provides ports. Each reader's data-available listener only wakes the thread (a flag, and a futex
+// wake only when the thread sleeps: never blocks); the thread then lets the component take what
+// arrived, off Cyclone's own receive thread.
 #pragma once
 
 #include <atomic>
@@ -37,14 +37,16 @@ public:
   std::thread &thread() { return thread_; }
 
 private:
-  ReceiveLoop(int wake_fd, std::function<void()> poll);
+  explicit ReceiveLoop(std::function<void()> poll);
   static void on_data_available(dds_entity_t reader, void *loop);
   void wake() const;
   bool take_wake() const;
   bool spin_for_wake() const;
+  void sleep_until_woken(int timeout_ms) const;
   void run();
 
-  int wake_fd_;
+  mutable std::atomic<std::uint32_t> woken_{0};    // something arrived (or stop)
+  mutable std::atomic<std::uint32_t> sleeping_{0}; // the thread waits on woken_
   dds_listener_t *listener_;
   std::function<void()> poll_;
   std::atomic<bool> stopping_{false};

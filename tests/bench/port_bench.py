@@ -216,7 +216,7 @@ class LatencyRaw:
 
 def bench_latency(args):
     rounds = 2 if args.quick else 4
-    count, warmup = (1000, 100) if args.quick else (2500, 100)  # per round
+    count, warmup = (1000, 2000) if args.quick else (2500, 2000)  # per round
     rsca = os.path.join(args.bin, "rsca")
     raw = os.path.join(args.bin, "rsca-bench-raw")
     work = tempfile.mkdtemp(prefix="rsca-portbench-")
