@@ -16,12 +16,17 @@ int main(int argc, char **argv) {
   std::string repository = "/tmp/rsca/domain";
   std::string level = "info";
   int registration_ms = 10000;
+  int call_ms = 5000;
   app.add_option("--dmd", dmd, "The domain's DMD; its name names the domain")
       ->check(CLI::ExistingFile);
   app.add_option("--repository", repository, "Where installed applications are kept")
       ->capture_default_str();
   app.add_option("--registration-timeout-ms", registration_ms,
                  "How long a launch waits for its components to register")
+      ->capture_default_str();
+  app.add_option("--call-timeout-ms", call_ms,
+                 "How long the domain waits for a node or component to answer a call")
+      ->check(CLI::PositiveNumber)
       ->capture_default_str();
   app.add_option("--log-level", level, "trace, debug, info, warn, error")->capture_default_str();
   std::string strategy = "pack";
@@ -36,6 +41,7 @@ int main(int argc, char **argv) {
   rsca::domain::DomainOptions options;
   options.repository = repository;
   options.registration_timeout = std::chrono::milliseconds(registration_ms);
+  options.call_timeout = std::chrono::milliseconds(call_ms);
   options.strategy = *rsca::allocator::parse_strategy(strategy);
   if (!dmd.empty()) {
     rsca::profile::ProfileLoader loader;

@@ -561,10 +561,12 @@ def bench_fanout(args):
     try:
         lease = {"RSCA_DDS_LEASE_MS": str(args.lease_ms)} if args.lease_ms else {}
         results["dds_lease_ms"] = args.lease_ms or "default"
-        # The domain waits up to a minute (not 10 s) for a launched component to register: with
-        # 50 and more component processes, discovery of a new one takes longer (FANOUT_LEASE_MS).
+        # The domain waits up to a minute (not 10 s) for a launched component to register, and 30 s
+        # (not 5 s) for its answers: with 50 and more component processes, discovery of a new one
+        # takes longer (FANOUT_LEASE_MS, docs/architecture.md on discovery cost).
         with Domain(rsca, nodes=2, sdrroot=SDRROOT, env=lease,
-                    domaind_args=["--registration-timeout-ms", "60000"]) as domain:
+                    domaind_args=["--registration-timeout-ms", "60000",
+                                  "--call-timeout-ms", "30000"]) as domain:
             results["payload_bytes"] = raw_sizes(raw, domain.env)["event_bytes"]
             qos = {}  # until the domain gave one: the same defaults (dds/port_qos.hpp)
             for n in counts:
