@@ -99,7 +99,7 @@ Context context_of(const ExecParams &p) {
 Expected<std::shared_ptr<control::Endpoint>>
 open_endpoint(const HostParams &host, std::shared_ptr<dds::Participant> participant) {
   control::EndpointOptions options{
-      .workers = 4, .senders = 2, .on_announcement = {}, .aliases = {}};
+      .workers = 4, .senders = 2, .on_announcement = {}, .aliases = {}, .prepare_kinds = {}};
   for (const auto &h : host.components)
     options.aliases.push_back(h.params.control_address);
   auto endpoint = control::Endpoint::open(std::move(participant), host.control_address, options);

@@ -175,6 +175,9 @@ Expected<void> Host::open(std::shared_ptr<dds::Participant> participant,
   serve("component.status", &Host::op_status);
   serve("component.await_matched", &Host::op_await_matched);
   serve("component.release", &Host::op_release);
+  // The domain calls next (initialize): the way back to it is made before it asks.
+  const std::string domain = c().context().domain.empty() ? "rsca" : c().context().domain;
+  endpoint_->prepare_replies(domain + "/domain");
   std::lock_guard lock(lifecycle_);
   return endpoint_->announce(address_, "component", announcement());
 }

@@ -35,7 +35,7 @@ InProcessComponent::open(const Factory &factory, Context context,
   // A device in its node gets an endpoint of its own with few threads: its operations come one
   // at a time, and one more worker serves a call while another waits (component.await_matched).
   const control::EndpointOptions options{
-      .workers = 2, .senders = 1, .on_announcement = {}, .aliases = {}};
+      .workers = 2, .senders = 1, .on_announcement = {}, .aliases = {}, .prepare_kinds = {}};
   if (auto opened =
           host->open(std::move(participant), std::move(endpoint), std::move(on_released), options);
       !opened)

@@ -1,5 +1,6 @@
 #include "control/endpoint.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <condition_variable>
 #include <deque>
@@ -434,6 +435,10 @@ void Endpoint::Impl::take_announcements() {
       } else {
         continue;
       }
+      if (event.kind == AnnouncementEvent::Kind::Alive &&
+          std::find(options.prepare_kinds.begin(), options.prepare_kinds.end(),
+                    event.endpoint_kind) != options.prepare_kinds.end())
+        writer_for(request_writers, request_topic.get(), event.address); // not waited for
       handler(event);
     }
     dds_return_loan(announcement_reader.get(), samples, n);
@@ -729,6 +734,12 @@ void Endpoint::prepare(const std::string &target) {
                                       impl_->route_of(target));
       !writer)
     spdlog::debug("preparing the way to {}: {}", target, writer.error().message);
+}
+
+void Endpoint::prepare_replies(const std::string &caller) {
+  if (auto writer = impl_->writer_for(impl_->reply_writers, impl_->reply_topic.get(), caller);
+      !writer)
+    spdlog::debug("preparing replies to {}: {}", caller, writer.error().message);
 }
 
 void Endpoint::abandon(const std::string &target, const std::string &why) {

@@ -79,6 +79,9 @@ struct EndpointOptions {
   AnnouncementHandler on_announcement;
   // More addresses this endpoint serves, fixed at open (a DDS partition each).
   std::vector<std::string> aliases;
+  // Announced endpoints of these kinds get their way prepared (see prepare) as soon as they are
+  // announced: the first call to a node then does not wait for DDS to match a new writer.
+  std::vector<std::string> prepare_kinds;
 };
 
 // One call of many made at once (Endpoint::call_all).
@@ -129,6 +132,9 @@ public:
   // Creates the way to `target` ahead of the first call, so that DDS discovery of an endpoint
   // that is about to appear overlaps with whatever happens before that call.
   void prepare(const std::string &target);
+  // The same for the replies to `caller` (the domain, for a node or component), whose first
+  // call then does not wait for DDS to match a new reply writer.
+  void prepare_replies(const std::string &caller);
   // Fails every call to `target` under way, saying `why`: its caller knows the addressee is dead
   // (its node saw it exit) sooner than DDS would (the addressee's lease).
   void abandon(const std::string &target, const std::string &why);

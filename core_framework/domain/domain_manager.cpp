@@ -1020,7 +1020,8 @@ DomainManager::create(std::shared_ptr<dds::Participant> participant, DomainOptio
       {.workers = 16,
        .senders = 4,
        .on_announcement = [raw](const control::AnnouncementEvent &e) { raw->on_announcement(e); },
-       .aliases = {}});
+       .aliases = {},
+       .prepare_kinds = {"node"}});
   if (!endpoint)
     return tl::unexpected(endpoint.error());
   impl->endpoint = std::move(*endpoint);

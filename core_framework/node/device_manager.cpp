@@ -218,6 +218,10 @@ DeviceManager::create(std::shared_ptr<dds::Participant> participant, NodeOptions
   if (auto ok = impl->start_devices(registry); !ok)
     return tl::unexpected(ok.error());
   impl->serve();
+  // The domain is the node's caller, and the node calls it: both ways are made now, so the
+  // first launch does not wait for DDS to match them.
+  impl->endpoint->prepare(impl->options.domain_name + "/domain");
+  impl->endpoint->prepare_replies(impl->options.domain_name + "/domain");
   if (auto ok = impl->endpoint->announce("node", impl->announcement()); !ok)
     return tl::unexpected(ok.error());
   spdlog::info("node {} announced with {} device(s)", impl->dcd->name, impl->devices.size());

@@ -86,7 +86,8 @@ public:
         {.workers = 2,
          .senders = 4,
          .on_announcement = [events = announcements_](const auto &e) { events->on_event(e); },
-         .aliases = {}});
+         .aliases = {},
+         .prepare_kinds = {}});
     REQUIRE(endpoint.has_value());
     endpoint_ = std::move(*endpoint);
   }

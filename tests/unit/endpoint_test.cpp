@@ -160,7 +160,8 @@ TEST_CASE("announcements are seen, updated and withdrawn", "[control]") {
                              events.push_back(e);
                              cv.notify_all();
                            },
-                       .aliases = {}});
+                       .aliases = {},
+                       .prepare_kinds = {}});
   auto wait_for = [&](auto predicate) {
     std::unique_lock lock(m);
     return cv.wait_for(lock, 5s, [&] { return predicate(events); });

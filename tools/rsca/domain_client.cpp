@@ -24,7 +24,8 @@ Expected<DomainClient> DomainClient::connect(const GlobalOptions &global) {
   const std::string address =
       fmt::format("{}/cli/{}-{}-{}", global.domain, host, getpid(), ++counter);
   auto endpoint = control::Endpoint::open(
-      *participant, address, {.workers = 1, .senders = 4, .on_announcement = {}, .aliases = {}});
+      *participant, address,
+      {.workers = 1, .senders = 4, .on_announcement = {}, .aliases = {}, .prepare_kinds = {}});
   if (!endpoint)
     return tl::unexpected(endpoint.error());
   DomainClient client;
