@@ -176,8 +176,7 @@ Expected<void> Host::open(std::shared_ptr<dds::Participant> participant,
   serve("component.await_matched", &Host::op_await_matched);
   serve("component.release", &Host::op_release);
   // The domain calls next (initialize): the way back to it is made before it asks.
-  const std::string domain = c().context().domain.empty() ? "rsca" : c().context().domain;
-  endpoint_->prepare_replies(domain + "/domain");
+  endpoint_->prepare_replies(domain_address());
   std::lock_guard lock(lifecycle_);
   return endpoint_->announce(address_, "component", announcement());
 }
@@ -203,7 +202,7 @@ void Host::serve(const std::string &operation, Operation op) {
       [this, op](const Json &body, const control::RequestContext &context) -> CallResult<Json> {
         log().debug("{} from {}", context.operation, context.sender);
         try {
-          return (this->*op)(body);
+          return (this->*op)(body, context);
         } catch (const nlohmann::json::exception &e) {
           return control::call_error(Status::BadRequest, e.what());
         } catch (const std::exception &e) {
@@ -220,7 +219,7 @@ Expected<void> Host::bring_up(const Json &properties) {
         std::tuple{"start", &Host::op_start, Json::object()}}) {
     if (std::string_view(name) == "configure" && properties.empty())
       continue;
-    if (auto ok = (this->*operation)(body); !ok)
+    if (auto ok = (this->*operation)(body, control::RequestContext{}); !ok)
       return make_error({where, 0, 0}, name, ok.error().message);
   }
   return {};
@@ -291,6 +290,12 @@ void Host::watch_connections() {
                                   [](const auto &port) { return port->watched(); }));
 }
 
+// The domain daemon's address (DOMAIN_NAME, rsca when not given).
+std::string Host::domain_address() const {
+  const auto &domain = c().context().domain;
+  return (domain.empty() ? std::string("rsca") : domain) + "/domain";
+}
+
 void Host::report_problems(std::vector<ConnectionProblem> problems) {
   for (const auto &p : problems)
     unreported_problems_[{p.connection, p.problem}] += p.count;
@@ -298,11 +303,10 @@ void Host::report_problems(std::vector<ConnectionProblem> problems) {
   if (unreported_problems_.empty() || now - last_problem_report_ < std::chrono::seconds(1))
     return;
   last_problem_report_ = now;
-  const std::string domain = c().context().domain.empty() ? "rsca" : c().context().domain;
   for (const auto &[key, count] : unreported_problems_) {
     log().warn("connection {}: {} ({} times)", key.first, key.second, count);
     // Not waited for: the receive thread never blocks on the domain.
-    endpoint_->call(domain + "/domain", "domain.connection_problem",
+    endpoint_->call(domain_address(), "domain.connection_problem",
                     Json{{"application", c().context().application},
                          {"component", c().context().name},
                          {"connection", key.first},
@@ -378,7 +382,7 @@ void Host::service_loop() {
 
 // ---- Operations
 
-CallResult<Json> Host::op_initialize(const Json &) {
+CallResult<Json> Host::op_initialize(const Json &, const control::RequestContext &) {
   std::lock_guard lock(lifecycle_);
   if (c().state() == State::Released)
     return control::call_error(Status::Unavailable, "the component is released");
@@ -393,7 +397,7 @@ CallResult<Json> Host::op_initialize(const Json &) {
   return Json::object();
 }
 
-CallResult<Json> Host::op_configure(const Json &body) {
+CallResult<Json> Host::op_configure(const Json &body, const control::RequestContext &) {
   auto it = body.find("properties");
   if (it == body.end())
     return control::call_error(Status::BadRequest, "the request needs \"properties\"");
@@ -415,7 +419,7 @@ CallResult<Json> Host::op_configure(const Json &body) {
   return Json::object();
 }
 
-CallResult<Json> Host::op_query(const Json &body) {
+CallResult<Json> Host::op_query(const Json &body, const control::RequestContext &) {
   auto ids = ids_field(body);
   if (!ids)
     return tl::unexpected(ids.error());
@@ -426,7 +430,7 @@ CallResult<Json> Host::op_query(const Json &body) {
   return Json{{"properties", std::move(*values)}};
 }
 
-CallResult<Json> Host::op_connect(const Json &body) {
+CallResult<Json> Host::op_connect(const Json &body, const control::RequestContext &) {
   auto connection = string_field(body, "connection");
   auto port_name = string_field(body, "port");
   auto direction = string_field(body, "direction");
@@ -476,7 +480,7 @@ CallResult<Json> Host::op_connect(const Json &body) {
   return Json::object();
 }
 
-CallResult<Json> Host::op_disconnect(const Json &body) {
+CallResult<Json> Host::op_disconnect(const Json &body, const control::RequestContext &) {
   auto connection = string_field(body, "connection");
   if (!connection)
     return tl::unexpected(connection.error());
@@ -495,7 +499,7 @@ CallResult<Json> Host::op_disconnect(const Json &body) {
   return Json::object();
 }
 
-CallResult<Json> Host::op_start(const Json &) {
+CallResult<Json> Host::op_start(const Json &, const control::RequestContext &) {
   std::lock_guard lock(lifecycle_);
   switch (c().state()) {
   case State::Released:
@@ -527,7 +531,7 @@ void Host::stop_component() {
     port->quiesce();
 }
 
-CallResult<Json> Host::op_stop(const Json &) {
+CallResult<Json> Host::op_stop(const Json &, const control::RequestContext &) {
   std::lock_guard lock(lifecycle_);
   if (c().state() != State::Started)
     return Json::object();
@@ -543,7 +547,7 @@ CallResult<Json> Host::op_stop(const Json &) {
   return Json::object();
 }
 
-CallResult<Json> Host::op_status(const Json &) {
+CallResult<Json> Host::op_status(const Json &, const control::RequestContext &) {
   Json ports = Json::array();
   for (const auto &port : c().ports_) {
     Json connections = Json::array();
@@ -565,7 +569,9 @@ CallResult<Json> Host::op_status(const Json &) {
 // Waits, bounded, until each named connection has matched the peers the domain expects: a
 // launch starts its components only once their first samples will find their readers. Replies
 // with what each connection matched; "complete" says whether all got there in time.
-CallResult<Json> Host::op_await_matched(const Json &body) {
+// The time counts from the request's arrival: in a batch for a whole host, the awaits of one
+// component after another all end within the caller's timeout.
+CallResult<Json> Host::op_await_matched(const Json &body, const control::RequestContext &context) {
   struct Awaited {
     const PortBase *port;
     std::string connection;
@@ -581,7 +587,7 @@ CallResult<Json> Host::op_await_matched(const Json &body) {
     awaited.push_back({port, entry.value("connection", ""), entry.value("peers", 1)});
   }
   const auto deadline =
-      std::chrono::steady_clock::now() + std::chrono::milliseconds(body.value("timeout_ms", 2000));
+      context.received + std::chrono::milliseconds(body.value("timeout_ms", 2000));
   auto all_matched = [&awaited] {
     bool all = true;
     for (auto &a : awaited) {
@@ -608,7 +614,7 @@ CallResult<Json> Host::op_await_matched(const Json &body) {
   return Json{{"complete", complete}, {"connections", std::move(connections)}};
 }
 
-CallResult<Json> Host::op_release(const Json &) {
+CallResult<Json> Host::op_release(const Json &, const control::RequestContext &) {
   shutdown("component.release");
   return Json::object();
 }

@@ -58,7 +58,7 @@ public:
   void close();
 
 private:
-  using Operation = CallResult<Json> (Host::*)(const Json &);
+  using Operation = CallResult<Json> (Host::*)(const Json &, const control::RequestContext &);
 
   Expected<void> check_ports() const;
   void serve(const std::string &operation, Operation op);
@@ -67,6 +67,7 @@ private:
   PortBase *find_port(const std::string &name) const;
   void poll_ports();
   void watch_connections();
+  std::string domain_address() const;
   // Tells the domain of connection problems, at most once a second (only the receive thread).
   void report_problems(std::vector<ConnectionProblem> problems);
   void configure_thread(std::thread &thread, std::string_view prefix);
@@ -75,16 +76,16 @@ private:
   void service_loop();
   void stop_component();
 
-  CallResult<Json> op_initialize(const Json &body);
-  CallResult<Json> op_configure(const Json &body);
-  CallResult<Json> op_query(const Json &body);
-  CallResult<Json> op_connect(const Json &body);
-  CallResult<Json> op_disconnect(const Json &body);
-  CallResult<Json> op_start(const Json &body);
-  CallResult<Json> op_stop(const Json &body);
-  CallResult<Json> op_status(const Json &body);
-  CallResult<Json> op_await_matched(const Json &body);
-  CallResult<Json> op_release(const Json &body);
+  CallResult<Json> op_initialize(const Json &body, const control::RequestContext &context);
+  CallResult<Json> op_configure(const Json &body, const control::RequestContext &context);
+  CallResult<Json> op_query(const Json &body, const control::RequestContext &context);
+  CallResult<Json> op_connect(const Json &body, const control::RequestContext &context);
+  CallResult<Json> op_disconnect(const Json &body, const control::RequestContext &context);
+  CallResult<Json> op_start(const Json &body, const control::RequestContext &context);
+  CallResult<Json> op_stop(const Json &body, const control::RequestContext &context);
+  CallResult<Json> op_status(const Json &body, const control::RequestContext &context);
+  CallResult<Json> op_await_matched(const Json &body, const control::RequestContext &context);
+  CallResult<Json> op_release(const Json &body, const control::RequestContext &context);
 
   Component &c() const { return *component_; }
   spdlog::logger &log() const { return component_->log(); }

@@ -35,10 +35,10 @@ struct DataConnection {
   std::shared_ptr<LocalTopic> local;
   std::shared_ptr<LocalInbox> inbox;
   std::chrono::nanoseconds deadline{0};
-  std::optional<std::chrono::steady_clock::time_point> last_arrival; // the receive thread's
-  std::int64_t deadline_periods_counted = 0;                         // the receive thread's
+  // The last write (uses) or arrival (provides), steady clock ns; 0: none yet.
+  std::atomic<std::int64_t> last_sample_ns{0};
   std::atomic<std::uint32_t> deadline_missed{0};
-  std::atomic<std::int64_t> last_write_ns{0}; // a writer's, on the steady clock; 0: none yet
+  std::uint32_t deadline_periods_reported = 0; // provides: of the current gap (receive thread)
   bool watched = false; // a reader with a deadline or a liveliness lease: problems to look for
 
   ~DataConnection() {
@@ -178,20 +178,6 @@ std::chrono::nanoseconds requested_deadline(const dds_qos_t *qos) {
   return std::chrono::nanoseconds{deadline};
 }
 
-// The deadline periods an in-host reader has gone without a sample since the last call, counted
-// as DDS counts a requested deadline: once a sample has arrived, each period without one.
-std::uint32_t local_deadline_misses(DataConnection &c) {
-  if (c.deadline.count() <= 0 || !c.last_arrival)
-    return 0;
-  const auto periods = (std::chrono::steady_clock::now() - *c.last_arrival) / c.deadline;
-  const auto missed = periods - c.deadline_periods_counted;
-  if (missed <= 0)
-    return 0;
-  c.deadline_periods_counted = periods;
-  c.deadline_missed.fetch_add(static_cast<std::uint32_t>(missed), std::memory_order_relaxed);
-  return static_cast<std::uint32_t>(missed);
-}
-
 // Whether a reader with this QoS can have problems to report (take_problems).
 bool has_problems_to_watch(const dds_qos_t *qos) {
   dds_liveliness_kind_t kind = DDS_LIVELINESS_AUTOMATIC;
@@ -236,16 +222,29 @@ void note_local_write(DataConnection &c) {
   if (c.deadline.count() <= 0)
     return;
   const std::int64_t now = steady_ns();
-  const std::int64_t before = c.last_write_ns.exchange(now, std::memory_order_relaxed);
+  const std::int64_t before = c.last_sample_ns.exchange(now, std::memory_order_relaxed);
   if (auto missed = periods_between(before, now, c.deadline); missed > 0)
     c.deadline_missed.fetch_add(missed, std::memory_order_relaxed);
+}
+
+// An in-host reader's requested deadline, counted as DDS counts it (once a sample has arrived,
+// each period without one): the periods of the current gap not reported yet.
+std::uint32_t local_deadline_misses(DataConnection &c) {
+  const auto periods =
+      periods_between(c.last_sample_ns.load(std::memory_order_relaxed), steady_ns(), c.deadline);
+  if (periods <= c.deadline_periods_reported)
+    return 0;
+  const std::uint32_t missed = periods - c.deadline_periods_reported;
+  c.deadline_periods_reported = periods;
+  c.deadline_missed.fetch_add(missed, std::memory_order_relaxed);
+  return missed;
 }
 
 // How often the writer (uses) or the reader's writers (provides) missed the connection's deadline.
 std::uint32_t deadline_misses(const DataConnection &c, profile::PortDirection direction) {
   if (c.in_host() && direction == profile::PortDirection::Uses) // and the current gap
     return c.deadline_missed.load(std::memory_order_relaxed) +
-           periods_between(c.last_write_ns.load(std::memory_order_relaxed), steady_ns(),
+           periods_between(c.last_sample_ns.load(std::memory_order_relaxed), steady_ns(),
                            c.deadline);
   if (c.in_host())
     return c.deadline_missed.load(std::memory_order_relaxed);
@@ -472,8 +471,8 @@ void ProvidesPort<T>::take_local(DataConnection &c, bool deliver) {
   auto arrived = c.inbox->take();
   if (arrived.empty())
     return;
-  c.last_arrival = std::chrono::steady_clock::now();
-  c.deadline_periods_counted = 0;
+  c.last_sample_ns.store(steady_ns(), std::memory_order_relaxed);
+  c.deadline_periods_reported = 0;
   c.samples.fetch_add(arrived.size(), std::memory_order_relaxed);
   if (!deliver || !callback_)
     return;

@@ -311,7 +311,8 @@ void Endpoint::Impl::take_requests() {
       if (!infos[i].valid_data)
         continue;
       const auto *r = static_cast<const rsca_ctl_Request *>(samples[i]);
-      RequestContext context{str(r->id), str(r->sender), str(r->operation), str(r->target)};
+      RequestContext context{str(r->id), str(r->sender), str(r->operation), str(r->target),
+                             Clock::now()};
       if (context.target.empty())
         context.target = address;
       Json body = parse_body(r->body);
@@ -354,8 +355,8 @@ CallResult<Json> Endpoint::Impl::run_batch(const RequestContext &context, const 
     return call_error(Status::BadRequest, "a batch needs \"calls\", an array");
   Json results = Json::array();
   for (const auto &c : *calls) {
-    RequestContext item{context.id, context.sender, c.value("operation", ""),
-                        c.value("target", "")};
+    RequestContext item{context.id, context.sender, c.value("operation", ""), c.value("target", ""),
+                        context.received};
     const Json item_body = c.value("body", Json::object());
     results.push_back(reply_json(item.operation == kBatch
                                      ? call_error(Status::BadRequest, "batches do not nest")
@@ -667,26 +668,25 @@ void Endpoint::stop_serving(const std::string &address) {
 
 std::vector<CallResult<Json>> Endpoint::call_all(const std::vector<Call> &calls,
                                                  std::chrono::milliseconds timeout) {
-  std::map<std::string, std::vector<std::size_t>> routed; // by the endpoint that serves them
+  // Calls to the addresses one endpoint serves, by that endpoint: two and more go as a batch.
+  std::map<std::string, std::vector<std::size_t>> by_endpoint;
   for (std::size_t i = 0; i < calls.size(); ++i)
-    if (auto via = impl_->route_of(calls[i].target); via != calls[i].target)
-      routed[via].push_back(i);
+    by_endpoint[impl_->route_of(calls[i].target)].push_back(i);
   std::vector<std::future<CallResult<Json>>> single(calls.size());
   std::vector<std::pair<std::vector<std::size_t>, std::future<CallResult<Json>>>> batches;
-  for (auto &[via, indexes] : routed) {
-    if (indexes.size() < 2)
+  for (auto &[via, indexes] : by_endpoint) {
+    const bool routed = via != calls[indexes.front()].target;
+    if (!routed || indexes.size() < 2) {
+      for (auto i : indexes)
+        single[i] = call(calls[i].target, calls[i].operation, calls[i].body, timeout);
       continue;
+    }
     Json items = Json::array();
     for (auto i : indexes)
       items.push_back({{"target", calls[i].target},
                        {"operation", calls[i].operation},
                        {"body", calls[i].body}});
     batches.emplace_back(indexes, call(via, kBatch, Json{{"calls", std::move(items)}}, timeout));
-  }
-  for (std::size_t i = 0; i < calls.size(); ++i) {
-    auto it = routed.find(impl_->route_of(calls[i].target));
-    if (it == routed.end() || it->second.size() < 2)
-      single[i] = call(calls[i].target, calls[i].operation, calls[i].body, timeout);
   }
   std::vector<CallResult<Json>> results(calls.size(), call_error(Status::Failed, "not made"));
   for (auto &[indexes, future] : batches) {

@@ -57,6 +57,9 @@ struct RequestContext {
   std::string sender;
   std::string operation;
   std::string target; // the address called: the endpoint's own or one of its aliases
+  // When the request arrived: a handler that waits counts its time from here, as its caller
+  // does, also when it ran late (after others of the same batch).
+  std::chrono::steady_clock::time_point received = std::chrono::steady_clock::now();
 };
 
 using Handler = std::function<CallResult<Json>(const Json &body, const RequestContext &context)>;

@@ -5,6 +5,7 @@
 #include <future>
 #include <map>
 #include <set>
+#include <unordered_map>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -92,6 +93,9 @@ public:
     app_->installed = request.installed;
     app_->profile = request.profile;
     app_->sad = request.profile->sad_path.string();
+    for (const auto &placement : request.profile->sad->placements)
+      for (const auto &ci : placement.instantiations)
+        instances_[ci.id] = {&ci, &placement, nullptr, kNone};
   }
 
   CallResult<std::shared_ptr<Application>> run() {
@@ -306,7 +310,7 @@ private:
         }
         if (properties.empty())
           continue;
-        calls.push_back({app_->find_component(ci.id)->address, "component.configure",
+        calls.push_back({component_of(ci.id)->address, "component.configure",
                          Json{{"properties", properties}}, ci.id});
       }
     }
@@ -372,7 +376,7 @@ private:
     if (target.kind == Kind::FindBy)
       return ConnectionEnd{};
     if (target.kind == Kind::ComponentInstantiation)
-      return ConnectionEnd{target.refid, port, "", app_->find_component(target.refid)->address};
+      return ConnectionEnd{target.refid, port, "", component_of(target.refid)->address};
     auto device = device_of(target);
     if (!device)
       return control::call_error(Status::BadRequest,
@@ -499,19 +503,18 @@ private:
   bool in_one_host(const ConnectionInstance &ci) const {
     if (ci.uses.component.empty() || ci.provides.component.empty())
       return false;
-    const auto *uses = app_->find_component(ci.uses.component);
-    const auto *provides = app_->find_component(ci.provides.component);
+    const auto *uses = component_of(ci.uses.component);
+    const auto *provides = component_of(ci.provides.component);
     return uses != nullptr && provides != nullptr && !uses->host.empty() &&
            uses->host == provides->host;
   }
 
   std::string repid_of(const profile::Connection &c) const {
-    const auto &sad = *request_.profile->sad;
     for (const auto *end : {&c.uses.target, &c.provides.target}) {
       if (end->kind != profile::EndpointTarget::Kind::ComponentInstantiation)
         continue;
       const profile::ComponentPlacement *placement = nullptr;
-      if (sad.find_instantiation(end->refid, &placement) == nullptr)
+      if (instantiation_of(end->refid, &placement) == nullptr)
         continue;
       const auto *pkg = request_.profile->softpkg_of(*placement);
       if (pkg == nullptr || !pkg->scd)
@@ -587,7 +590,7 @@ private:
 
   void append_execparams(const ComponentInstance &c, std::vector<std::string> &args) const {
     const profile::ComponentPlacement *placement = nullptr;
-    const auto *ci = request_.profile->sad->find_instantiation(c.id, &placement);
+    const auto *ci = instantiation_of(c.id, &placement);
     const auto *pkg = request_.profile->softpkg_of(*placement);
     for (const auto &ref : ci->properties) {
       const auto *definition = pkg->find_property(profile::refid_of(ref));
@@ -601,17 +604,38 @@ private:
   }
 
   const allocator::Placement *placement_of(const std::string &instance) const {
-    for (const auto &p : app_->plan.placements)
-      if (p.instance == instance)
-        return &p;
-    return nullptr;
+    auto it = instances_.find(instance);
+    return it != instances_.end() ? it->second.planned : nullptr;
+  }
+
+  // The SAD's instantiation of that id, and the placement holding it; nullptr when none.
+  const profile::ComponentInstantiation *
+  instantiation_of(const std::string &instance,
+                   const profile::ComponentPlacement **placement = nullptr) const {
+    auto it = instances_.find(instance);
+    if (it == instances_.end())
+      return nullptr;
+    if (placement != nullptr)
+      *placement = it->second.placement;
+    return it->second.instantiation;
+  }
+
+  ComponentInstance *component_of(const std::string &instance) const {
+    auto it = instances_.find(instance);
+    return it == instances_.end() || it->second.component == kNone
+               ? nullptr
+               : &app_->components[it->second.component];
   }
 
   void build_components() {
     const auto &sad = *request_.profile->sad;
+    app_->components.reserve(app_->plan.placements.size());
     for (const auto &p : app_->plan.placements) {
-      const profile::ComponentPlacement *placement = nullptr;
-      const auto *ci = sad.find_instantiation(p.instance, &placement);
+      auto &indexed = instances_.at(p.instance);
+      indexed.planned = &p;
+      indexed.component = app_->components.size();
+      const profile::ComponentPlacement *placement = indexed.placement;
+      const auto *ci = indexed.instantiation;
       ComponentInstance c;
       c.id = p.instance;
       c.usage_name = ci->usage_name.empty() ? ci->id : ci->usage_name;
@@ -682,6 +706,18 @@ private:
 
     return fmt::format("{}", fmt::join(undone, "; "));
   }
+
+  // Per instance id: the SAD's instantiation and placement, the allocator's placement and the
+  // component (an index into app_->components), so that per-component and per-connection
+  // look-ups keep a launch linear in its size.
+  static constexpr std::size_t kNone = static_cast<std::size_t>(-1);
+  struct Instance {
+    const profile::ComponentInstantiation *instantiation = nullptr;
+    const profile::ComponentPlacement *placement = nullptr;
+    const allocator::Placement *planned = nullptr;
+    std::size_t component = kNone;
+  };
+  std::unordered_map<std::string, Instance> instances_;
 
   const DomainServices &s_;
   const LaunchRequest &request_;

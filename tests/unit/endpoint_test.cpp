@@ -1,5 +1,6 @@
 // The control plane between real DDS participants in one process, on a DDS domain of its own.
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <future>
 #include <mutex>
@@ -212,11 +213,13 @@ TEST_CASE(
   auto host = open(pp, "test/host", options);
   std::mutex m;
   std::vector<std::string> request_ids;
+  std::vector<std::chrono::steady_clock::time_point> received;
   for (const std::string name : {"a", "b"})
     host->on("test/host/" + name, "who",
              [&, name](const Json &, const control::RequestContext &ctx) {
                std::lock_guard lock(m);
                request_ids.push_back(ctx.id);
+               received.push_back(ctx.received);
                return control::CallResult<Json>(Json{{"me", name}, {"target", ctx.target}});
              });
   auto client = open(pp, "test/client");
@@ -232,6 +235,7 @@ TEST_CASE(
   client->route("test/host/b", "test/host");
   client->route("test/host/c", "test/host");
   request_ids.clear();
+  received.clear();
   auto results = client->call_all({{"test/host/a", "who", Json::object()},
                                    {"test/host/b", "who", Json::object()},
                                    {"test/host/a", "nope", Json::object()},
@@ -249,12 +253,36 @@ TEST_CASE(
   CHECK_THAT(results[3].error().message, Catch::Contains("test/host/c does not serve"));
   REQUIRE(request_ids.size() == 2);
   CHECK(request_ids[0] == request_ids[1]);
+  // Both count their time from the batch's arrival, although the second ran after the first.
+  REQUIRE(received.size() == 2);
+  CHECK(received[0] == received[1]);
+
+  // Bad input: a batch without calls, a batch inside a batch.
+  auto malformed = client->call_sync("test/host", "endpoint.batch", Json::object(), 5s);
+  REQUIRE_FALSE(malformed.has_value());
+  CHECK(malformed.error().status == Status::BadRequest);
+  CHECK(malformed.error().message == "a batch needs \"calls\", an array");
+  auto nested = client->call_sync(
+      "test/host", "endpoint.batch",
+      Json{{"calls", {{{"target", "test/host/a"}, {"operation", "endpoint.batch"}}}}}, 5s);
+  REQUIRE(nested.has_value());
+  CHECK(nested->at("results")[0].at("error") == "batches do not nest");
 
   // A single routed call goes on its own, through the host's partition.
   auto single = client->call_all({{"test/host/a", "who", Json::object()}}, 5s);
   REQUIRE(single.size() == 1);
   REQUIRE(single[0].has_value());
   CHECK(single[0]->at("target") == "test/host/a");
+}
+
+TEST_CASE("an alias that is not a valid address is refused at open", "[control]") {
+  auto pp = test::participant();
+  control::EndpointOptions options;
+  options.aliases = {"test/host/a", "test/host/*"};
+  auto endpoint = Endpoint::open(pp, "test/host", options);
+  REQUIRE_FALSE(endpoint.has_value());
+  CHECK_THAT(endpoint.error().to_string(),
+             Catch::Contains("\"test/host/*\" is not a valid endpoint address"));
 }
 
 TEST_CASE("stop_serving waits for the address's running handler, then the address is not served",
