@@ -5,6 +5,7 @@
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 
+#include "common/process_priority.hpp"
 #include "common/termination_signals.hpp"
 #include "dds/participant.hpp"
 #include "gpp/gpp_device.hpp"
@@ -24,7 +25,8 @@ std::filesystem::path own_folder() {
 } // namespace
 
 int main(int argc, char **argv) {
-  rsca::TerminationSignals signals; // before any thread exists
+  const int nice = rsca::run_above_applications(); // before any thread exists
+  rsca::TerminationSignals signals;                // before any thread exists
   CLI::App app{"rsca-noded — an rsca node daemon (DeviceManager)"};
   rsca::node::NodeOptions options;
   std::string dcd, sdrroot, level = "info";
@@ -41,6 +43,7 @@ int main(int argc, char **argv) {
   CLI11_PARSE(app, argc, argv);
   spdlog::set_level(spdlog::level::from_str(level));
   spdlog::set_pattern("%Y-%m-%dT%H:%M:%S.%e %^%l%$ noded: %v");
+  spdlog::info("running at nice {} (components at 0)", nice);
 
   options.dcd = dcd;
   if (!sdrroot.empty())

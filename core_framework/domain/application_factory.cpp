@@ -280,7 +280,7 @@ private:
     std::vector<std::string> addresses;
     for (const auto &c : app_->components)
       addresses.push_back(c.address);
-    auto ok = s_.components->wait_registered(addresses, Clock::now() + s_.registration_timeout);
+    auto ok = s_.components->wait_registered(addresses, s_.registration_timeout);
     if (!ok)
       return ok;
     for (auto &c : app_->components)

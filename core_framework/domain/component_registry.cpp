@@ -39,8 +39,18 @@ void ComponentRegistry::announced(const std::string &address, const nlohmann::js
   changed_.notify_all();
 }
 
+// Not an exit: under load a participant's DDS lease can run out while its process lives on, and
+// its endpoint comes back with its next announcement. Exits come from the node (exited) or with
+// the node itself (node_gone).
 void ComponentRegistry::gone(const std::string &address) {
-  exited(address, "its endpoint disappeared");
+  {
+    std::lock_guard lock(mutex_);
+    auto it = entries_.find(address);
+    if (it == entries_.end())
+      return;
+    it->second.registered = false;
+  }
+  changed_.notify_all();
 }
 
 void ComponentRegistry::exited(const std::string &address, const std::string &why) {
@@ -76,32 +86,45 @@ std::optional<nlohmann::json> ComponentRegistry::announcement(const std::string 
 
 control::CallResult<void>
 ComponentRegistry::wait_registered(const std::vector<std::string> &addresses,
-                                   std::chrono::steady_clock::time_point deadline) {
+                                   std::chrono::milliseconds quiet) {
   std::unique_lock lock(mutex_);
   std::string failure;
-  auto settled = [&] {
-    bool all = true;
+  std::size_t registered = 0;
+  // Counts the registered addresses; false as soon as one has exited.
+  auto count = [&] {
+    registered = 0;
     for (const auto &a : addresses) {
       auto it = entries_.find(a);
       if (it != entries_.end() && it->second.exited) {
         failure = fmt::format("{} exited before registering: {}", a, it->second.why);
-        return true;
+        return false;
       }
-      all = all && it != entries_.end() && it->second.registered;
+      registered += it != entries_.end() && it->second.registered ? 1 : 0;
     }
-    return all;
+    return true;
   };
-  if (!changed_.wait_until(lock, deadline, settled)) {
-    std::vector<std::string> missing;
-    for (const auto &a : addresses)
-      if (auto it = entries_.find(a); it == entries_.end() || !it->second.registered)
-        missing.push_back(a);
-    return control::call_error(control::Status::Timeout,
-                               fmt::format("not registered in time: {}", fmt::join(missing, ", ")));
+  while (count() && registered < addresses.size()) {
+    const std::size_t before = registered;
+    const bool progressed = changed_.wait_for(lock, quiet, [&] {
+      return !count() || registered == addresses.size() || registered > before;
+    });
+    if (!progressed)
+      return control::call_error(control::Status::Timeout,
+                                 fmt::format("not registered in time ({} ms without one more): {}",
+                                             quiet.count(), fmt::join(missing(addresses), ", ")));
   }
   if (!failure.empty())
     return control::call_error(control::Status::Failed, failure);
   return {};
+}
+
+std::vector<std::string>
+ComponentRegistry::missing(const std::vector<std::string> &addresses) const {
+  std::vector<std::string> out;
+  for (const auto &a : addresses)
+    if (auto it = entries_.find(a); it == entries_.end() || !it->second.registered)
+      out.push_back(a);
+  return out;
 }
 
 bool ComponentRegistry::wait_gone(const std::string &address,

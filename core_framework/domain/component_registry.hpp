@@ -21,6 +21,7 @@ public:
   // exit count. Exits of addresses nobody expects (released components) are ignored.
   void expect(const std::string &address, const std::string &node);
   void announced(const std::string &address, const nlohmann::json &body);
+  // Its endpoint disappeared from DDS: not registered until it announces itself again.
   void gone(const std::string &address);
   void exited(const std::string &address, const std::string &why);
   // The node is gone and its components with it: marks them exited, and returns their addresses.
@@ -31,14 +32,20 @@ public:
   bool registered(const std::string &address) const;
   std::optional<nlohmann::json> announcement(const std::string &address) const;
 
-  // Waits until every address has registered; fails at once when one of them exits, or at the
-  // deadline, naming which did not register.
+  // Waits until every address has registered; fails at once when one of them exits, or when
+  // `quiet` passes without one more of them registering, naming which did not. The wait is
+  // bounded by progress, not by a total: a hundred processes on a busy host register one after
+  // another for longer than any one of them may take (DDS discovery of a hundred participants
+  // on this 2-core machine takes 10 s, docs/architecture.md), yet a stuck launch still ends.
   control::CallResult<void> wait_registered(const std::vector<std::string> &addresses,
-                                            std::chrono::steady_clock::time_point deadline);
+                                            std::chrono::milliseconds quiet);
   // Waits until the address is gone or exited.
   bool wait_gone(const std::string &address, std::chrono::steady_clock::time_point deadline);
 
 private:
+  // The addresses that have not registered (called with the mutex held).
+  std::vector<std::string> missing(const std::vector<std::string> &addresses) const;
+
   struct Entry {
     bool registered = false;
     bool exited = false;

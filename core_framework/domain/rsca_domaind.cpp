@@ -3,13 +3,15 @@
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 
+#include "common/process_priority.hpp"
 #include "common/termination_signals.hpp"
 #include "dds/participant.hpp"
 #include "domain/domain_manager.hpp"
 #include "profile/profile_loader.hpp"
 
 int main(int argc, char **argv) {
-  rsca::TerminationSignals signals; // before any thread exists
+  const int nice = rsca::run_above_applications(); // before any thread exists
+  rsca::TerminationSignals signals;                // before any thread exists
   CLI::App app{"rsca-domaind — the rsca domain daemon (DomainManager, ApplicationFactory, "
                "ResourceAllocator)"};
   std::string dmd;
@@ -22,7 +24,7 @@ int main(int argc, char **argv) {
   app.add_option("--repository", repository, "Where installed applications are kept")
       ->capture_default_str();
   app.add_option("--registration-timeout-ms", registration_ms,
-                 "How long a launch waits for its components to register")
+                 "How long a launch waits for one more of its components to register")
       ->capture_default_str();
   app.add_option("--call-timeout-ms", call_ms,
                  "How long the domain waits for a node or component to answer a call")
@@ -37,6 +39,7 @@ int main(int argc, char **argv) {
   CLI11_PARSE(app, argc, argv);
   spdlog::set_level(spdlog::level::from_str(level));
   spdlog::set_pattern("%Y-%m-%dT%H:%M:%S.%e %^%l%$ domaind: %v");
+  spdlog::info("running at nice {}", nice);
 
   rsca::domain::DomainOptions options;
   options.repository = repository;

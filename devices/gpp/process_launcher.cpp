@@ -27,6 +27,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "common/process_priority.hpp"
 #include "gpp/host_info.hpp"
 
 namespace rsca::gpp {
@@ -302,8 +303,11 @@ Expected<pid_t> spawn(const ExecRequest &request, int log_fd) {
   auto argv = c_strings(arguments);
   auto envp = c_strings(environment);
   pid_t pid = 0;
-  rc = ::posix_spawn(&pid, request.executable.c_str(), actions.get(), attributes.get(), argv.data(),
-                     envp.data());
+  {
+    ApplicationPriority as_application; // the node daemon runs above what it starts
+    rc = ::posix_spawn(&pid, request.executable.c_str(), actions.get(), attributes.get(),
+                       argv.data(), envp.data());
+  }
   if (rc != 0) {
     return launch_error(
         request, fmt::format("cannot execute {}: {}", request.executable.string(), errno_text(rc)));

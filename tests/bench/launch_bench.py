@@ -10,7 +10,10 @@ component hosts (N = 10, 100, 1000), and for each launches and releases the chai
 - teardown: `rsca release`, CLI wall clock (an upper bound: it includes the CLI's own start and
   DDS discovery, about 40 ms);
 - baseline: a plain fork/exec of N processes of the same executable, started at once and waited
-  for (they exit at once: no exec parameters), the cost of process creation alone.
+  for (they exit at once: no exec parameters), the cost of process creation alone;
+- DDS baseline (processes only): `rsca-bench-raw discovery`, N processes forked at once, each with
+  a bare Cyclone DDS participant joined as a component process joins, and the time until each has
+  discovered all the others: what launching N component processes costs DDS alone.
 Growth from one N to the next says whether launch time is about linear in N.
 """
 import argparse
@@ -23,6 +26,10 @@ import time
 
 from local_domain import Domain, cpu_ticks, memory_kb, summary
 
+# How long the DDS baseline waits for N participants to discover each other: --quick stops at
+# 3 s, beyond the 2 s a launch of 100 processes has (issue 7), to stay within its two minutes.
+DISCOVERY_TIMEOUT_MS = 30000
+DISCOVERY_TIMEOUT_MS_QUICK = 3000
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 
@@ -42,6 +49,18 @@ def baseline_ms(relay, n):
     for p in procs:
         p.wait()
     return (time.perf_counter() - began) * 1e3
+
+
+def discovery_baseline(raw, n, env, timeout_ms):
+    """`rsca-bench-raw discovery` for N participants, under a discovery tag of its own."""
+    env = dict(env, RSCA_DDS_TAG=env["RSCA_DDS_TAG"] + "-discovery")
+    out = subprocess.run([raw, "discovery", "--participants", str(n), "--timeout-ms",
+                          str(timeout_ms)], env=env, capture_output=True, text=True,
+                         timeout=timeout_ms / 1000 + 60)
+    try:
+        return json.loads(out.stdout)
+    except ValueError:
+        return {"participants": n, "error": (out.stderr or out.stdout)[:300]}
 
 
 def host_footprint(domain, app):
@@ -115,6 +134,10 @@ def main():
                     n_runs = 1  # it fails on this machine (see docs/architecture.md)
                 results.append(bench_n(domain, n, hosted, n_runs, sdr,
                                        os.path.join(args.bin, "rsca-relay")))
+            if not hosted:  # with the domain down, so that only the baseline's processes run
+                results[-1]["raw_discovery"] = discovery_baseline(
+                    os.path.join(args.bin, "rsca-bench-raw"), n, domain.env,
+                    DISCOVERY_TIMEOUT_MS_QUICK if args.quick else DISCOVERY_TIMEOUT_MS)
     with open(args.out, "w") as f:
         json.dump({"launch": results}, f, indent=2)
     print("| components | as | nodes | launch (domain) median | p95 | launch (CLI) median | "
@@ -130,6 +153,18 @@ def main():
               f"{r['launch_domain_ms']['p95']:.1f} ms | {r['launch_cli_ms']['median']:.1f} ms | "
               f"{r['release_cli_ms']['median']:.1f} ms | {r['release_cli_ms']['p95']:.1f} ms | "
               f"{r['baseline_fork_exec_ms']['median']:.1f} ms |")
+    for r in results:
+        d = r.get("raw_discovery")
+        if not d:
+            continue
+        if "settled_max_ms" in d and d["settled"] == d["participants"]:
+            seen = (f"all discovered all others after {d['settled_max_ms']:.0f} ms (median "
+                    f"{d['settled_median_ms']:.0f} ms)")
+        else:
+            seen = (f"{d.get('settled', 0)} of {d['participants']} had discovered all others "
+                    f"within {d.get('timeout_ms', 0)} ms {d.get('error', '')}")
+        print(f"DDS baseline at {r['components']} processes: {d['participants']} bare Cyclone "
+              f"participants forked at once: {seen}")
     for a, b in zip(results, results[1:]):
         if a["kind"] != b["kind"] or "launch_domain_ms" not in a or "launch_domain_ms" not in b:
             continue

@@ -9,9 +9,11 @@ of the component processes they ran and of the other programs is killed by proce
 """
 import json
 import os
+import shutil
 import signal
 import statistics
 import subprocess
+import sys
 import tempfile
 import time
 
@@ -171,7 +173,7 @@ class Domain:
                                stdout=subprocess.DEVNULL, timeout=120)
         except BaseException:
             self.daemons = self.daemon_pids()
-            self.__exit__(None, None, None)
+            self.__exit__(*sys.exc_info())
             raise
         self.daemons = self.daemon_pids()
         return self
@@ -194,6 +196,11 @@ class Domain:
             except subprocess.TimeoutExpired:
                 kill_group(proc.pid)
                 proc.wait()
+        # The run folder (daemon and component logs) stays only when something went wrong.
+        if exc[0] is None:
+            shutil.rmtree(self.run_dir, ignore_errors=True)
+        else:
+            print(f"local domain: logs kept in {self.run_dir}", file=sys.stderr)
 
     def _ours(self, pid):
         """Whether `pid` still runs one of the build's programs (and is not a reused pid)."""

@@ -156,6 +156,9 @@ public:
     }
   }
 
+  // The process of node daemon `index` (from 1).
+  pid_t node_pid(int index) const { return nodes_[index - 1]->pid(); }
+
   // Every component process the nodes run now.
   std::vector<long> running_pids() {
     std::vector<long> pids;

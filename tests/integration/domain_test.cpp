@@ -2,6 +2,7 @@
 // domain of their own, driven through the CLI and the control plane. Each test checks that what
 // it launched leaves nothing behind: no component process, no allocation, no application.
 #include <signal.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -16,6 +17,21 @@
 using namespace rsca::test;
 using namespace std::chrono_literals;
 using rsca::control::Json;
+
+namespace {
+
+// The nice value of a process's main thread (/proc/PID/stat, the 19th field).
+int nice_of(long pid) {
+  std::ifstream stat(fmt::format("/proc/{}/stat", pid));
+  std::string text((std::istreambuf_iterator<char>(stat)), std::istreambuf_iterator<char>());
+  std::istringstream fields(text.substr(text.rfind(')') + 2)); // after the command name
+  std::string field;
+  for (int i = 3; i <= 19 && fields >> field; ++i) {
+  }
+  return std::stoi(field);
+}
+
+} // namespace
 
 TEST_CASE("ProducerConsumer: install, launch, data flows, configure, query, stop, release",
           "[integration][domain]") {
@@ -49,6 +65,13 @@ TEST_CASE("ProducerConsumer: install, launch, data flows, configure, query, stop
         allowed = line.substr(line.find_first_not_of(" \t", 18));
     CHECK(allowed == std::to_string(schedule.at("cpu").get<int>()));
   }
+  // The node daemons run above the components they start when they may raise their priority;
+  // the components run at the priority the nodes were started with (this test's).
+  const int ours = getpriority(PRIO_PROCESS, 0);
+  CHECK(nice_of(domain.node_pid(1)) <= ours);
+  CHECK(nice_of(domain.node_pid(2)) <= ours);
+  for (long pid : pids)
+    CHECK(nice_of(pid) == ours);
 
   // Data flows across the connection: the consumer's count grows.
   CHECK(TestDomain::wait_for([&] { return received(domain, "ProducerConsumer") > 20; }));

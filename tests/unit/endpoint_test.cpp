@@ -2,9 +2,11 @@
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <functional>
 #include <future>
 #include <mutex>
 #include <string>
+#include <thread>
 #include <unistd.h>
 #include <vector>
 
@@ -49,6 +51,47 @@ private:
   std::condition_variable cv_;
   bool open_ = false;
 };
+
+// How many writers of this participant's control plane write `topic` into `partition` (an
+// address), as DDS's built-in publication topic shows them.
+int writers_into(const std::shared_ptr<dds::Participant> &pp, const char *topic,
+                 const std::string &partition) {
+  const dds_entity_t reader =
+      dds_create_reader(pp->get(), DDS_BUILTIN_TOPIC_DCPSPUBLICATION, nullptr, nullptr);
+  REQUIRE(reader > 0);
+  void *samples[256] = {nullptr};
+  dds_sample_info_t infos[256];
+  const dds_return_t n = dds_read(reader, samples, infos, 256, 256);
+  int count = 0;
+  for (dds_return_t i = 0; i < n; ++i) {
+    const auto *w = static_cast<const dds_builtintopic_endpoint_t *>(samples[i]);
+    uint32_t names = 0;
+    char **parts = nullptr;
+    if (!infos[i].valid_data || std::string(w->topic_name) != topic ||
+        !dds_qget_partition(w->qos, &names, &parts))
+      continue;
+    for (uint32_t k = 0; k < names; ++k) {
+      count += partition == parts[k] ? 1 : 0;
+      dds_free(parts[k]);
+    }
+    dds_free(parts);
+  }
+  if (n > 0)
+    dds_return_loan(reader, samples, n);
+  dds_delete(reader);
+  return count;
+}
+
+// Polls `done` until it holds or 5 s have passed.
+bool eventually(const std::function<bool()> &done) {
+  const auto deadline = std::chrono::steady_clock::now() + 5s;
+  while (!done()) {
+    if (std::chrono::steady_clock::now() > deadline)
+      return false;
+    std::this_thread::sleep_for(10ms); // pacing the poll of a condition
+  }
+  return true;
+}
 
 control::CallResult<Json> fast(const Json &, const control::RequestContext &) {
   return Json{{"ok", true}};
@@ -202,6 +245,42 @@ TEST_CASE("the way to an endpoint can be prepared before it exists and forgotten
   reply = client->call_sync("test/later", "ping", Json::object(), 5s);
   REQUIRE(reply.has_value());
   CHECK(reply->at("pong") == true);
+}
+
+TEST_CASE("preparing makes the request or reply writer before the first call", "[control]") {
+  auto pp = test::participant();
+  auto client = open(pp, "test/client");
+  CHECK(writers_into(pp, "rsca_ctl_Request", "test/ahead") == 0);
+  client->prepare("test/ahead");
+  CHECK(writers_into(pp, "rsca_ctl_Request", "test/ahead") == 1);
+  client->prepare("test/ahead"); // made once
+  CHECK(writers_into(pp, "rsca_ctl_Request", "test/ahead") == 1);
+  CHECK(writers_into(pp, "rsca_ctl_Reply", "test/caller") == 0);
+  client->prepare_replies("test/caller");
+  CHECK(writers_into(pp, "rsca_ctl_Reply", "test/caller") == 1);
+}
+
+TEST_CASE("endpoints of a prepared kind get their way made when they announce themselves",
+          "[control]") {
+  auto pp = test::participant();
+  std::atomic<bool> saw_node{false}, saw_monitor{false};
+  control::EndpointOptions options;
+  options.prepare_kinds = {"node"};
+  options.on_announcement = [&](const control::AnnouncementEvent &event) {
+    if (event.address == "test/node1")
+      saw_node = true;
+    if (event.address == "test/monitor")
+      saw_monitor = true;
+  };
+  auto domain = open(pp, "test/domain", options);
+  auto node = open(pp, "test/node1");
+  auto monitor = open(pp, "test/monitor");
+  REQUIRE(node->announce("node", Json::object()).has_value());
+  REQUIRE(monitor->announce("monitor", Json::object()).has_value());
+  // The way is made before the announcement is handed on, so once both have been seen:
+  REQUIRE(eventually([&] { return saw_node && saw_monitor; }));
+  CHECK(writers_into(pp, "rsca_ctl_Request", "test/node1") == 1);
+  CHECK(writers_into(pp, "rsca_ctl_Request", "test/monitor") == 0);
 }
 
 TEST_CASE(
