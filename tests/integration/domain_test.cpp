@@ -141,6 +141,20 @@ TEST_CASE("a component that never registers fails the launch at register",
   CHECK(domain.running_pids().empty());
 }
 
+TEST_CASE("a launch the CLI stops waiting for is reported as possibly still under way",
+          "[integration][domain][failure]") {
+  TestDomain domain(2, /*registration_timeout_ms=*/1500);
+  domain.install("NeverRegisters");
+  // The CLI waits six of its 100 ms timeouts; the domain gives up on registration after 1.5 s.
+  auto [rc, out] = domain.cli({"--timeout-ms", "100", "launch", "NeverRegisters"});
+  CHECK(rc == 4); // a timeout
+  CHECK_THAT(out, Catch::Contains("had not finished launching NeverRegisters after 600 ms"));
+  CHECK_THAT(out, Catch::Contains("may still be under way"));
+  CHECK_THAT(out, !Catch::Contains("rsca domain up"));
+  CHECK(TestDomain::wait_for([&] { return domain.running_pids().empty(); }));
+  domain.require_clean({});
+}
+
 TEST_CASE("a property value of the wrong type is refused at install, before anything runs",
           "[integration][domain][failure]") {
   TestDomain domain;

@@ -180,11 +180,24 @@ int launch(const std::string &what, const std::string &name, bool no_start,
   const bool show_progress = !global.json && isatty(STDOUT_FILENO);
   if (show_progress)
     fmt::print("launching {}\n", application);
-  auto future =
-      client->call_async("app.create", request, std::chrono::milliseconds(global.timeout_ms) * 6);
+  const auto launch_timeout = std::chrono::milliseconds(global.timeout_ms) * 6;
+  const auto sent = std::chrono::steady_clock::now();
+  auto future = client->call_async("app.create", request, launch_timeout);
   if (show_progress)
     follow_progress(*client, launch_id, future);
   auto reply = future.get();
+  // The CLI's own deadline, not the domain's reply that a step timed out: the domain took the
+  // request (else the call fails as unavailable) but is not done with it.
+  if (!reply && reply.error().status == control::Status::Timeout &&
+      std::chrono::steady_clock::now() - sent >= launch_timeout) {
+    return report_failure(
+        global, "launch",
+        {control::Status::Timeout,
+         fmt::format("the domain had not finished launching {} after {} ms; it may still be "
+                     "under way (see `rsca ls apps`); a larger --timeout-ms waits longer (six "
+                     "times it for a launch)",
+                     application, launch_timeout.count())});
+  }
   if (!reply)
     return report_failure(global, "launch", reply.error());
   if (global.json) {

@@ -7,6 +7,7 @@
 // A ping whose echo has not come back after `timeout_ms` is sent again (counted in `resent`): the
 // first ones may be written before the echo's reader is matched, and a volatile writer does not
 // keep them for it. An echo of an earlier attempt is recognized by its timestamp and ignored.
+#include <algorithm>
 #include <atomic>
 #include <mutex>
 
@@ -68,16 +69,17 @@ private:
       done_ = true;
       return std::nullopt;
     }
-    {
-      std::lock_guard lock(mutex_);
-      const std::uint64_t now = mono_ns();
-      if (sent_at_ == 0 || now - sent_at_ > timeout_ns_) {
-        if (sent_at_ != 0)
-          ++resent_;
-        send(now);
-      }
+    std::lock_guard lock(mutex_);
+    const std::uint64_t now = mono_ns();
+    if (sent_at_ == 0 || now - sent_at_ > timeout_ns_) {
+      if (sent_at_ != 0)
+        ++resent_;
+      send(now);
     }
-    return std::chrono::milliseconds(10);
+    // Back when the ping in flight would be overdue (10 ms at the soonest): like the raw ping's
+    // loop, it does not wake while echoes come back in time. The end is seen within a timeout.
+    const std::uint64_t overdue_in = sent_at_ + timeout_ns_ - std::min(now, sent_at_ + timeout_ns_);
+    return std::chrono::nanoseconds(std::max<std::uint64_t>(overdue_in, 10'000'000u));
   }
 
   void on_echo(const Samples &echo) {
