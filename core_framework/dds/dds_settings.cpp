@@ -36,15 +36,40 @@ void replace_all(std::string &text, std::string_view key, const std::string &val
 
 } // namespace
 
+namespace {
+
+std::chrono::milliseconds env_ms_or(const std::string &name, std::chrono::milliseconds fallback) {
+  return std::chrono::milliseconds(
+      env_number_or(name.c_str(), static_cast<std::uint64_t>(fallback.count())));
+}
+
+// The timing's variables: RSCA_DDS_LEASE_MS... with prefix "RSCA_DDS_".
+std::vector<std::pair<std::string, std::string>> timing_environment(const DdsSettings::Timing &t,
+                                                                    const std::string &prefix) {
+  return {{prefix + "LEASE_MS", std::to_string(t.lease.count())},
+          {prefix + "HEARTBEAT_MS", std::to_string(t.heartbeat.count())},
+          {prefix + "WRITER_LINGER_MS", std::to_string(t.writer_linger.count())}};
+}
+
+DdsSettings::Timing timing_from_environment(DdsSettings::Timing t, const std::string &prefix) {
+  t.lease = env_ms_or(prefix + "LEASE_MS", t.lease);
+  t.heartbeat = env_ms_or(prefix + "HEARTBEAT_MS", t.heartbeat);
+  t.writer_linger = env_ms_or(prefix + "WRITER_LINGER_MS", t.writer_linger);
+  return t;
+}
+
+constexpr const char *kPrefix = "RSCA_DDS_";
+constexpr const char *kComponentPrefix = "RSCA_DDS_COMPONENT_";
+
+} // namespace
+
 DdsSettings DdsSettings::from_environment() {
   DdsSettings s;
   s.domain_id = static_cast<std::uint32_t>(env_number_or("RSCA_DDS_DOMAIN", s.domain_id));
   s.interface_name = env_or("RSCA_DDS_INTERFACE", s.interface_name);
   s.peer = env_or("RSCA_DDS_PEER", s.peer);
-  s.lease = std::chrono::milliseconds(
-      env_number_or("RSCA_DDS_LEASE_MS", static_cast<std::uint64_t>(s.lease.count())));
-  s.component_lease = std::chrono::milliseconds(env_number_or(
-      "RSCA_DDS_COMPONENT_LEASE_MS", static_cast<std::uint64_t>(s.component_lease.count())));
+  s.timing = timing_from_environment(s.timing, kPrefix);
+  s.component_timing = timing_from_environment(s.component_timing, kComponentPrefix);
   s.trace = env_or("RSCA_DDS_TRACE", s.trace);
   s.tag = env_or("RSCA_DDS_TAG", s.tag);
   // Only characters that need no escaping in the XML configuration.
@@ -59,19 +84,27 @@ DdsSettings DdsSettings::from_environment() {
 }
 
 std::vector<std::pair<std::string, std::string>> DdsSettings::environment() const {
-  return {{"RSCA_DDS_DOMAIN", std::to_string(domain_id)},
-          {"RSCA_DDS_INTERFACE", interface_name},
-          {"RSCA_DDS_PEER", peer},
-          {"RSCA_DDS_LEASE_MS", std::to_string(lease.count())},
-          {"RSCA_DDS_COMPONENT_LEASE_MS", std::to_string(component_lease.count())},
-          {"RSCA_DDS_TRACE", trace},
-          {"RSCA_DDS_TAG", tag}};
+  std::vector<std::pair<std::string, std::string>> env{
+      {"RSCA_DDS_DOMAIN", std::to_string(domain_id)},
+      {"RSCA_DDS_INTERFACE", interface_name},
+      {"RSCA_DDS_PEER", peer},
+      {"RSCA_DDS_TRACE", trace},
+      {"RSCA_DDS_TAG", tag}};
+  for (auto &variable : timing_environment(timing, kPrefix))
+    env.push_back(std::move(variable));
+  for (auto &variable : timing_environment(component_timing, kComponentPrefix))
+    env.push_back(std::move(variable));
+  return env;
+}
+
+DdsSettings DdsSettings::for_component() const {
+  DdsSettings component = *this;
+  component.timing = component_timing;
+  return component;
 }
 
 std::vector<std::pair<std::string, std::string>> DdsSettings::component_environment() const {
-  DdsSettings component = *this;
-  component.lease = component_lease;
-  return component.environment();
+  return for_component().environment();
 }
 
 std::string cyclone_config(const DdsSettings &settings) {
@@ -87,7 +120,9 @@ std::string cyclone_config(const DdsSettings &settings) {
   replace_all(text, "${PEERS}",
               unicast ? fmt::format(R"(<Peers><Peer address="{}"/></Peers>)", settings.peer) : "");
   replace_all(text, "${MAX_PARTICIPANTS}", std::to_string(settings.max_participants));
-  replace_all(text, "${LEASE}", fmt::format("{}ms", settings.lease.count()));
+  replace_all(text, "${LEASE}", fmt::format("{}ms", settings.timing.lease.count()));
+  replace_all(text, "${HEARTBEAT}", fmt::format("{}ms", settings.timing.heartbeat.count()));
+  replace_all(text, "${WRITER_LINGER}", fmt::format("{}ms", settings.timing.writer_linger.count()));
   replace_all(text, "${TRACE}", settings.trace);
   replace_all(text, "${TAG}", settings.tag);
   return text;

@@ -83,12 +83,14 @@ class Domain:
     environment of the daemons (and so of the components) and of the CLI, e.g. RSCA_DDS_* settings
     (docs/architecture.md). `env` is what other programs of the run must use to join the domain."""
 
-    def __init__(self, rsca, nodes, sdrroot=None, env=None, domaind_args=None):
+    def __init__(self, rsca, nodes, sdrroot=None, env=None, domaind_args=None, cli_args=None):
         self.rsca = rsca
         # With domaind_args (e.g. ["--registration-timeout-ms", "60000"]), the daemons are started
         # here as `rsca domain up` starts them (own session, log and pid file in the run folder,
         # the SDR root's DMD and dev/nodes/nodeI DCDs), rsca-domaind with these arguments more.
         self.domaind_args = domaind_args
+        # Global CLI options of every call through cli(), e.g. ["--timeout-ms", "30000"].
+        self.cli_args = cli_args or []
         self.spawned = []
         self.run_dir = tempfile.mkdtemp(prefix="rsca-bench-")
         # DDS domain ids up to 224: with MaxAutoParticipantIndex 600 (cyclonedds.xml) the unicast
@@ -107,8 +109,8 @@ class Domain:
 
     def cli(self, *args, check=True, timeout=600):
         started = time.perf_counter()
-        out = subprocess.run([self.rsca, "--json", *args], env=self.env, capture_output=True,
-                             text=True, timeout=timeout)
+        out = subprocess.run([self.rsca, "--json", *self.cli_args, *args], env=self.env,
+                             capture_output=True, text=True, timeout=timeout)
         elapsed = (time.perf_counter() - started) * 1e3
         if check and out.returncode != 0:
             raise RuntimeError(f"rsca {' '.join(args)} failed ({out.returncode}): "

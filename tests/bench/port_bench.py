@@ -52,6 +52,15 @@ SDRROOT = os.path.join(HERE, "profiles")
 # cores by themselves (50: ~0.8 core, 100: ~2 cores, measured); the daemons then miss their own
 # leases and the domain drops its nodes. --lease-ms 1000 runs it with the default anyway.
 FANOUT_LEASE_MS = 10000
+
+
+def lease_env(lease_ms):
+    """The environment that gives every process of the run this DDS lease: the daemons and the CLI
+    (RSCA_DDS_LEASE_MS), the components and the raw programs that stand in for them
+    (RSCA_DDS_COMPONENT_LEASE_MS). None: the project's own leases."""
+    if not lease_ms:
+        return {}
+    return {"RSCA_DDS_LEASE_MS": str(lease_ms), "RSCA_DDS_COMPONENT_LEASE_MS": str(lease_ms)}
 # A launch the domain rolled back (e.g. a component not registered within the domain's 10 s while
 # the host is busy) is tried again, this many times in all.
 LAUNCH_ATTEMPTS = 3
@@ -220,7 +229,7 @@ def bench_latency(args):
     rsca = os.path.join(args.bin, "rsca")
     raw = os.path.join(args.bin, "rsca-bench-raw")
     work = tempfile.mkdtemp(prefix="rsca-portbench-")
-    lease = {"RSCA_DDS_LEASE_MS": str(args.lease_ms)} if args.lease_ms else {}
+    lease = lease_env(args.lease_ms)
     rtts = {"rsca": array.array("Q"), "raw": array.array("Q")}
     before = host_state()
     try:
@@ -400,9 +409,9 @@ def udp_counters():
 def wait_discovery_settled(limit=30.0):
     """Waits (at most `limit` s) until the DDS discovery that the last launch set off is over:
     for 2 s no UDP datagram dropped for a full receive buffer and under 3000 datagrams/s. A new
-    participant makes every other one send its announcement to the 600 discovery ports of the
-    project's Cyclone configuration; launching more while that lasts loses discovery datagrams,
-    and a component then registers only after the next announcement period."""
+    participant leaves every other one heartbeating its discovery data to all of its readers
+    (docs/architecture.md on discovery cost); launching more while that lasts feeds the storm,
+    loses datagrams, and components then register only after a resend."""
     deadline = time.monotonic() + limit
     calm, previous = 0, udp_counters()
     while calm < 4 and time.monotonic() < deadline:
@@ -427,8 +436,8 @@ def fanout_rsca(domain, n, batch, schedule, work):
             for attempt in range(1, LAUNCH_ATTEMPTS + 1):
                 wait_discovery_settled()
                 try:
-                    _, ms = domain.cli("--timeout-ms", "60000", "launch", name, "--name",
-                                       name.lower(), "--strategy", "spread")
+                    _, ms = domain.cli("launch", name, "--name", name.lower(), "--strategy",
+                                       "spread")
                     break
                 except RuntimeError as e:  # rolled back by the domain: nothing is left of it
                     if attempt == LAUNCH_ATTEMPTS:
@@ -559,14 +568,16 @@ def bench_fanout(args):
     work = tempfile.mkdtemp(prefix="rsca-portbench-")
     results = {"schedule": vars(schedule), "subscribers": {}}
     try:
-        lease = {"RSCA_DDS_LEASE_MS": str(args.lease_ms)} if args.lease_ms else {}
+        lease = lease_env(args.lease_ms)
         results["dds_lease_ms"] = args.lease_ms or "default"
         # The domain waits up to a minute (not 10 s) for a launched component to register, and 30 s
-        # (not 5 s) for its answers: with 50 and more component processes, discovery of a new one
-        # takes longer (FANOUT_LEASE_MS, docs/architecture.md on discovery cost).
+        # (not 5 s) for its answers, and the CLI as long for the domain's: with 50 and more
+        # component processes, discovery of a new one takes longer (FANOUT_LEASE_MS,
+        # docs/architecture.md on discovery cost).
         with Domain(rsca, nodes=2, sdrroot=SDRROOT, env=lease,
                     domaind_args=["--registration-timeout-ms", "60000",
-                                  "--call-timeout-ms", "30000"]) as domain:
+                                  "--call-timeout-ms", "30000"],
+                    cli_args=["--timeout-ms", "30000"]) as domain:
             results["payload_bytes"] = raw_sizes(raw, domain.env)["event_bytes"]
             qos = {}  # until the domain gave one: the same defaults (dds/port_qos.hpp)
             for n in counts:
@@ -683,8 +694,9 @@ def main():
     parser.add_argument("--batch", type=int, default=5,
                         help="fanout: subscribers per application launched (default 5)")
     parser.add_argument("--lease-ms", type=int, default=None,
-                        help="RSCA_DDS_LEASE_MS of every process of the run, rsca and raw alike "
-                        "(fanout default 10000, latency default: the project's, 1000)")
+                        help="DDS lease of every process of the run, rsca and raw alike "
+                        "(fanout default 10000; latency default: the project's, 1000 for the "
+                        "daemons, 10000 for components and raw programs)")
     parser.add_argument("--keep", action="store_true", help="keep the raw measurement files")
     args = parser.parse_args()
     if args.lease_ms is None and args.benchmark == "fanout":

@@ -52,15 +52,58 @@ TEST_CASE("a peer from the environment cannot break the configuration's XML", "[
   CHECK(settings.peer == "127.0.0.1xa");
 }
 
-TEST_CASE("component processes get the component lease, the rest of the settings alike", "[dds]") {
+TEST_CASE("component processes get the component timing, the rest of the settings alike", "[dds]") {
+  using std::chrono::milliseconds;
   DdsSettings settings;
-  settings.lease = std::chrono::milliseconds(1000);
-  settings.component_lease = std::chrono::milliseconds(7000);
+  settings.timing = {milliseconds(1000), milliseconds(10), milliseconds(900)};
+  settings.component_timing = {milliseconds(7000), milliseconds(70), milliseconds(7)};
   settings.tag = "t1";
   const auto own = settings.environment();
   const auto component = settings.component_environment();
   CHECK(value_of(own, "RSCA_DDS_LEASE_MS") == "1000");
+  CHECK(value_of(own, "RSCA_DDS_HEARTBEAT_MS") == "10");
+  CHECK(value_of(own, "RSCA_DDS_WRITER_LINGER_MS") == "900");
   CHECK(value_of(component, "RSCA_DDS_LEASE_MS") == "7000");
+  CHECK(value_of(component, "RSCA_DDS_HEARTBEAT_MS") == "70");
+  CHECK(value_of(component, "RSCA_DDS_WRITER_LINGER_MS") == "7");
   CHECK(value_of(component, "RSCA_DDS_COMPONENT_LEASE_MS") == "7000");
   CHECK(value_of(component, "RSCA_DDS_TAG") == "t1");
+
+  const auto daemon_config = cyclone_config(settings);
+  const auto component_config = cyclone_config(settings.for_component());
+  CHECK(contains(daemon_config, "<LeaseDuration>1000ms</LeaseDuration>"));
+  CHECK(contains(daemon_config, ">10ms</HeartbeatInterval>"));
+  CHECK(contains(daemon_config, "<WriterLingerDuration>900ms</WriterLingerDuration>"));
+  CHECK(contains(component_config, "<LeaseDuration>7000ms</LeaseDuration>"));
+  CHECK(contains(component_config, ">70ms</HeartbeatInterval>"));
+  CHECK(contains(component_config, "<WriterLingerDuration>7ms</WriterLingerDuration>"));
+}
+
+TEST_CASE("both timings come from the environment, and a child process keeps them", "[dds]") {
+  const std::vector<std::pair<const char *, const char *>> variables{
+      {"RSCA_DDS_HEARTBEAT_MS", "20"},
+      {"RSCA_DDS_WRITER_LINGER_MS", "30"},
+      {"RSCA_DDS_COMPONENT_LEASE_MS", "4000"},
+      {"RSCA_DDS_COMPONENT_HEARTBEAT_MS", "200"},
+      {"RSCA_DDS_COMPONENT_WRITER_LINGER_MS", "40"}};
+  for (const auto &[name, value] : variables)
+    ::setenv(name, value, 1);
+  const auto settings = DdsSettings::from_environment();
+  for (const auto &[name, value] : variables)
+    ::unsetenv(name);
+  CHECK(settings.timing.heartbeat == std::chrono::milliseconds(20));
+  CHECK(settings.timing.writer_linger == std::chrono::milliseconds(30));
+  CHECK(settings.component_timing.lease == std::chrono::milliseconds(4000));
+  CHECK(settings.component_timing.heartbeat == std::chrono::milliseconds(200));
+  CHECK(settings.component_timing.writer_linger == std::chrono::milliseconds(40));
+  // What a node hands a component, read back there, is the component timing.
+  const auto env = settings.component_environment();
+  for (const auto &[name, value] : env)
+    ::setenv(name.c_str(), value.c_str(), 1);
+  const auto in_component = DdsSettings::from_environment();
+  for (const auto &[name, value] : env)
+    ::unsetenv(name.c_str());
+  CHECK(in_component.timing.lease == std::chrono::milliseconds(4000));
+  CHECK(in_component.timing.heartbeat == std::chrono::milliseconds(200));
+  CHECK(in_component.timing.writer_linger == std::chrono::milliseconds(40));
 }

@@ -2,9 +2,9 @@
 // the same exchanges as the benchmark components, written directly on the Cyclone C API, with the
 // same IDL types (dds/ports.idl), the same QoS (the JSON of component.connect, turned into a DDS
 // QoS by the same dds::qos_from_json) and the same Cyclone configuration (a participant made by
-// dds::Participant from the RSCA_DDS_* environment, as every rsca process does). No component
-// runtime, no control endpoint, no domain: one participant, the data readers and writers, a
-// waitset with a read condition, and dds_take with loans.
+// dds::Participant from the RSCA_DDS_* environment with the settings of a component process). No
+// component runtime, no control endpoint, no domain: one participant, the data readers and writers,
+// a waitset with a read condition, and dds_take with loans.
 //
 //   rsca-bench-raw sizes
 //   rsca-bench-raw ping --out TOPIC --in TOPIC --qos JSON --count N --warmup W --output FILE
@@ -60,13 +60,15 @@ dds_entity_t must(dds_entity_t result, const char *what) {
   return result;
 }
 
-// The process's DDS side: a participant joined like every rsca process, topics of the port types.
+// The process's DDS side: a participant joined as a component process joins (the component lease
+// and heartbeat), topics of the port types.
 struct Dds {
   std::shared_ptr<rsca::dds::Participant> participant;
   rsca::dds::Qos qos;
 
   explicit Dds(const std::string &qos_json) {
-    auto p = rsca::dds::Participant::create(rsca::dds::DdsSettings::from_environment());
+    auto p =
+        rsca::dds::Participant::create(rsca::dds::DdsSettings::from_environment().for_component());
     if (!p)
       die(p.error().to_string());
     participant = *p;
@@ -318,9 +320,8 @@ int sub(const std::string &topic, const std::string &qos, std::uint64_t capacity
 // (the project's configuration with the component lease): it writes on `report` when it has seen
 // all `participants` (itself included), the nanoseconds since `started`, then waits for SIGTERM.
 [[noreturn]] void discovery_member(std::size_t participants, std::uint64_t started, int report) {
-  auto settings = rsca::dds::DdsSettings::from_environment();
-  settings.lease = settings.component_lease;
-  auto participant = rsca::dds::Participant::create(settings);
+  auto participant =
+      rsca::dds::Participant::create(rsca::dds::DdsSettings::from_environment().for_component());
   if (!participant)
     _exit(1);
   const dds_entity_t reader =
