@@ -111,6 +111,8 @@ public:
         break;
       const auto began = Clock::now();
       detail_.clear();
+      if (request_.cancelled && request_.cancelled->load())
+        return fail(name, {Status::Failed, "cancelled before this step"});
       if (auto ok = (this->*step)(); !ok)
         return fail(name, ok.error());
       progress_({name, detail_, ms_since(began)});
@@ -280,7 +282,8 @@ private:
     std::vector<std::string> addresses;
     for (const auto &c : app_->components)
       addresses.push_back(c.address);
-    auto ok = s_.components->wait_registered(addresses, s_.registration_timeout);
+    auto ok = s_.components->wait_registered(addresses, s_.registration_timeout,
+                                             request_.cancelled.get());
     if (!ok)
       return ok;
     for (auto &c : app_->components)

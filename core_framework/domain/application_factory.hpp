@@ -4,6 +4,8 @@
 // that was done (processes, allocations, connections) and says which step failed and why.
 #pragma once
 
+#include <atomic>
+
 #include <chrono>
 #include <functional>
 #include <map>
@@ -33,6 +35,9 @@ struct LaunchRequest {
   std::map<std::string, std::string> assignments; // instance id → device id
   std::optional<allocator::Strategy> strategy;    // the domain's when not given
   bool start = true;
+  // Set while the launch runs to have it stop and roll back (ComponentRegistry::interrupt() ends
+  // a registration wait at once); checked before each step.
+  std::shared_ptr<const std::atomic<bool>> cancelled;
 };
 
 // A device's data ports as its node announced them.

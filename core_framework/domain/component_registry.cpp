@@ -86,12 +86,18 @@ std::optional<nlohmann::json> ComponentRegistry::announcement(const std::string 
 
 control::CallResult<void>
 ComponentRegistry::wait_registered(const std::vector<std::string> &addresses,
-                                   std::chrono::milliseconds quiet) {
+                                   std::chrono::milliseconds quiet,
+                                   const std::atomic<bool> *cancelled) {
   std::unique_lock lock(mutex_);
   std::string failure;
   std::size_t registered = 0;
-  // Counts the registered addresses; false as soon as one has exited.
+  // Counts the registered addresses; false as soon as one has exited or the wait is cancelled.
   auto count = [&] {
+    if (cancelled != nullptr && cancelled->load()) {
+      failure =
+          fmt::format("cancelled while {} of {} had registered", registered, addresses.size());
+      return false;
+    }
     registered = 0;
     for (const auto &a : addresses) {
       auto it = entries_.find(a);
@@ -116,6 +122,11 @@ ComponentRegistry::wait_registered(const std::vector<std::string> &addresses,
   if (!failure.empty())
     return control::call_error(control::Status::Failed, failure);
   return {};
+}
+
+void ComponentRegistry::interrupt() {
+  { std::lock_guard lock(mutex_); }
+  changed_.notify_all();
 }
 
 std::vector<std::string>

@@ -2,6 +2,7 @@
 // that a launch can wait for its components — bounded, and failing at once when one dies.
 #pragma once
 
+#include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <map>
@@ -32,13 +33,16 @@ public:
   bool registered(const std::string &address) const;
   std::optional<nlohmann::json> announcement(const std::string &address) const;
 
-  // Waits until every address has registered; fails at once when one of them exits, or when
-  // `quiet` passes without one more of them registering, naming which did not. The wait is
-  // bounded by progress, not by a total: a hundred processes on a busy host register one after
-  // another for longer than any one of them may take (DDS discovery of a hundred participants
-  // on this 2-core machine takes 10 s, docs/architecture.md), yet a stuck launch still ends.
+  // Waits until every address has registered; fails at once when one of them exits or when
+  // `cancelled` (if given) is set and interrupt() called, or when `quiet` passes without one more
+  // of them registering, naming which did not. The wait is bounded by progress, not by a total:
+  // a hundred processes on a busy host register one after another for longer than any one of
+  // them may take (docs/architecture.md on discovery cost), yet a stuck launch still ends.
   control::CallResult<void> wait_registered(const std::vector<std::string> &addresses,
-                                            std::chrono::milliseconds quiet);
+                                            std::chrono::milliseconds quiet,
+                                            const std::atomic<bool> *cancelled = nullptr);
+  // Wakes every wait, so that a wait whose `cancelled` was set ends.
+  void interrupt();
   // Waits until the address is gone or exited.
   bool wait_gone(const std::string &address, std::chrono::steady_clock::time_point deadline);
 

@@ -44,6 +44,7 @@ struct NodeRecord {
 struct LaunchProgress {
   std::vector<LaunchStep> steps;
   bool done = false;
+  std::atomic<bool> cancelled{false}; // app.cancel: the launch stops and rolls back
 };
 
 Json steps_json(const std::vector<LaunchStep> &steps) {
@@ -206,6 +207,7 @@ struct DomainManager::Impl {
   CallResult<Json> list_installed();
   CallResult<Json> create_application(const Json &body);
   CallResult<Json> progress(const Json &body);
+  CallResult<Json> cancel_launch(const Json &body);
   CallResult<std::shared_ptr<Application>> find_application(const Json &body);
   CallResult<Json> release(const Json &body);
   CallResult<Json> configure(const Json &body);
@@ -364,6 +366,7 @@ CallResult<Json> DomainManager::Impl::create_application(const Json &body) {
     launches[body.value("launch_id", request.name)] = progress;
   }
   request.start = body.value("start", true);
+  request.cancelled = std::shared_ptr<const std::atomic<bool>>(progress, &progress->cancelled);
   auto placement = placement_options(body);
   if (!placement) {
     std::lock_guard lock(mutex);
@@ -407,6 +410,27 @@ CallResult<Json> DomainManager::Impl::progress(const Json &body) {
   if (it == launches.end())
     return control::call_error(Status::NotFound, fmt::format("no launch {}", *id));
   return Json{{"steps", steps_json(it->second->steps)}, {"done", it->second->done}};
+}
+
+// A caller that stops waiting for its launch (the CLI's own deadline) cancels it, so that no
+// application it gave up on appears later: the launch rolls back at its next step, or at once
+// when it is waiting for registrations.
+CallResult<Json> DomainManager::Impl::cancel_launch(const Json &body) {
+  auto id = required<std::string>(body, "launch_id");
+  if (!id)
+    return tl::unexpected(id.error());
+  {
+    std::lock_guard lock(mutex);
+    auto it = launches.find(*id);
+    if (it == launches.end())
+      return control::call_error(Status::NotFound, fmt::format("no launch {}", *id));
+    if (it->second->done)
+      return Json{{"cancelled", false}, {"done", true}};
+    it->second->cancelled = true;
+  }
+  spdlog::info("launch {} cancelled by its caller", *id);
+  components.interrupt();
+  return Json{{"cancelled", true}, {"done", false}};
 }
 
 CallResult<std::shared_ptr<Application>> DomainManager::Impl::find_application(const Json &body) {
@@ -941,6 +965,7 @@ void DomainManager::Impl::serve() {
   bind("connection.create", &Impl::create_connection);
   bind("connection.destroy", &Impl::destroy_connection);
   bind("app.progress", &Impl::progress);
+  bind("app.cancel", &Impl::cancel_launch);
   bind("app.release", &Impl::release);
   bind("app.configure", &Impl::configure);
   bind("app.query", &Impl::query);

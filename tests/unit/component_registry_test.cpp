@@ -1,5 +1,6 @@
 // The ComponentRegistry's wait for a launch's components: done when all have registered, failed at
 // once by an exit, and timed out only after a quiet interval without one more registration.
+#include <atomic>
 #include <chrono>
 #include <string>
 #include <thread>
@@ -93,4 +94,37 @@ TEST_CASE("an endpoint that disappears is waited for again, not taken for an exi
   announcer.join();
   CHECK(ok.has_value());
   CHECK(registry.registered(addresses[0]));
+}
+
+TEST_CASE("a cancelled wait ends when interrupted, long before its quiet interval",
+          "[unit][registry]") {
+  ComponentRegistry registry;
+  auto addresses = expect_all(registry, 2);
+  registry.announced(addresses[0], nlohmann::json::object());
+  std::atomic<bool> cancelled{false};
+  std::thread canceller([&] {
+    cancelled = true;
+    registry.interrupt();
+  });
+  const auto began = std::chrono::steady_clock::now();
+  auto ok = registry.wait_registered(addresses, 1h, &cancelled);
+  canceller.join();
+  REQUIRE_FALSE(ok.has_value());
+  CHECK(ok.error().status == Status::Failed);
+  CHECK_THAT(ok.error().message, Catch::Contains("cancelled while 1 of 2 had registered"));
+  // It ended on the interrupt, not on the hour-long quiet interval.
+  CHECK(std::chrono::steady_clock::now() - began < 1h);
+}
+
+TEST_CASE("an interrupt without a cancellation leaves a wait waiting", "[unit][registry]") {
+  ComponentRegistry registry;
+  auto addresses = expect_all(registry, 1);
+  std::atomic<bool> cancelled{false};
+  std::thread other([&] {
+    registry.interrupt(); // another launch's cancel
+    registry.announced(addresses[0], nlohmann::json::object());
+  });
+  auto ok = registry.wait_registered(addresses, 10s, &cancelled);
+  other.join();
+  CHECK(ok.has_value());
 }

@@ -1,6 +1,7 @@
 // rsca install | uninstall | launch | start | stop | release | configure | query, and show APP.
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -152,6 +153,22 @@ void follow_progress(const DomainClient &client, const std::string &launch_id,
   }
 }
 
+// Asks the domain to cancel a launch the CLI stopped waiting for, so that no application the user
+// was told had not launched turns up later; says what became of it.
+std::string cancel_launch(const DomainClient &client, const std::string &launch_id,
+                          const GlobalOptions &global) {
+  // At least 2 s: a user who wants quick answers (a small --timeout-ms) still wants it cancelled.
+  const auto timeout =
+      std::max<std::chrono::milliseconds>(std::chrono::milliseconds(global.timeout_ms), 2s);
+  auto cancelled = client.call("app.cancel", Json{{"launch_id", launch_id}}, timeout);
+  if (!cancelled)
+    return fmt::format("cancelling it failed ({}): it may still be under way (see `rsca ls apps`)",
+                       cancelled.error().message);
+  if (!cancelled->value("cancelled", false))
+    return "it finished meanwhile (see `rsca ls apps`)";
+  return "the launch is cancelled: the domain rolls back what it did (see `rsca ls apps`)";
+}
+
 int launch(const std::string &what, const std::string &name, bool no_start,
            const std::vector<std::string> &assignments, const std::string &strategy,
            const GlobalOptions &global) {
@@ -190,13 +207,13 @@ int launch(const std::string &what, const std::string &name, bool no_start,
   // request (else the call fails as unavailable) but is not done with it.
   if (!reply && reply.error().status == control::Status::Timeout &&
       std::chrono::steady_clock::now() - sent >= launch_timeout) {
-    return report_failure(
-        global, "launch",
-        {control::Status::Timeout,
-         fmt::format("the domain had not finished launching {} after {} ms; it may still be "
-                     "under way (see `rsca ls apps`); a larger --timeout-ms waits longer (six "
-                     "times it for a launch)",
-                     application, launch_timeout.count())});
+    return report_failure(global, "launch",
+                          {control::Status::Timeout,
+                           fmt::format("the domain had not finished launching {} after {} ms; {}; "
+                                       "a larger --timeout-ms waits longer (six times it for a "
+                                       "launch)",
+                                       application, launch_timeout.count(),
+                                       cancel_launch(*client, launch_id, global))});
   }
   if (!reply)
     return report_failure(global, "launch", reply.error());
