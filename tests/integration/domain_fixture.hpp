@@ -230,6 +230,8 @@ public:
   }
 
   const fs::path &run_dir() const { return run_; }
+  // The environment that joins this domain (for programs a test starts itself).
+  const ChildProcess::Environment &env() const { return env_; }
 
 private:
   void launch_node(const fs::path &dcd) {

@@ -157,6 +157,34 @@ TEST_CASE("a launch the CLI stops waiting for is cancelled and rolled back",
   domain.require_clean({});
 }
 
+TEST_CASE("Ctrl-C on rsca launch cancels the launch, which rolls back",
+          "[integration][domain][failure]") {
+  TestDomain domain(2, /*registration_timeout_ms=*/60000);
+  domain.install("NeverRegisters");
+  const fs::path out = domain.run_dir() / "interrupted.out";
+  // exec: the signal goes to rsca itself, not to a shell around it.
+  ChildProcess cli("/bin/sh",
+                   {"-c", "exec \"$0\" \"$@\" > " + out.string() + " 2>&1",
+                    (kBin / "rsca").string(), "launch", "NeverRegisters"},
+                   domain.env());
+  // The launch is waiting for the registration that never comes once its process runs.
+  REQUIRE(TestDomain::wait_for([&] { return !domain.running_pids().empty(); }));
+  ::kill(cli.pid(), SIGINT);
+  const auto status = cli.wait_exit(20s);
+  std::ifstream in(out);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  INFO(text);
+  REQUIRE(status.has_value());
+  REQUIRE(WIFEXITED(*status));
+  CHECK(WEXITSTATUS(*status) == 6); // failed, rolled back
+  CHECK_THAT(text, Catch::Contains("interrupted; the launch is cancelled"));
+  CHECK_THAT(text,
+             Catch::Contains("failed at step 'register': cancelled while 1 of 2 had registered"));
+  CHECK_THAT(text, Catch::Contains("rolled back"));
+  CHECK(TestDomain::wait_for([&] { return domain.running_pids().empty(); }));
+  domain.require_clean({});
+}
+
 TEST_CASE("a property value of the wrong type is refused at install, before anything runs",
           "[integration][domain][failure]") {
   TestDomain domain;

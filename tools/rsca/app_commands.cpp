@@ -1,7 +1,9 @@
 // rsca install | uninstall | launch | start | stop | release | configure | query, and show APP.
+#include <signal.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -132,29 +134,43 @@ std::string installed_name_of(const std::string &what, const GlobalOptions &glob
 
 namespace {
 
-// Prints each launch step as the domain completes it, while the launch runs.
-void follow_progress(const DomainClient &client, const std::string &launch_id,
-                     std::future<control::CallResult<Json>> &launch) {
-  std::size_t shown = 0;
-  for (;;) {
-    const bool finished = launch.wait_for(50ms) == std::future_status::ready;
-    auto progress = client.call("app.progress", Json{{"launch_id", launch_id}}, 2s);
-    if (progress) {
-      const auto &steps = progress->at("steps");
-      for (; shown < steps.size(); ++shown) {
-        const auto &s = steps[shown];
-        const bool failed = s.value("detail", "") == "failed";
-        fmt::print("  {} {:<10} {:>8.1f} ms  {}\n", failed ? "x" : "+", s.value("step", ""),
-                   s.value("ms", 0.0), failed ? "" : s.value("detail", ""));
-      }
-    }
-    if (finished)
-      return;
+std::atomic<bool> g_interrupted{false};
+
+// Ctrl-C during a launch: noted, so that the launch is cancelled rather than the CLI killed.
+class InterruptsNoted {
+public:
+  InterruptsNoted() {
+    g_interrupted = false;
+    struct sigaction noting {};
+    noting.sa_handler = [](int) { g_interrupted = true; };
+    sigemptyset(&noting.sa_mask);
+    sigaction(SIGINT, &noting, &previous_);
+  }
+  ~InterruptsNoted() { sigaction(SIGINT, &previous_, nullptr); }
+  InterruptsNoted(const InterruptsNoted &) = delete;
+  InterruptsNoted &operator=(const InterruptsNoted &) = delete;
+
+private:
+  struct sigaction previous_ {};
+};
+
+// Prints the launch steps the domain completed since the last call (`shown` of them were).
+void print_progress(const DomainClient &client, const std::string &launch_id, std::size_t &shown) {
+  auto progress = client.call("app.progress", Json{{"launch_id", launch_id}}, 2s);
+  if (!progress)
+    return;
+  const auto &steps = progress->at("steps");
+  for (; shown < steps.size(); ++shown) {
+    const auto &s = steps[shown];
+    const bool failed = s.value("detail", "") == "failed";
+    fmt::print("  {} {:<10} {:>8.1f} ms  {}\n", failed ? "x" : "+", s.value("step", ""),
+               s.value("ms", 0.0), failed ? "" : s.value("detail", ""));
   }
 }
 
-// Asks the domain to cancel a launch the CLI stopped waiting for, so that no application the user
-// was told had not launched turns up later; says what became of it.
+// Asks the domain to cancel a launch the CLI stops waiting for (its deadline passed, or Ctrl-C),
+// so that no application the user was told had not launched turns up later; says what became of
+// it.
 std::string cancel_launch(const DomainClient &client, const std::string &launch_id,
                           const GlobalOptions &global) {
   // At least 2 s: a user who wants quick answers (a small --timeout-ms) still wants it cancelled.
@@ -167,6 +183,28 @@ std::string cancel_launch(const DomainClient &client, const std::string &launch_
   if (!cancelled->value("cancelled", false))
     return "it finished meanwhile (see `rsca ls apps`)";
   return "the launch is cancelled: the domain rolls back what it did (see `rsca ls apps`)";
+}
+
+// Waits for the launch's reply, showing its steps on a terminal. On Ctrl-C it asks the domain
+// once to cancel the launch and goes on waiting: the reply then says what was rolled back.
+control::CallResult<Json> await_launch(const DomainClient &client, const std::string &launch_id,
+                                       std::future<control::CallResult<Json>> &launch,
+                                       bool show_progress, const GlobalOptions &global) {
+  std::size_t shown = 0;
+  bool cancelling = false;
+  for (;;) {
+    const bool finished = launch.wait_for(50ms) == std::future_status::ready;
+    if (show_progress)
+      print_progress(client, launch_id, shown);
+    if (finished)
+      return launch.get();
+    if (g_interrupted && !cancelling) {
+      cancelling = true;
+      const std::string outcome = cancel_launch(client, launch_id, global);
+      if (!global.json)
+        fmt::print(stderr, "rsca launch: interrupted; {}\n", outcome);
+    }
+  }
 }
 
 int launch(const std::string &what, const std::string &name, bool no_start,
@@ -199,10 +237,9 @@ int launch(const std::string &what, const std::string &name, bool no_start,
     fmt::print("launching {}\n", application);
   const auto launch_timeout = std::chrono::milliseconds(global.timeout_ms) * 6;
   const auto sent = std::chrono::steady_clock::now();
+  InterruptsNoted interrupts;
   auto future = client->call_async("app.create", request, launch_timeout);
-  if (show_progress)
-    follow_progress(*client, launch_id, future);
-  auto reply = future.get();
+  auto reply = await_launch(*client, launch_id, future, show_progress, global);
   // The CLI's own deadline, not the domain's reply that a step timed out: the domain took the
   // request (else the call fails as unavailable) but is not done with it.
   if (!reply && reply.error().status == control::Status::Timeout &&
