@@ -208,6 +208,10 @@ struct DomainManager::Impl {
   CallResult<Json> create_application(const Json &body);
   CallResult<Json> progress(const Json &body);
   CallResult<Json> cancel_launch(const Json &body);
+  CallResult<std::shared_ptr<LaunchProgress>> find_launch(const Json &body);
+  // Marks the launch done, unless a cancel came after its last step: then false, and the caller
+  // releases what was launched.
+  bool finish_launch(LaunchProgress &progress, bool launched);
   CallResult<std::shared_ptr<Application>> find_application(const Json &body);
   CallResult<Json> release(const Json &body);
   CallResult<Json> configure(const Json &body);
@@ -380,8 +384,19 @@ CallResult<Json> DomainManager::Impl::create_application(const Json &body) {
   };
   const auto began = std::chrono::steady_clock::now();
   auto app = factory().create(request, record);
+  if (!finish_launch(*progress, app.has_value())) {
+    // Cancelled after its last step: its caller was told it would not run.
+    if (auto released = factory().release(**app); !released)
+      spdlog::warn("application {} launched as its cancel came; releasing it failed: {}",
+                   request.name, released.error().message);
+    else
+      spdlog::warn("application {} launched as its cancel came; released", request.name);
+    app = control::call_error(
+        Status::Failed,
+        fmt::format("launch of {} cancelled after its last step; released", request.name));
+    finish_launch(*progress, false);
+  }
   std::lock_guard lock(mutex);
-  progress->done = true;
   if (!app) {
     applications.erase(request.name);
     events->publish(app.error().status == Status::Rejected ? "application.rejected"
@@ -401,7 +416,7 @@ CallResult<Json> DomainManager::Impl::create_application(const Json &body) {
   return reply;
 }
 
-CallResult<Json> DomainManager::Impl::progress(const Json &body) {
+CallResult<std::shared_ptr<LaunchProgress>> DomainManager::Impl::find_launch(const Json &body) {
   auto id = required<std::string>(body, "launch_id");
   if (!id)
     return tl::unexpected(id.error());
@@ -409,28 +424,42 @@ CallResult<Json> DomainManager::Impl::progress(const Json &body) {
   auto it = launches.find(*id);
   if (it == launches.end())
     return control::call_error(Status::NotFound, fmt::format("no launch {}", *id));
-  return Json{{"steps", steps_json(it->second->steps)}, {"done", it->second->done}};
+  return it->second;
+}
+
+CallResult<Json> DomainManager::Impl::progress(const Json &body) {
+  auto launch = find_launch(body);
+  if (!launch)
+    return tl::unexpected(launch.error());
+  std::lock_guard lock(mutex);
+  return Json{{"steps", steps_json((*launch)->steps)}, {"done", (*launch)->done}};
 }
 
 // A caller that stops waiting for its launch (the CLI's own deadline) cancels it, so that no
 // application it gave up on appears later: the launch rolls back at its next step, or at once
 // when it is waiting for registrations.
 CallResult<Json> DomainManager::Impl::cancel_launch(const Json &body) {
-  auto id = required<std::string>(body, "launch_id");
-  if (!id)
-    return tl::unexpected(id.error());
+  auto launch = find_launch(body);
+  if (!launch)
+    return tl::unexpected(launch.error());
   {
     std::lock_guard lock(mutex);
-    auto it = launches.find(*id);
-    if (it == launches.end())
-      return control::call_error(Status::NotFound, fmt::format("no launch {}", *id));
-    if (it->second->done)
+    if ((*launch)->done)
       return Json{{"cancelled", false}, {"done", true}};
-    it->second->cancelled = true;
+    (*launch)->cancelled = true;
   }
-  spdlog::info("launch {} cancelled by its caller", *id);
+  spdlog::info("launch {} cancelled by its caller", body.value("launch_id", ""));
   components.interrupt();
   return Json{{"cancelled", true}, {"done", false}};
+}
+
+// Under the mutex, so that a cancel either finds the launch done (and says so) or is seen here.
+bool DomainManager::Impl::finish_launch(LaunchProgress &progress, bool launched) {
+  std::lock_guard lock(mutex);
+  if (launched && progress.cancelled)
+    return false;
+  progress.done = true;
+  return true;
 }
 
 CallResult<std::shared_ptr<Application>> DomainManager::Impl::find_application(const Json &body) {
