@@ -43,7 +43,7 @@ int main(int argc, char **argv) {
   CLI11_PARSE(app, argc, argv);
   spdlog::set_level(spdlog::level::from_str(level));
   spdlog::set_pattern("%Y-%m-%dT%H:%M:%S.%e %^%l%$ noded: %v");
-  spdlog::info("running at nice {} (components at 0)", nice);
+  spdlog::info("running at nice {} (components at {})", nice, rsca::application_nice());
 
   options.dcd = dcd;
   if (!sdrroot.empty())

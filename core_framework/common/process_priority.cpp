@@ -27,6 +27,10 @@ int run_above_applications(int nice) {
   return current_nice();
 }
 
+int application_nice() {
+  return g_application_nice;
+}
+
 ApplicationPriority::ApplicationPriority() : saved_(current_nice()) {
   if (saved_ < g_application_nice)
     ::setpriority(PRIO_PROCESS, 0, g_application_nice);

@@ -15,6 +15,9 @@ inline constexpr int kDaemonNice = -10;
 // any thread exists.
 int run_above_applications(int nice = kDaemonNice);
 
+// The nice value the process was started with, which the processes it starts get.
+int application_nice();
+
 // For its scope, the calling thread at the nice value its process was started with (before
 // run_above_applications), so that a process it starts runs as an application would; then back
 // (or left there if the process may no longer raise it).
