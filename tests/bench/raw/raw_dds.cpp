@@ -4,20 +4,24 @@
 // QoS by the same dds::qos_from_json) and the same Cyclone configuration (a participant made by
 // dds::Participant from the RSCA_DDS_* environment with the settings of a component process). No
 // component runtime, no control endpoint, no domain: one participant, the data readers and writers,
-// a waitset with a read condition, and dds_take with loans.
+// a waitset with a read condition (or, with --wake listener, the wake rsca's receive loop uses),
+// and dds_take with loans.
 //
 //   rsca-bench-raw sizes
-//   rsca-bench-raw ping --out TOPIC --in TOPIC --qos JSON --count N --warmup W --output FILE
-//   rsca-bench-raw echo --in TOPIC --out TOPIC --qos JSON            (until SIGTERM)
+//   rsca-bench-raw ping --out TOPIC --in TOPIC --qos JSON [--wake waitset|listener]
+//                       --count N --warmup W --output FILE
+//   rsca-bench-raw echo --in TOPIC --out TOPIC --qos JSON [--wake waitset|listener] (until SIGTERM)
 //   rsca-bench-raw pub --topic TOPIC --qos JSON --subscribers N --output FILE [schedule...]
 //   rsca-bench-raw sub --topic TOPIC --qos JSON --capacity N --output FILE   (until SIGTERM)
 //   rsca-bench-raw discovery --participants N --timeout-ms T
 //
 // Times, payloads and result files: tests/bench/bench_common.hpp.
 #include <fcntl.h>
+#include <linux/futex.h>
 #include <poll.h>
 #include <signal.h>
 #include <sys/resource.h>
+#include <sys/syscall.h>
 #include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
@@ -26,6 +30,7 @@
 #include <atomic>
 #include <cstdio>
 #include <cstring>
+#include <map>
 #include <set>
 #include <string>
 #include <vector>
@@ -95,18 +100,67 @@ struct Dds {
   }
 };
 
-// A waitset that wakes when `reader` has data (or every `timeout`, to look at the stop flag).
-struct Receiver {
-  dds_entity_t waitset;
-  dds_entity_t reader;
+// How the receiving thread learns that `reader` has data: a waitset with a read condition (the
+// usual way), or a data-available listener that only wakes it with a flag and a futex, the way
+// rsca's receive loop does (component/receive_loop.cpp). Either wakes every `timeout` as well,
+// to look at the stop flag.
+enum class Wake { waitset, listener };
 
-  Receiver(const Dds &dds, dds_entity_t reader_) : reader(reader_) {
-    waitset = must(dds_create_waitset(dds.participant->get()), "creating a waitset");
+class Receiver {
+public:
+  Receiver(const Dds &dds, dds_entity_t reader, Wake wake) : reader_(reader) {
+    if (wake == Wake::listener) {
+      listener_ = dds_create_listener(this);
+      dds_lset_data_available(listener_, &Receiver::on_data_available);
+      must(dds_set_listener(reader_, listener_), "setting the data-available listener");
+      return;
+    }
+    waitset_ = must(dds_create_waitset(dds.participant->get()), "creating a waitset");
     const dds_entity_t condition =
-        must(dds_create_readcondition(reader, DDS_ANY_STATE), "creating a read condition");
-    must(dds_waitset_attach(waitset, condition, reader), "attaching the read condition");
+        must(dds_create_readcondition(reader_, DDS_ANY_STATE), "creating a read condition");
+    must(dds_waitset_attach(waitset_, condition, reader_), "attaching the read condition");
   }
-  void wait(dds_duration_t timeout) const { dds_waitset_wait(waitset, nullptr, 0, timeout); }
+  ~Receiver() {
+    if (listener_ == nullptr)
+      return;
+    dds_set_listener(reader_, nullptr);
+    dds_delete_listener(listener_);
+  }
+  Receiver(const Receiver &) = delete;
+  Receiver &operator=(const Receiver &) = delete;
+
+  dds_entity_t reader() const { return reader_; }
+
+  void wait(dds_duration_t timeout) {
+    if (listener_ == nullptr) {
+      dds_waitset_wait(waitset_, nullptr, 0, timeout);
+      return;
+    }
+    if (woken_.exchange(0) != 0)
+      return;
+    sleeping_.store(1);
+    if (woken_.load() == 0) {
+      const timespec until{static_cast<time_t>(timeout / DDS_NSECS_IN_SEC),
+                           static_cast<long>(timeout % DDS_NSECS_IN_SEC)};
+      ::syscall(SYS_futex, &woken_, FUTEX_WAIT_PRIVATE, 0, &until, nullptr, 0);
+    }
+    sleeping_.store(0);
+    woken_.store(0);
+  }
+
+private:
+  static void on_data_available(dds_entity_t, void *self) {
+    auto *receiver = static_cast<Receiver *>(self);
+    receiver->woken_.store(1);
+    if (receiver->sleeping_.load() != 0)
+      ::syscall(SYS_futex, &receiver->woken_, FUTEX_WAKE_PRIVATE, 1, nullptr, nullptr, 0);
+  }
+
+  dds_entity_t reader_;
+  dds_entity_t waitset_ = 0;
+  dds_listener_t *listener_ = nullptr;
+  std::atomic<std::uint32_t> woken_{0};
+  std::atomic<std::uint32_t> sleeping_{0};
 };
 
 constexpr std::uint32_t kBatch = 32;
@@ -130,11 +184,11 @@ void write_results(const std::string &path, const std::vector<std::uint64_t> &va
 // ---- ping-pong ---------------------------------------------------------------------------------
 
 int ping(const std::string &out_topic, const std::string &in_topic, const std::string &qos,
-         std::uint64_t count, std::uint64_t warmup, std::uint64_t timeout_ms,
+         Wake wake, std::uint64_t count, std::uint64_t warmup, std::uint64_t timeout_ms,
          const std::string &output) {
   Dds dds(qos);
   const dds_entity_t writer = dds.writer(dds.topic(&rsca_port_SampleSeq_desc, out_topic));
-  Receiver in(dds, dds.reader(dds.topic(&rsca_port_SampleSeq_desc, in_topic)));
+  Receiver in(dds, dds.reader(dds.topic(&rsca_port_SampleSeq_desc, in_topic)), wake);
   double values[rsca::bench::kSampleDoubles] = {0, 0, 0};
   rsca_port_SampleSeq sample{};
   sample.stream_id = const_cast<char *>("");
@@ -156,7 +210,7 @@ int ping(const std::string &out_topic, const std::string &in_topic, const std::s
     in.wait(DDS_MSECS(10));
     void *samples[kBatch] = {nullptr};
     dds_sample_info_t infos[kBatch];
-    const dds_return_t n = dds_take(in.reader, samples, infos, kBatch, kBatch);
+    const dds_return_t n = dds_take(in.reader(), samples, infos, kBatch, kBatch);
     bool answered = false;
     std::uint64_t now = 0;
     for (dds_return_t i = 0; i < n; ++i) {
@@ -168,7 +222,7 @@ int ping(const std::string &out_topic, const std::string &in_topic, const std::s
       answered = true;
     }
     if (n > 0)
-      dds_return_loan(in.reader, samples, n);
+      dds_return_loan(in.reader(), samples, n);
     if (answered) {
       if (++completed > warmup)
         rtts.push_back(now - sent_at);
@@ -189,23 +243,31 @@ int ping(const std::string &out_topic, const std::string &in_topic, const std::s
   return completed >= target ? 0 : 1;
 }
 
-int echo(const std::string &in_topic, const std::string &out_topic, const std::string &qos) {
+// The CPU time it reports counts from the first sample on: its start-up is not part of the
+// exchange (the ping's counts from its first send).
+int echo(const std::string &in_topic, const std::string &out_topic, const std::string &qos,
+         Wake wake) {
   Dds dds(qos);
   const dds_entity_t writer = dds.writer(dds.topic(&rsca_port_SampleSeq_desc, out_topic));
-  Receiver in(dds, dds.reader(dds.topic(&rsca_port_SampleSeq_desc, in_topic)));
+  Receiver in(dds, dds.reader(dds.topic(&rsca_port_SampleSeq_desc, in_topic)), wake);
   std::uint64_t echoed = 0;
+  std::uint64_t cpu_before = 0;
   while (!g_stop) {
     in.wait(DDS_MSECS(100));
     void *samples[kBatch] = {nullptr};
     dds_sample_info_t infos[kBatch];
-    const dds_return_t n = dds_take(in.reader, samples, infos, kBatch, kBatch);
+    const dds_return_t n = dds_take(in.reader(), samples, infos, kBatch, kBatch);
+    if (n > 0 && echoed == 0)
+      cpu_before = process_cpu_us();
     for (dds_return_t i = 0; i < n; ++i)
       if (infos[i].valid_data && dds_write(writer, samples[i]) >= 0)
         ++echoed;
     if (n > 0)
-      dds_return_loan(in.reader, samples, n);
+      dds_return_loan(in.reader(), samples, n);
   }
-  std::printf("{\"echoed\": %llu}\n", static_cast<unsigned long long>(echoed));
+  const std::uint64_t cpu_us = echoed == 0 ? 0 : process_cpu_us() - cpu_before;
+  std::printf("{\"echoed\": %llu, \"cpu_us\": %llu}\n", static_cast<unsigned long long>(echoed),
+              static_cast<unsigned long long>(cpu_us));
   return 0;
 }
 
@@ -282,14 +344,14 @@ int pub(const std::string &topic, const std::string &qos, std::int32_t subscribe
 int sub(const std::string &topic, const std::string &qos, std::uint64_t capacity,
         const std::string &output) {
   Dds dds(qos);
-  Receiver in(dds, dds.reader(dds.topic(&rsca_port_PropertyEvent_desc, topic)));
+  Receiver in(dds, dds.reader(dds.topic(&rsca_port_PropertyEvent_desc, topic)), Wake::waitset);
   std::vector<std::uint64_t> received_at(capacity, 0);
   std::uint64_t received = 0, unexpected = 0;
   while (!g_stop) {
     in.wait(DDS_MSECS(100));
     void *samples[kBatch] = {nullptr};
     dds_sample_info_t infos[kBatch];
-    const dds_return_t n = dds_take(in.reader, samples, infos, kBatch, kBatch);
+    const dds_return_t n = dds_take(in.reader(), samples, infos, kBatch, kBatch);
     for (dds_return_t i = 0; i < n; ++i) {
       if (!infos[i].valid_data)
         continue;
@@ -305,7 +367,7 @@ int sub(const std::string &topic, const std::string &qos, std::uint64_t capacity
       ++received;
     }
     if (n > 0)
-      dds_return_loan(in.reader, samples, n);
+      dds_return_loan(in.reader(), samples, n);
   }
   write_results(output, received_at);
   std::printf("{\"received\": %llu, \"unexpected\": %llu}\n",
@@ -474,11 +536,16 @@ int main(int argc, char **argv) {
   ping_cmd->add_option("--warmup", warmup, "Round trips first, not measured");
   ping_cmd->add_option("--timeout-ms", timeout_ms, "Send a ping again after");
   ping_cmd->add_option("--output", output, "File of the round-trip times")->required();
+  const std::map<std::string, Wake> wakes{{"waitset", Wake::waitset}, {"listener", Wake::listener}};
+  Wake wake = Wake::waitset;
+  ping_cmd->add_option("--wake", wake, "How the receiving thread is woken")
+      ->transform(CLI::CheckedTransformer(wakes));
 
   auto *echo_cmd = app.add_subcommand("echo", "Writes back every sample, until SIGTERM");
   echo_cmd->add_option("--in", in_topic)->required();
   echo_cmd->add_option("--out", out_topic)->required();
   echo_cmd->add_option("--qos", qos);
+  echo_cmd->add_option("--wake", wake)->transform(CLI::CheckedTransformer(wakes));
 
   auto *pub_cmd = app.add_subcommand("pub", "Publishes the fan-out schedule; send times");
   pub_cmd->add_option("--topic", topic)->required();
@@ -515,9 +582,9 @@ int main(int argc, char **argv) {
   sigaction(SIGINT, &action, nullptr);
 
   if (*ping_cmd)
-    return ping(out_topic, in_topic, qos, count, warmup, timeout_ms, output);
+    return ping(out_topic, in_topic, qos, wake, count, warmup, timeout_ms, output);
   if (*echo_cmd)
-    return echo(in_topic, out_topic, qos);
+    return echo(in_topic, out_topic, qos, wake);
   if (*pub_cmd)
     return pub(topic, qos, subscribers, match_timeout_ms, schedule, output);
   if (*sub_cmd)
