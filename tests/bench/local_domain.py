@@ -220,14 +220,95 @@ class Domain:
         return pids
 
 
-class Processes:
-    """Programs started for a benchmark, each in a process group of its own; all of them are
-    stopped (SIGTERM, then SIGKILL) when it goes, also on failure."""
+# The leader of a shared session (Processes(shared_session=True)): starts programs in its session
+# on request, each in a process group of its own, and reports how they end. One JSON request per
+# line on stdin, one JSON reply per line on stdout; it exits when stdin closes.
+SESSION_LEADER = r"""
+import json, subprocess, sys
+children = {}
+for line in sys.stdin:
+    request = json.loads(line)
+    if request["op"] == "start":
+        with open(request["stdout"], "w") as out, open(request["stderr"], "w") as err:
+            child = subprocess.Popen(request["args"], env=request["env"], stdin=subprocess.DEVNULL,
+                                     stdout=out, stderr=err, process_group=0)
+        children[child.pid] = child
+        reply = child.pid
+    else:
+        try:
+            reply = children[request["pid"]].wait(timeout=request["timeout"])
+        except subprocess.TimeoutExpired:
+            reply = None
+    print(json.dumps(reply), flush=True)
+"""
 
+
+class SessionChild:
+    """A program started by a session leader: what Processes needs of a subprocess.Popen (pid,
+    poll, communicate, returncode), its stdout read from the file it went to."""
+
+    def __init__(self, leader, pid, stdout_path):
+        self.leader, self.pid, self.stdout_path = leader, pid, stdout_path
+        self.returncode = None
+
+    def _wait(self, timeout):
+        if self.returncode is None:
+            self.returncode = self.leader.ask({"op": "wait", "pid": self.pid, "timeout": timeout})
+        return self.returncode
+
+    def poll(self):
+        return self._wait(0)
+
+    def communicate(self, timeout=None):
+        if self._wait(timeout) is None:
+            raise subprocess.TimeoutExpired(str(self.pid), timeout)
+        with open(self.stdout_path) as f:
+            return f.read(), None
+
+
+class SessionLeader:
     def __init__(self):
-        self.started = []
+        self.proc = subprocess.Popen([sys.executable, "-c", SESSION_LEADER],
+                                     stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True,
+                                     start_new_session=True)
+
+    def ask(self, request):
+        self.proc.stdin.write(json.dumps(request) + "\n")
+        self.proc.stdin.flush()
+        return json.loads(self.proc.stdout.readline())
 
     def start(self, args, env, log_path):
+        stdout_path = log_path + ".out"
+        pid = self.ask({"op": "start", "args": args, "env": env, "stdout": stdout_path,
+                        "stderr": log_path})
+        return SessionChild(self, pid, stdout_path)
+
+    def close(self):
+        self.proc.stdin.close()
+        try:
+            self.proc.wait(timeout=5)
+        except subprocess.TimeoutExpired:
+            kill_group(self.proc.pid)
+            self.proc.wait()
+
+
+class Processes:
+    """Programs started for a benchmark, each in a process group of its own; all of them are
+    stopped (SIGTERM, then SIGKILL) when it goes, also on failure. Each is in a session of its own,
+    or with `shared_session` all are in one new session, as the component processes a node
+    starts share its session: with autogroup scheduling (Linux's default) a session is a
+    scheduling group, and that changes how processes that talk to each other are scheduled
+    (docs/architecture.md)."""
+
+    def __init__(self, shared_session=False):
+        self.started = []
+        self.leader = SessionLeader() if shared_session else None
+
+    def start(self, args, env, log_path):
+        if self.leader is not None:
+            proc = self.leader.start(args, env, log_path)
+            self.started.append(proc)
+            return proc
         log = open(log_path, "w")
         try:
             proc = subprocess.Popen(args, env=env, stdin=subprocess.DEVNULL,
@@ -238,7 +319,8 @@ class Processes:
         self.started.append(proc)
         return proc
 
-    def stop(self, procs, timeout=10):
+    @staticmethod
+    def stop(procs, timeout=10):
         """SIGTERM to each, then SIGKILL to what is still there after `timeout`; returns each
         one's stdout."""
         for p in procs:
@@ -259,8 +341,14 @@ class Processes:
         return self
 
     def __exit__(self, *exc):
+        self.close()
+
+    def close(self):
+        """Stops every program started, and their process groups."""
         running = [p for p in self.started if p.poll() is None]
         if running:
             self.stop(running, timeout=5)
         for p in self.started:  # their groups too: nothing they started may outlive them
             kill_group(p.pid)
+        if self.leader is not None:
+            self.leader.close()

@@ -20,13 +20,14 @@ latency: strict ping-pong between BenchPing_1 and BenchEcho_1 (uses port -> prov
   trip and the CPU time both processes spend per round trip; the output ends with the ratio lines.
 fanout: BenchPublisher_1 publishes on the event channel BenchFanOut to N BenchSubscriber_i
   processes (N = 1, 10, 50, 100; --quick: 1 and 10), raw DDS the same with one raw publisher and N
-  raw subscriber processes on one topic. Latency: events at a low rate (100 Hz), per event the time
-  until the last subscriber has it (max over subscribers of receive time minus send time), p50 and
-  p99. Sustained rate: steps of rising rates (250 to 128000 events/s, each after a pause); per
-  step, the events every subscriber received, per second from the step's first send to its last
-  receipt ("events/s to all", the best step counts), and whether any subscriber missed any
-  ("loss-free up to": the highest rate with no loss in it or below; with the default keep-last 16
-  a subscriber held up for 16 periods loses the oldest events).
+  raw subscriber processes on one topic, in two sessions as the components are in two nodes'.
+  Latency: events at a low rate (100 Hz), per event the time until the last subscriber has it
+  (max over subscribers of receive time minus send time), p50 and p99. Sustained rate: steps of
+  rising rates (250 to 128000 events/s, each after a pause); per step, the events every
+  subscriber received, per second from the step's first send to its last receipt ("events/s to
+  all", the best step counts), and whether any subscriber missed any ("loss-free up to": the
+  highest rate with no loss in it or below; with the default keep-last 16 a subscriber held up
+  for 16 periods loses the oldest events).
 
 Every process started is stopped at the end, also on failure.
 """
@@ -36,7 +37,6 @@ import copy
 import json
 import math
 import os
-import shlex
 import shutil
 import statistics
 import subprocess
@@ -190,48 +190,47 @@ class LatencyRsca:
 
 
 class LatencyRaw:
-    """Each round runs `rsca-bench-raw echo` and `rsca-bench-raw ping` together, in one session
-    of their own, as BenchPing_1 and BenchEcho_1 share the session of the node that started them.
-    The arrangement matters: with the kernel's autogroup scheduling every session is a scheduling
-    group, and a ping-pong between two groups was up to 10 us faster per round trip here than one
-    within a group (docs/architecture.md). The echo reports its CPU time from its first sample
-    on."""
+    """`rsca-bench-raw echo` for the whole run; each round runs `rsca-bench-raw ping` to its end.
+    The two share a session of their own, as BenchPing_1 and BenchEcho_1 share the session of the
+    node that started them (local_domain.Processes says why that matters)."""
 
-    def __init__(self, domain, raw, work, qos, count, warmup, procs, wake):
+    def __init__(self, domain, raw, work, qos, count, warmup, wake):
         self.domain, self.raw, self.work, self.count, self.warmup = domain, raw, work, count, warmup
-        self.procs, self.wake = procs, wake
+        self.wake = wake
+        self.procs = Processes(shared_session=True)
         self.ping_topic = f"rsca_bench_raw_ping_{wake}_{os.getpid()}"
         self.echo_topic = f"rsca_bench_raw_echo_{wake}_{os.getpid()}"
         self.qos = json.dumps(qos)
+        self.echo = self.procs.start(
+            [raw, "echo", "--in", self.ping_topic, "--out", self.echo_topic, "--qos", self.qos,
+             "--wake", wake], domain.env, os.path.join(work, f"raw-{wake}-echo.log"))
         self.cpu_us = 0.0
         self.round_trips = 0
         self.resent = 0
 
     def run(self, index):
         output = os.path.join(self.work, f"raw-{self.wake}-rtt-{index}.bin")
-        echo = [self.raw, "echo", "--in", self.ping_topic, "--out", self.echo_topic, "--qos",
-                self.qos, "--wake", self.wake]
-        ping = [self.raw, "ping", "--out", self.ping_topic, "--in", self.echo_topic, "--qos",
-                self.qos, "--wake", self.wake, "--count", str(self.count), "--warmup", str(self.warmup), "--output",
-                output]
-        # The ping's status is the round's; the echo is stopped once the ping is done.
-        script = (f"{shlex.join(echo)} & echo_pid=$!; {shlex.join(ping)}; status=$?; "
-                  "kill -TERM $echo_pid; wait $echo_pid; exit $status")
-        pair = self.procs.start(["sh", "-c", script], self.domain.env,
-                                os.path.join(self.work, f"raw-{self.wake}-{index}.log"))
+        echo_before = cpu_us(self.echo.pid)
+        ping = self.procs.start(
+            [self.raw, "ping", "--out", self.ping_topic, "--in", self.echo_topic, "--qos",
+             self.qos, "--wake", self.wake, "--count", str(self.count), "--warmup",
+             str(self.warmup), "--output", output], self.domain.env,
+            os.path.join(self.work, f"raw-{self.wake}-ping-{index}.log"))
         try:
-            out, _ = pair.communicate(timeout=60 + self.count * 0.01)
+            out, _ = ping.communicate(timeout=60 + self.count * 0.01)
         except subprocess.TimeoutExpired:
             raise RuntimeError("rsca-bench-raw ping did not finish") from None
-        if pair.returncode != 0:
-            raise RuntimeError(f"rsca-bench-raw ping failed ({pair.returncode}); see {self.work}")
-        lines = [json.loads(line) for line in out.splitlines() if line.strip()]
-        ping_summary = next(line for line in lines if "completed" in line)
-        echo_summary = next(line for line in lines if "echoed" in line)
-        self.cpu_us += ping_summary["cpu_us"] + echo_summary["cpu_us"]
-        self.round_trips += ping_summary["completed"]
-        self.resent += ping_summary["resent"]
+        if ping.returncode != 0:
+            raise RuntimeError(f"rsca-bench-raw ping failed ({ping.returncode}); see {self.work}")
+        summary_ = json.loads(out)
+        # The echo's CPU over the ping's whole life (its start-up included: the echo idles then).
+        self.cpu_us += summary_["cpu_us"] + cpu_us(self.echo.pid) - echo_before
+        self.round_trips += summary_["completed"]
+        self.resent += summary_["resent"]
         return read_u64(output)
+
+    def close(self):
+        self.procs.close()
 
 
 # The latency benchmark's sides: the rsca components, the raw programs with a waitset (the baseline
@@ -249,13 +248,13 @@ def bench_latency(args):
     rtts = {name: array.array("Q") for name in SIDES}
     before = host_state()
     try:
-        with Domain(rsca, nodes=2, sdrroot=SDRROOT, env=lease) as domain, Processes() as procs:
+        with Domain(rsca, nodes=2, sdrroot=SDRROOT, env=lease) as domain:
             sizes = raw_sizes(raw, domain.env)
             sides = {"rsca": LatencyRsca(domain, work, count, warmup)}
             try:
                 for name, wake in (("raw", "waitset"), ("raw_listener", "listener")):
                     sides[name] = LatencyRaw(domain, raw, work, sides["rsca"].qos, count, warmup,
-                                             procs, wake)
+                                             wake)
                 # Each round starts with another side: a change of the machine's load during
                 # the run falls on all alike.
                 for index in range(rounds):
@@ -263,7 +262,8 @@ def bench_latency(args):
                         name = SIDES[(index + k) % len(SIDES)]
                         rtts[name].extend(sides[name].run(index))
             finally:
-                sides["rsca"].close()
+                for side in sides.values():
+                    side.close()
     finally:
         if not args.keep:
             shutil.rmtree(work, ignore_errors=True)
@@ -495,12 +495,15 @@ def fanout_raw(domain, raw, n, schedule, qos, work):
     qos_json = json.dumps(qos)
     pub_out = os.path.join(work, "raw-pub.bin")
     subs_out = [os.path.join(work, f"raw-sub-{i}.bin") for i in range(1, n + 1)]
-    with Processes() as procs:
-        subs = [procs.start([raw, "sub", "--topic", topic, "--qos", qos_json, "--capacity",
-                             str(schedule.total()), "--output", out], domain.env,
-                            os.path.join(work, f"raw-sub-{i}.log"))
+    # Two sessions, as the rsca side's components are in the sessions of the domain's two nodes:
+    # the subscribers in halves, the publisher with the first half.
+    with Processes(shared_session=True) as first, Processes(shared_session=True) as second:
+        subs = [(first if i <= (n + 1) // 2 else second).start(
+                    [raw, "sub", "--topic", topic, "--qos", qos_json, "--capacity",
+                     str(schedule.total()), "--output", out], domain.env,
+                    os.path.join(work, f"raw-sub-{i}.log"))
                 for i, out in enumerate(subs_out, 1)]
-        pub = procs.start([raw, "pub", "--topic", topic, "--qos", qos_json, "--subscribers",
+        pub = first.start([raw, "pub", "--topic", topic, "--qos", qos_json, "--subscribers",
                            str(n), "--output", pub_out, *schedule.raw_args()], domain.env,
                           os.path.join(work, "raw-pub.log"))
         try:
@@ -510,7 +513,7 @@ def fanout_raw(domain, raw, n, schedule, qos, work):
         if pub.returncode != 0:
             raise RuntimeError(f"rsca-bench-raw pub failed ({pub.returncode}); see {work}")
         time.sleep(1.0)  # what is still in flight arrives
-        sub_outs = procs.stop(subs, timeout=30)
+        sub_outs = Processes.stop(subs, timeout=30)
     bad = [i for i, s in enumerate(subs, 1) if s.returncode != 0]
     if bad:
         raise RuntimeError(f"rsca-bench-raw sub {bad} failed; see {work}")

@@ -243,31 +243,24 @@ int ping(const std::string &out_topic, const std::string &in_topic, const std::s
   return completed >= target ? 0 : 1;
 }
 
-// The CPU time it reports counts from the first sample on: its start-up is not part of the
-// exchange (the ping's counts from its first send).
 int echo(const std::string &in_topic, const std::string &out_topic, const std::string &qos,
          Wake wake) {
   Dds dds(qos);
   const dds_entity_t writer = dds.writer(dds.topic(&rsca_port_SampleSeq_desc, out_topic));
   Receiver in(dds, dds.reader(dds.topic(&rsca_port_SampleSeq_desc, in_topic)), wake);
   std::uint64_t echoed = 0;
-  std::uint64_t cpu_before = 0;
   while (!g_stop) {
     in.wait(DDS_MSECS(100));
     void *samples[kBatch] = {nullptr};
     dds_sample_info_t infos[kBatch];
     const dds_return_t n = dds_take(in.reader(), samples, infos, kBatch, kBatch);
-    if (n > 0 && echoed == 0)
-      cpu_before = process_cpu_us();
     for (dds_return_t i = 0; i < n; ++i)
       if (infos[i].valid_data && dds_write(writer, samples[i]) >= 0)
         ++echoed;
     if (n > 0)
       dds_return_loan(in.reader(), samples, n);
   }
-  const std::uint64_t cpu_us = echoed == 0 ? 0 : process_cpu_us() - cpu_before;
-  std::printf("{\"echoed\": %llu, \"cpu_us\": %llu}\n", static_cast<unsigned long long>(echoed),
-              static_cast<unsigned long long>(cpu_us));
+  std::printf("{\"echoed\": %llu}\n", static_cast<unsigned long long>(echoed));
   return 0;
 }
 
