@@ -77,6 +77,15 @@ def wait_gone(pids, timeout):
     return not any(alive(p) for p in pids)
 
 
+def dds_env():
+    """The environment of a benchmark run's DDS programs: a DDS domain id and discovery tag of
+    the run's own, so that nothing else on the host takes part."""
+    # DDS domain ids up to 224: with MaxAutoParticipantIndex 600 (cyclonedds.xml) the unicast
+    # discovery ports of a domain id from 228 on run past 65535.
+    return dict(os.environ, RSCA_DDS_DOMAIN=str(150 + os.getpid() % 75),
+                RSCA_DDS_TAG=f"bench-{os.getpid()}")
+
+
 class Domain:
     """`rsca domain up --nodes N` on a DDS domain id and run folder of its own. With `sdrroot`,
     the DMD and the node DCDs (dev/nodes/node1..N) come from that SDR root; `env` adds to the
@@ -93,11 +102,7 @@ class Domain:
         self.cli_args = cli_args or []
         self.spawned = []
         self.run_dir = tempfile.mkdtemp(prefix="rsca-bench-")
-        # DDS domain ids up to 224: with MaxAutoParticipantIndex 600 (cyclonedds.xml) the unicast
-        # discovery ports of a domain id from 228 on run past 65535.
-        self.env = dict(os.environ, RSCA_RUN_DIR=self.run_dir,
-                        RSCA_DDS_DOMAIN=str(150 + os.getpid() % 75),
-                        RSCA_DDS_TAG=f"bench-{os.getpid()}", **(env or {}))
+        self.env = dict(dds_env(), RSCA_RUN_DIR=self.run_dir, **(env or {}))
         self.nodes = nodes
         self.sdrroot = sdrroot
         self.daemons = {}
