@@ -9,6 +9,7 @@ of the component processes they ran and of the other programs is killed by proce
 """
 import json
 import os
+import select
 import shutil
 import signal
 import statistics
@@ -225,70 +226,132 @@ class Domain:
         return pids
 
 
-# The leader of a shared session (Processes(shared_session=True)): starts programs in its session
-# on request, each in a process group of its own, and reports how they end. One JSON request per
-# line on stdin, one JSON reply per line on stdout; it exits when stdin closes.
+# The leader of a shared session (Processes(shared_session=True)). It starts programs in its
+# session on request (a JSON line on stdin: args, env, stdout and stderr paths), each in a process
+# group of its own, and says so on stdout ({"started": pid} or {"error": why}); a thread waits for
+# them, blocked, and reports each end ({"exited": pid, "returncode": rc}). It never polls: it runs
+# in the session it serves, and a process that woke up there would share the benchmark's CPUs as
+# no process in a node's session does. When stdin closes, what it started and is still running
+# is killed.
 SESSION_LEADER = r"""
-import json, subprocess, sys
-children = {}
+import json, os, signal, sys, threading
+lock = threading.Condition()
+running = set()
+
+def say(message):
+    with lock:
+        sys.stdout.write(json.dumps(message) + "\n")
+        sys.stdout.flush()
+
+def reap():
+    while True:
+        with lock:
+            while not running:
+                lock.wait()
+        pid, status = os.wait()
+        with lock:
+            running.discard(pid)
+        say({"exited": pid, "returncode": os.waitstatus_to_exitcode(status)})
+
+threading.Thread(target=reap, daemon=True).start()
 for line in sys.stdin:
     request = json.loads(line)
-    if request["op"] == "start":
-        with open(request["stdout"], "w") as out, open(request["stderr"], "w") as err:
-            child = subprocess.Popen(request["args"], env=request["env"], stdin=subprocess.DEVNULL,
-                                     stdout=out, stderr=err, process_group=0)
-        children[child.pid] = child
-        reply = child.pid
-    else:
+    try:
+        files = [(os.POSIX_SPAWN_OPEN, 0, os.devnull, os.O_RDONLY, 0),
+                 (os.POSIX_SPAWN_OPEN, 1, request["stdout"], os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o644),
+                 (os.POSIX_SPAWN_OPEN, 2, request["stderr"], os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o644)]
+        with lock:
+            pid = os.posix_spawnp(request["args"][0], request["args"], request["env"],
+                                  file_actions=files, setpgroup=0)
+            running.add(pid)
+            lock.notify()
+        say({"started": pid})
+    except Exception as e:
+        say({"error": f"cannot start {request['args'][0]}: {e}"})
+with lock:
+    for pid in running:
         try:
-            reply = children[request["pid"]].wait(timeout=request["timeout"])
-        except subprocess.TimeoutExpired:
-            reply = None
-    print(json.dumps(reply), flush=True)
+            os.killpg(pid, signal.SIGKILL)
+        except ProcessLookupError:
+            pass
 """
 
 
 class SessionChild:
-    """A program started by a session leader: what Processes needs of a subprocess.Popen (pid,
-    poll, communicate, returncode), its stdout read from the file it went to."""
+    """A program a session leader started: what Processes needs of a subprocess.Popen (pid, poll,
+    communicate, returncode); its stdout is read from the file it went to."""
 
     def __init__(self, leader, pid, stdout_path):
         self.leader, self.pid, self.stdout_path = leader, pid, stdout_path
         self.returncode = None
 
-    def _wait(self, timeout):
-        if self.returncode is None:
-            self.returncode = self.leader.ask({"op": "wait", "pid": self.pid, "timeout": timeout})
+    def poll(self):
+        self.returncode = self.leader.returncode(self.pid, 0)
         return self.returncode
 
-    def poll(self):
-        return self._wait(0)
-
     def communicate(self, timeout=None):
-        if self._wait(timeout) is None:
+        self.returncode = self.leader.returncode(self.pid, timeout)
+        if self.returncode is None:
             raise subprocess.TimeoutExpired(str(self.pid), timeout)
         with open(self.stdout_path) as f:
             return f.read(), None
 
 
 class SessionLeader:
+    """A process in a new session of its own that starts programs in that session for us
+    (SESSION_LEADER)."""
+
     def __init__(self):
         self.proc = subprocess.Popen([sys.executable, "-c", SESSION_LEADER],
-                                     stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True,
+                                     stdin=subprocess.PIPE, stdout=subprocess.PIPE,
                                      start_new_session=True)
+        self.pending = b""   # what was read of the leader's stdout beyond the last whole line
+        self.exited = {}     # pid -> return code, as reported
+        self.started = []    # the leader's answers to start requests, in order
 
-    def ask(self, request):
-        self.proc.stdin.write(json.dumps(request) + "\n")
-        self.proc.stdin.flush()
-        return json.loads(self.proc.stdout.readline())
+    def _read(self, timeout):
+        """Takes in the leader's next messages; waits up to `timeout` s (None: for ever) for
+        some. Returns whether any came."""
+        fd = self.proc.stdout.fileno()
+        if not select.select([fd], [], [], timeout)[0]:
+            return False
+        chunk = os.read(fd, 65536)
+        if not chunk:
+            raise RuntimeError("the session leader of the benchmark's processes exited")
+        *lines, self.pending = (self.pending + chunk).split(b"\n")
+        for line in lines:
+            message = json.loads(line)
+            if "exited" in message:
+                self.exited[message["exited"]] = message["returncode"]
+            else:
+                self.started.append(message)
+        return True
 
     def start(self, args, env, log_path):
         stdout_path = log_path + ".out"
-        pid = self.ask({"op": "start", "args": args, "env": env, "stdout": stdout_path,
-                        "stderr": log_path})
-        return SessionChild(self, pid, stdout_path)
+        request = {"args": args, "env": env, "stdout": stdout_path, "stderr": log_path}
+        self.proc.stdin.write((json.dumps(request) + "\n").encode())
+        self.proc.stdin.flush()
+        while not self.started:
+            if not self._read(30):
+                raise RuntimeError(f"the session leader did not start {args[0]} within 30 s")
+        answer = self.started.pop(0)
+        if "error" in answer:
+            raise RuntimeError(answer["error"])
+        return SessionChild(self, answer["started"], stdout_path)
+
+    def returncode(self, pid, timeout):
+        """`pid`'s return code once it has ended, waiting up to `timeout` s (None: for ever) for
+        that; None if it still runs."""
+        deadline = None if timeout is None else time.monotonic() + timeout
+        while pid not in self.exited:
+            left = None if deadline is None else max(0.0, deadline - time.monotonic())
+            if not self._read(left):
+                return None
+        return self.exited[pid]
 
     def close(self):
+        """Ends the leader, which kills what it started and still runs."""
         self.proc.stdin.close()
         try:
             self.proc.wait(timeout=5)
@@ -349,11 +412,14 @@ class Processes:
         self.close()
 
     def close(self):
-        """Stops every program started, and their process groups."""
-        running = [p for p in self.started if p.poll() is None]
-        if running:
-            self.stop(running, timeout=5)
-        for p in self.started:  # their groups too: nothing they started may outlive them
-            kill_group(p.pid)
-        if self.leader is not None:
-            self.leader.close()
+        """Stops every program started, and their process groups, also when stopping them
+        fails (e.g. the session leader is gone)."""
+        try:
+            running = [p for p in self.started if p.poll() is None]
+            if running:
+                self.stop(running, timeout=5)
+        finally:
+            for p in self.started:  # their groups too: nothing they started may outlive them
+                kill_group(p.pid)
+            if self.leader is not None:
+                self.leader.close()

@@ -14,13 +14,14 @@ latency: strict ping-pong between BenchPing_1 and BenchEcho_1 (uses port -> prov
   both ways), and between `rsca-bench-raw ping` and `rsca-bench-raw echo`, once woken by a waitset
   (the baseline of the ratio lines) and once by a listener as rsca's receive loop is; each raw
   pair in one session, as the two components are in their node's (docs/architecture.md says why
-  that matters). Rounds of 2000 warm-up round trips (not measured) and 2500 measured ones
-  (--quick: 1000), 4 rounds of each side (--quick: 2), each round starting with another side so
-  that a change of the machine's load falls on all alike. Median, p99 (and more) of the round
+  that matters). Rounds of 2000 warm-up round trips (not measured) and 2000 measured ones
+  (--quick: 1000), 6 rounds of each side (--quick: 3), each round running the sides in another
+  order so that a change of the machine's load falls on all alike. Median, p99 (and more) of the round
   trip and the CPU time both processes spend per round trip; the output ends with the ratio lines.
 fanout: BenchPublisher_1 publishes on the event channel BenchFanOut to N BenchSubscriber_i
   processes (N = 1, 10, 50, 100; --quick: 1 and 10), raw DDS the same with one raw publisher and N
-  raw subscriber processes on one topic, in two sessions as the components are in two nodes'.
+  raw subscriber processes on one topic, in one session per node as the components were placed
+  (a node's components share its session).
   Latency: events at a low rate (100 Hz), per event the time until the last subscriber has it
   (max over subscribers of receive time minus send time), p50 and p99. Sustained rate: steps of
   rising rates (250 to 128000 events/s, each after a pause); per step, the events every
@@ -33,7 +34,9 @@ Every process started is stopped at the end, also on failure.
 """
 import argparse
 import array
+import contextlib
 import copy
+import itertools
 import json
 import math
 import os
@@ -201,9 +204,13 @@ class LatencyRaw:
         self.ping_topic = f"rsca_bench_raw_ping_{wake}_{os.getpid()}"
         self.echo_topic = f"rsca_bench_raw_echo_{wake}_{os.getpid()}"
         self.qos = json.dumps(qos)
-        self.echo = self.procs.start(
-            [raw, "echo", "--in", self.ping_topic, "--out", self.echo_topic, "--qos", self.qos,
-             "--wake", wake], domain.env, os.path.join(work, f"raw-{wake}-echo.log"))
+        try:
+            self.echo = self.procs.start(
+                [raw, "echo", "--in", self.ping_topic, "--out", self.echo_topic, "--qos",
+                 self.qos, "--wake", wake], domain.env, os.path.join(work, f"raw-{wake}-echo.log"))
+        except BaseException:
+            self.procs.close()
+            raise
         self.cpu_us = 0.0
         self.round_trips = 0
         self.resent = 0
@@ -239,8 +246,14 @@ SIDES = ("rsca", "raw", "raw_listener")
 
 
 def bench_latency(args):
-    rounds = 2 if args.quick else 4
-    count, warmup = (1000, 2000) if args.quick else (2500, 2000)  # per round
+    # Each round runs the sides in another order, so that a change of the machine's load during
+    # the run falls on all alike and none always follows the same other: all six orders, or
+    # (--quick) three in which each side comes first once.
+    orders = list(itertools.permutations(SIDES))
+    if args.quick:
+        orders = orders[::2]
+    rounds = len(orders)
+    count, warmup = (1000, 2000) if args.quick else (2000, 2000)  # per round
     rsca = os.path.join(args.bin, "rsca")
     raw = os.path.join(args.bin, "rsca-bench-raw")
     work = tempfile.mkdtemp(prefix="rsca-portbench-")
@@ -248,22 +261,18 @@ def bench_latency(args):
     rtts = {name: array.array("Q") for name in SIDES}
     before = host_state()
     try:
-        with Domain(rsca, nodes=2, sdrroot=SDRROOT, env=lease) as domain:
+        with Domain(rsca, nodes=2, sdrroot=SDRROOT, env=lease) as domain, \
+                contextlib.ExitStack() as closing:
             sizes = raw_sizes(raw, domain.env)
             sides = {"rsca": LatencyRsca(domain, work, count, warmup)}
-            try:
-                for name, wake in (("raw", "waitset"), ("raw_listener", "listener")):
-                    sides[name] = LatencyRaw(domain, raw, work, sides["rsca"].qos, count, warmup,
-                                             wake)
-                # Each round starts with another side: a change of the machine's load during
-                # the run falls on all alike.
-                for index in range(rounds):
-                    for k in range(len(SIDES)):
-                        name = SIDES[(index + k) % len(SIDES)]
-                        rtts[name].extend(sides[name].run(index))
-            finally:
-                for side in sides.values():
-                    side.close()
+            closing.callback(sides["rsca"].close)
+            for name, wake in (("raw", "waitset"), ("raw_listener", "listener")):
+                sides[name] = LatencyRaw(domain, raw, work, sides["rsca"].qos, count, warmup,
+                                         wake)
+                closing.callback(sides[name].close)
+            for index, order in enumerate(orders):
+                for name in order:
+                    rtts[name].extend(sides[name].run(index))
     finally:
         if not args.keep:
             shutil.rmtree(work, ignore_errors=True)
@@ -285,17 +294,16 @@ def bench_latency(args):
 
     print(f"Round trip of a {results['payload_bytes']}-byte SampleSeq between two processes on one "
           f"host, strict ping-pong, {rounds} rounds of {warmup} warm-up and {count} measured round "
-          f"trips each, each round starting with another side; each raw pair in one session, "
+          f"trips each, the sides in another order each round; each raw pair in one session, "
           f"as the components are in their node's; QoS {qos['reliability']}, "
           f"{qos['durability']}, {qos['history']} {qos.get('depth', '')}.")
     print()
     print("| round trip | rsca (uses -> provides port) | raw Cyclone DDS (waitset) | rsca/raw "
           "| raw, rsca's wake (listener) | rsca/that |")
     print("| --- | --- | --- | --- | --- | --- |")
-    rows = [(key, label) for key, label in (
-        ("min_us", "min"), ("p50_us", "p50"), ("p90_us", "p90"), ("p99_us", "p99"),
-        ("p999_us", "p99.9"), ("max_us", "max"), ("mean_us", "mean"))]
-    rows.append(("cpu_us_per_round_trip", "CPU per round trip (both processes)"))
+    rows = [("min_us", "min"), ("p50_us", "p50"), ("p90_us", "p90"), ("p99_us", "p99"),
+            ("p999_us", "p99.9"), ("max_us", "max"), ("mean_us", "mean"),
+            ("cpu_us_per_round_trip", "CPU per round trip (both processes)")]
     for key, label in rows:
         print(f"| {label} | {r[key]:.1f} us | {w[key]:.1f} us | {ratio(r[key], w[key]):.2f} "
               f"| {wl[key]:.1f} us | {ratio(r[key], wl[key]):.2f} |")
@@ -453,15 +461,16 @@ def fanout_rsca(domain, n, batch, schedule, work):
     for path in [pub_out] + subs_out:
         if os.path.exists(path):
             os.remove(path)
-    launched, launch_ms = [], []
+    launched, launch_ms, placement = [], [], {}
     try:
         for name, sad in sads:  # the subscribers first, the publisher with the last of them
             domain.cli("--sdrroot", sdr, "install", sad)
             for attempt in range(1, LAUNCH_ATTEMPTS + 1):
                 wait_discovery_settled()
                 try:
-                    _, ms = domain.cli("launch", name, "--name", name.lower(), "--strategy",
-                                       "spread")
+                    reply, ms = domain.cli("launch", name, "--name", name.lower(), "--strategy",
+                                           "spread")
+                    note_placement(placement, reply)
                     break
                 except RuntimeError as e:  # rolled back by the domain: nothing is left of it
                     if attempt == LAUNCH_ATTEMPTS:
@@ -487,25 +496,46 @@ def fanout_rsca(domain, n, batch, schedule, work):
             domain.cli("uninstall", name, check=False)
     return (read_u64(pub_out), [read_u64(p) for p in subs_out], qos,
             dict(props.get("properties", props), applications=len(launched),
-                 launch_cli_ms=launch_ms))
+                 launch_cli_ms=launch_ms, placement=placement))
 
 
-def fanout_raw(domain, raw, n, schedule, qos, work):
+def note_placement(placement, reply):
+    """Counts, per node, the subscribers and the publisher a launch reply placed there."""
+    for c in reply.get("components", []):
+        node = placement.setdefault(c.get("node", "?"), {"publisher": 0, "subscribers": 0})
+        node["publisher" if c.get("id", "").startswith("BenchPublisher") else "subscribers"] += 1
+
+
+def raw_sessions(n, placement):
+    """How the raw fan-out's processes are grouped in sessions: as the components were on the
+    nodes (one session per node: a node's components share its session), or when that is not
+    known (the rsca side failed), two halves with the publisher in the first. Returns a list of
+    (publisher here, subscribers here)."""
+    if (placement and sum(p["subscribers"] for p in placement.values()) == n
+            and sum(p["publisher"] for p in placement.values()) == 1):
+        return [(p["publisher"] > 0, p["subscribers"]) for p in placement.values()]
+    return [(True, (n + 1) // 2), (False, n // 2)]
+
+
+def fanout_raw(domain, raw, n, schedule, qos, work, placement):
     topic = f"rsca_bench_raw_fanout_{n}_{os.getpid()}"
     qos_json = json.dumps(qos)
     pub_out = os.path.join(work, "raw-pub.bin")
     subs_out = [os.path.join(work, f"raw-sub-{i}.bin") for i in range(1, n + 1)]
-    # Two sessions, as the rsca side's components are in the sessions of the domain's two nodes:
-    # the subscribers in halves, the publisher with the first half.
-    with Processes(shared_session=True) as first, Processes(shared_session=True) as second:
-        subs = [(first if i <= (n + 1) // 2 else second).start(
+    with contextlib.ExitStack() as closing:
+        subs, pub, outs = [], None, iter(enumerate(subs_out, 1))
+        for with_publisher, count in raw_sessions(n, placement):
+            session = closing.enter_context(Processes(shared_session=True))
+            for i, out in itertools.islice(outs, count):
+                subs.append(session.start(
                     [raw, "sub", "--topic", topic, "--qos", qos_json, "--capacity",
                      str(schedule.total()), "--output", out], domain.env,
-                    os.path.join(work, f"raw-sub-{i}.log"))
-                for i, out in enumerate(subs_out, 1)]
-        pub = first.start([raw, "pub", "--topic", topic, "--qos", qos_json, "--subscribers",
-                           str(n), "--output", pub_out, *schedule.raw_args()], domain.env,
-                          os.path.join(work, "raw-pub.log"))
+                    os.path.join(work, f"raw-sub-{i}.log")))
+            if with_publisher:
+                pub = session.start(
+                    [raw, "pub", "--topic", topic, "--qos", qos_json, "--subscribers", str(n),
+                     "--output", pub_out, *schedule.raw_args()], domain.env,
+                    os.path.join(work, "raw-pub.log"))
         try:
             out, _ = pub.communicate(timeout=120 + 3 * schedule.seconds())
         except subprocess.TimeoutExpired:
@@ -612,15 +642,18 @@ def bench_fanout(args):
                 entry = {"host_before": host_state()}
                 # Each side on its own: a side that fails (e.g. a launch the domain rolled back
                 # three times) is reported as such, the other still measured.
+                placement = None
                 try:
                     send, subs, qos, props = fanout_rsca(domain, n, args.batch, schedule, work)
                     entry["rsca"] = dict(analyse_fanout(send, subs, schedule), publisher=props)
+                    placement = props["placement"]
                     del send, subs
                 except RuntimeError as e:
                     entry["rsca"] = {"error": str(e)}
                     print(f"rsca, {n} subscribers: {e}", file=sys.stderr, flush=True)
                 try:
-                    send, subs, raw_props = fanout_raw(domain, raw, n, schedule, qos, work)
+                    send, subs, raw_props = fanout_raw(domain, raw, n, schedule, qos, work,
+                                                       placement)
                     entry["raw"] = dict(analyse_fanout(send, subs, schedule), publisher=raw_props)
                     del send, subs
                 except RuntimeError as e:
