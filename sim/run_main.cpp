@@ -85,6 +85,9 @@ int main(int argc, char **argv) {
       {"overshoot", outcome->overshoot},
       {"braking_distance", outcome->braking_distance},
       {"predicted_tolerance", outcome->predicted_tolerance},
+      // What the exact range used here leaves out, and a controller reading the real sensor
+      // (the one rsca's IRSensor device serves) has to allow for.
+      {"sensor_noise_sigma", scenario.sensors.front().noise_sigma},
       {"within_tolerance",
        outcome->overshoot >= 0.0 && outcome->overshoot <= outcome->predicted_tolerance},
       {"sim_time", state.time},
