@@ -23,6 +23,7 @@
 #include "common/exec_environment.hpp"
 #include "component/host.hpp"
 #include "component/process.hpp"
+#include "profile/runtime_model.hpp"
 
 namespace rsca::component {
 
@@ -120,14 +121,26 @@ void wait_for_exit(const ExitEvents &events, detail::Host &host, spdlog::logger 
   host.shutdown(name);
 }
 
+// The component's profile, or null when it cannot be read (said in the log). The loader goes at
+// once: the XML reader it may have needed is unloaded before the component runs.
+std::shared_ptr<const profile::ResolvedSoftPkg> load_profile(const std::string &spd,
+                                                             spdlog::logger &log) {
+  profile::ComponentProfileLoader loader;
+  auto softpkg = loader.load(spd);
+  if (!softpkg) {
+    log.error("cannot load the profile {}:\n{}", spd, softpkg.error().to_string());
+    return nullptr;
+  }
+  if (!loader.fallback_reason().empty())
+    log.debug("{} read from its XML: {}", spd, loader.fallback_reason());
+  return *softpkg;
+}
+
 int run_host(const ExecParams &params, const ExitEvents &events, const Factory &factory,
              std::shared_ptr<spdlog::logger> logger) {
-  // The loader goes at once: the XML reader it held is unloaded before the component runs.
-  auto softpkg = profile::ProfileLoader().load_softpkg(params.profile);
-  if (!softpkg) {
-    logger->error("cannot load the profile {}:\n{}", params.profile, softpkg.error().to_string());
+  auto softpkg = load_profile(params.profile, *logger);
+  if (!softpkg)
     return kExitProfile;
-  }
   Context context{params.identifier,
                   params.name_binding,
                   params.application,
@@ -145,7 +158,7 @@ int run_host(const ExecParams &params, const ExitEvents &events, const Factory &
     logger->error("constructing the component failed: {}", e.what());
     return kExitFailure;
   }
-  detail::Host host(std::move(component), *softpkg);
+  detail::Host host(std::move(component), softpkg);
   if (auto prepared = host.prepare(params.others); !prepared) {
     logger->error("the component does not fit its profile:\n{}", prepared.error().to_string());
     return kExitProfile;

@@ -20,6 +20,7 @@
 #include "profile/profile_loader.hpp"
 #include "profile/property_binding.hpp"
 #include "profile/property_json.hpp"
+#include "profile/runtime_model.hpp"
 
 namespace rsca::domain {
 namespace {
@@ -203,6 +204,7 @@ struct DomainManager::Impl {
   void on_announcement(const control::AnnouncementEvent &event);
   Expected<void> load_installed();
   CallResult<Json> install(const Json &body);
+  void write_runtime_models(const profile::ResolvedApplication &app);
   CallResult<Json> uninstall(const Json &body);
   CallResult<Json> list_installed();
   CallResult<Json> create_application(const Json &body);
@@ -248,11 +250,21 @@ Expected<void> DomainManager::Impl::load_installed() {
                    app.error().to_string());
       continue;
     }
+    write_runtime_models(*app); // an installation from before runtime models had none
     installed[r.name] = {r.name, sad,
                          std::make_shared<const profile::ResolvedApplication>(std::move(*app))};
   }
   spdlog::info("{} installed application(s) loaded", installed.size());
   return {};
+}
+
+// Its components' processes then start without reading XML; one without a model still starts,
+// reading its profile (profile/runtime_model.hpp).
+void DomainManager::Impl::write_runtime_models(const profile::ResolvedApplication &app) {
+  for (const auto &[id, softpkg] : app.component_files)
+    if (auto ok = profile::write_runtime_model(*softpkg); !ok)
+      spdlog::warn("no runtime model for {}: {}", softpkg->spd_path.string(),
+                   ok.error().to_string());
 }
 
 CallResult<Json> DomainManager::Impl::install(const Json &body) {
@@ -298,6 +310,7 @@ CallResult<Json> DomainManager::Impl::install(const Json &body) {
   auto final_app = final_loader.load_application(final_dir / *rel_sad);
   if (!final_app)
     return control::call_error(Status::Failed, final_app.error().to_string());
+  write_runtime_models(*final_app);
   if (auto ok = store->put_installed({name, (fs::path(name) / *rel_sad).string()}); !ok)
     return control::call_error(Status::Failed, ok.error().to_string());
   installed[name] = {name, final_dir / *rel_sad,

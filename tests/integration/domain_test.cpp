@@ -104,6 +104,41 @@ TEST_CASE("ProducerConsumer: install, launch, data flows, configure, query, stop
   domain.require_clean(pids);
 }
 
+TEST_CASE("install writes each component's runtime model, and its process starts from it",
+          "[integration][domain]") {
+  TestDomain domain;
+  auto [rc, out] = domain.cli(
+      {"install",
+       (kSource / "profiles/dom/waveforms/ProducerConsumer/ProducerConsumer.sad.xml").string()});
+  INFO(out);
+  REQUIRE(rc == 0);
+  const fs::path components = domain.run_dir() / "repository/ProducerConsumer/dom/components";
+  const fs::path model = components / "Producer/Producer.spd.xml.model.json";
+  REQUIRE(fs::exists(model));
+  CHECK(fs::exists(components / "Consumer/Consumer.spd.xml.model.json"));
+  // A default changed in the model only (its sources untouched): the launched process has it,
+  // so it read the model, not the XML.
+  Json edited = Json::parse(std::ifstream(model));
+  for (auto &d : edited["properties"]["definitions"])
+    if (d["id"] == "message")
+      d["value"] = "from the model";
+  std::ofstream(model) << edited.dump();
+
+  auto [lrc, lout] = domain.cli({"launch", "ProducerConsumer"});
+  INFO(lout);
+  REQUIRE(lrc == 0);
+  auto q = domain.call(
+      "app.query",
+      Json{{"app", "ProducerConsumer"}, {"component", "Producer_1"}, {"ids", {"message"}}});
+  REQUIRE(q.has_value());
+  CHECK(q->at("properties").at("message") == "from the model");
+  auto app = domain.call("app.show", Json{{"app", "ProducerConsumer"}});
+  REQUIRE(app.has_value());
+  const auto pids = pids_of(*app);
+  REQUIRE(domain.call("app.release", Json{{"app", "ProducerConsumer"}}).has_value());
+  domain.require_clean(pids);
+}
+
 TEST_CASE("a missing executable fails the launch at execute and rolls back",
           "[integration][domain][failure]") {
   TestDomain domain;

@@ -1,0 +1,213 @@
+// Runtime models (profile/runtime_model.hpp): every software package of the corpus and of the
+// project reads back from its model as it was read from its XML, a model is used only while the
+// files it came from are unchanged, and the component loader falls back to the XML otherwise.
+#include "profile/runtime_model.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+using namespace rsca::profile;
+using Catch::Matchers::Contains;
+namespace fs = std::filesystem;
+using Json = nlohmann::json;
+
+namespace {
+
+const fs::path kCorpus = fs::path(RSCA_CORPUS_DIR).lexically_normal();
+const fs::path kOwn = fs::path(RSCA_SOURCE_DIR) / "profiles";
+
+std::vector<fs::path> spds_under(const fs::path &root) {
+  std::vector<fs::path> files;
+  for (const auto &entry : fs::recursive_directory_iterator(root))
+    if (entry.path().string().ends_with(".spd.xml"))
+      files.push_back(entry.path());
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+std::vector<const PropertyDefinition *> definitions_of(const ResolvedSoftPkg &softpkg) {
+  std::vector<const PropertyDefinition *> out;
+  auto add = [&out](const std::shared_ptr<const Properties> &prf) {
+    if (prf)
+      for (const auto &d : prf->properties)
+        out.push_back(&d);
+  };
+  add(softpkg.properties);
+  for (const auto &implementation : softpkg.implementations)
+    add(implementation.properties);
+  return out;
+}
+
+std::string default_text(const PropertyDefinition &d) {
+  auto value = default_value(d);
+  return value ? format_value(*value) : "(none)";
+}
+
+// What a component runs on, compared field by field against the package read from its XML.
+void check_same(const ResolvedSoftPkg &xml, const ResolvedSoftPkg &model) {
+  const auto expected = definitions_of(xml);
+  const auto actual = definitions_of(model);
+  REQUIRE(actual.size() == expected.size());
+  for (std::size_t i = 0; i < expected.size(); ++i) {
+    const auto &e = common_of(*expected[i]);
+    const auto &a = common_of(*actual[i]);
+    INFO("property " << e.id);
+    CHECK(a.id == e.id);
+    CHECK(a.mode == e.mode);
+    CHECK(a.kinds == e.kinds);
+    CHECK(a.where.line == e.where.line);
+    CHECK(expected[i]->index() == actual[i]->index());
+    CHECK(default_text(*actual[i]) == default_text(*expected[i]));
+  }
+  REQUIRE(static_cast<bool>(model.scd) == static_cast<bool>(xml.scd));
+  if (!xml.scd)
+    return;
+  REQUIRE(model.scd->ports.size() == xml.scd->ports.size());
+  for (const auto &port : xml.scd->ports) {
+    const auto *found = model.scd->find_port(port.name, port.direction);
+    REQUIRE(found != nullptr);
+    CHECK(found->repid == port.repid);
+  }
+}
+
+// A copy of the project's Producer package in an SDR root of its own, with its runtime model.
+struct ProducerCopy {
+  fs::path root = fs::temp_directory_path() / ("rsca-runtime-model-" + std::to_string(::getpid()));
+  fs::path dir = root / "dom/components/Producer";
+  fs::path spd = dir / "Producer.spd.xml";
+
+  ProducerCopy() {
+    fs::remove_all(root);
+    fs::create_directories(dir);
+    for (const auto &entry : fs::directory_iterator(kOwn / "dom/components/Producer"))
+      fs::copy_file(entry.path(), dir / entry.path().filename());
+    auto softpkg = ProfileLoader().load_softpkg(spd);
+    INFO((softpkg ? "" : softpkg.error().to_string()));
+    REQUIRE(softpkg.has_value());
+    REQUIRE(write_runtime_model(**softpkg).has_value());
+  }
+  ~ProducerCopy() { fs::remove_all(root); }
+
+  Json model() const { return Json::parse(std::ifstream(runtime_model_path(spd))); }
+  void set_model(const Json &json) const { std::ofstream(runtime_model_path(spd)) << json.dump(); }
+};
+
+const PropertyDefinition *find(const ResolvedSoftPkg &softpkg, const std::string &id) {
+  return softpkg.find_property(id);
+}
+
+} // namespace
+
+TEST_CASE("every software package reads back from its runtime model as from its XML",
+          "[profile][runtime-model]") {
+  ProfileLoader loader;
+  std::size_t checked = 0;
+  for (const auto &root : {kCorpus, kOwn}) {
+    for (const auto &spd : spds_under(root)) {
+      auto xml = loader.load_softpkg(spd);
+      if (!xml && root == kCorpus)
+        continue; // the corpus test says which do not load on their own
+      INFO((xml ? "" : xml.error().to_string()));
+      REQUIRE(xml.has_value());
+      INFO(spd.string());
+      const Json model = to_runtime_model(**xml);
+      auto back = from_runtime_model(model, spd);
+      REQUIRE(back.has_value());
+      CHECK((*back)->spd_path == spd);
+      check_same(**xml, **back);
+      // Nothing is lost on the way: the model of what was read back is the same model.
+      CHECK(to_runtime_model(**back) == model);
+      ++checked;
+    }
+  }
+  CHECK(checked >= 40); // 44 when written: the corpus's and the project's packages
+}
+
+TEST_CASE("a component loader uses the runtime model while its sources are unchanged",
+          "[profile][runtime-model]") {
+  ProducerCopy copy;
+  // A default changed in the model only: seen, so the package came from the model.
+  Json model = copy.model();
+  for (auto &d : model["properties"]["definitions"])
+    if (d["id"] == "message")
+      d["value"] = "from the model";
+  copy.set_model(model);
+
+  ComponentProfileLoader loader;
+  auto softpkg = loader.load(copy.spd);
+  REQUIRE(softpkg.has_value());
+  CHECK(loader.fallback_reason().empty());
+  REQUIRE(find(**softpkg, "message") != nullptr);
+  CHECK(default_text(*find(**softpkg, "message")) == "from the model");
+  // Read once: a second instance of the package gets the same one.
+  auto again = loader.load(copy.spd);
+  REQUIRE(again.has_value());
+  CHECK(again->get() == softpkg->get());
+}
+
+TEST_CASE("a runtime model older than a file it came from is not used: the XML is read",
+          "[profile][runtime-model]") {
+  ProducerCopy copy;
+  Json model = copy.model();
+  for (auto &d : model["properties"]["definitions"])
+    if (d["id"] == "message")
+      d["value"] = "from the model";
+  copy.set_model(model);
+  const fs::path prf = copy.dir / "Producer.prf.xml";
+  fs::last_write_time(prf, fs::last_write_time(prf) + std::chrono::seconds(1));
+
+  auto read = read_runtime_model(copy.spd);
+  REQUIRE_FALSE(read.has_value());
+  CHECK_THAT(read.error().to_string(), Contains("Producer.prf.xml changed since it was written"));
+
+  ComponentProfileLoader loader;
+  auto softpkg = loader.load(copy.spd);
+  REQUIRE(softpkg.has_value());
+  CHECK_THAT(loader.fallback_reason(), Contains("changed since it was written"));
+  CHECK(default_text(*find(**softpkg, "message")) == "hello"); // the PRF's own default
+}
+
+TEST_CASE("a missing or broken runtime model makes the component loader read the XML",
+          "[profile][runtime-model]") {
+  ProducerCopy copy;
+  SECTION("missing") {
+    fs::remove(runtime_model_path(copy.spd));
+    ComponentProfileLoader loader;
+    REQUIRE(loader.load(copy.spd).has_value());
+    CHECK_THAT(loader.fallback_reason(), Contains("there is none"));
+  }
+  SECTION("not JSON") {
+    std::ofstream(runtime_model_path(copy.spd)) << "{ truncated";
+    ComponentProfileLoader loader;
+    REQUIRE(loader.load(copy.spd).has_value());
+    CHECK_THAT(loader.fallback_reason(), Contains("not JSON"));
+  }
+  SECTION("a value that does not fit its type") {
+    Json model = copy.model();
+    for (auto &d : model["properties"]["definitions"])
+      if (d["id"] == "rate_hz")
+        d["value"] = "fast";
+    copy.set_model(model);
+    ComponentProfileLoader loader;
+    auto softpkg = loader.load(copy.spd);
+    REQUIRE(softpkg.has_value());
+    CHECK_THAT(loader.fallback_reason(), Contains("fast"));
+    CHECK(default_text(*find(**softpkg, "rate_hz")) == "100");
+  }
+  SECTION("another format") {
+    Json model = copy.model();
+    model["format"] = 99;
+    copy.set_model(model);
+    ComponentProfileLoader loader;
+    REQUIRE(loader.load(copy.spd).has_value());
+    CHECK_THAT(loader.fallback_reason(), Contains("format 99"));
+  }
+}
