@@ -137,59 +137,62 @@ void read_common(const Json &json, PropertyCommon &p) {
   p.where = where_from(json.at("where"));
 }
 
-Json simple_json(const SimpleProperty &p) {
-  Json out = common_json("simple", p);
-  Json enumerations = Json::array();
-  for (const auto &e : p.enumerations)
-    enumerations.push_back({e.label, scalar_json(e.value)});
+// What a simple and a simple sequence have alike besides the common part: a type, and units, a
+// range and an action in it.
+template <typename Typed>
+Json typed_json(const char *shape, const Typed &p) {
+  Json out = common_json(shape, p);
   out.update({{"type", type_json(p.type)},
-              {"value", p.value ? scalar_json(*p.value) : Json()},
               {"units", p.units},
               {"range", range_json(p.range)},
-              {"enumerations", enumerations},
               {"action", action_json(p.action)},
-              {"commandline", p.commandline},
               {"optional", p.optional}});
   return out;
 }
 
-SimpleProperty simple_from(const Json &json) {
-  SimpleProperty p;
+template <typename Typed>
+Typed typed_from(const Json &json) {
+  Typed p;
   read_common(json, p);
   p.type = type_from(json.at("type"));
-  if (!json.at("value").is_null())
-    p.value = scalar_from(json.at("value"), p.type);
   p.units = json.at("units").get<std::string>();
   p.range = range_from(json.at("range"), p.type);
-  for (const auto &e : json.at("enumerations"))
-    p.enumerations.push_back({e.at(0).get<std::string>(), scalar_from(e.at(1), p.type)});
   p.action = action_from(json.at("action"));
-  p.commandline = json.at("commandline").get<bool>();
   p.optional = json.at("optional").get<bool>();
   return p;
 }
 
+Json simple_json(const SimpleProperty &p) {
+  Json enumerations = Json::array();
+  for (const auto &e : p.enumerations)
+    enumerations.push_back({e.label, scalar_json(e.value)});
+  Json out = typed_json("simple", p);
+  out.update({{"value", p.value ? scalar_json(*p.value) : Json()},
+              {"enumerations", enumerations},
+              {"commandline", p.commandline}});
+  return out;
+}
+
+SimpleProperty simple_from(const Json &json) {
+  auto p = typed_from<SimpleProperty>(json);
+  if (!json.at("value").is_null())
+    p.value = scalar_from(json.at("value"), p.type);
+  for (const auto &e : json.at("enumerations"))
+    p.enumerations.push_back({e.at(0).get<std::string>(), scalar_from(e.at(1), p.type)});
+  p.commandline = json.at("commandline").get<bool>();
+  return p;
+}
+
 Json sequence_json(const SimpleSequenceProperty &p) {
-  Json out = common_json("simplesequence", p);
-  out.update({{"type", type_json(p.type)},
-              {"values", p.values ? scalars_json(*p.values) : Json()},
-              {"units", p.units},
-              {"range", range_json(p.range)},
-              {"action", action_json(p.action)},
-              {"optional", p.optional}});
+  Json out = typed_json("simplesequence", p);
+  out["values"] = p.values ? scalars_json(*p.values) : Json();
   return out;
 }
 
 SimpleSequenceProperty sequence_from(const Json &json) {
-  SimpleSequenceProperty p;
-  read_common(json, p);
-  p.type = type_from(json.at("type"));
+  auto p = typed_from<SimpleSequenceProperty>(json);
   if (!json.at("values").is_null())
     p.values = scalars_from(json.at("values"), p.type);
-  p.units = json.at("units").get<std::string>();
-  p.range = range_from(json.at("range"), p.type);
-  p.action = action_from(json.at("action"));
-  p.optional = json.at("optional").get<bool>();
   return p;
 }
 

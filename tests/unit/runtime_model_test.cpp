@@ -98,6 +98,14 @@ struct ProducerCopy {
 
   Json model() const { return Json::parse(std::ifstream(runtime_model_path(spd))); }
   void set_model(const Json &json) const { std::ofstream(runtime_model_path(spd)) << json.dump(); }
+  // Changes the default of one property in the model only.
+  void set_default(const std::string &id, const std::string &value) const {
+    Json edited = model();
+    for (auto &d : edited["properties"]["definitions"])
+      if (d["id"] == id)
+        d["value"] = value;
+    set_model(edited);
+  }
 };
 
 const PropertyDefinition *find(const ResolvedSoftPkg &softpkg, const std::string &id) {
@@ -135,11 +143,7 @@ TEST_CASE("a component loader uses the runtime model while its sources are uncha
           "[profile][runtime-model]") {
   ProducerCopy copy;
   // A default changed in the model only: seen, so the package came from the model.
-  Json model = copy.model();
-  for (auto &d : model["properties"]["definitions"])
-    if (d["id"] == "message")
-      d["value"] = "from the model";
-  copy.set_model(model);
+  copy.set_default("message", "from the model");
 
   ComponentProfileLoader loader;
   auto softpkg = loader.load(copy.spd);
@@ -156,11 +160,7 @@ TEST_CASE("a component loader uses the runtime model while its sources are uncha
 TEST_CASE("a runtime model older than a file it came from is not used: the XML is read",
           "[profile][runtime-model]") {
   ProducerCopy copy;
-  Json model = copy.model();
-  for (auto &d : model["properties"]["definitions"])
-    if (d["id"] == "message")
-      d["value"] = "from the model";
-  copy.set_model(model);
+  copy.set_default("message", "from the model");
   const fs::path prf = copy.dir / "Producer.prf.xml";
   fs::last_write_time(prf, fs::last_write_time(prf) + std::chrono::seconds(1));
 
@@ -191,11 +191,7 @@ TEST_CASE("a missing or broken runtime model makes the component loader read the
     CHECK_THAT(loader.fallback_reason(), Contains("not JSON"));
   }
   SECTION("a value that does not fit its type") {
-    Json model = copy.model();
-    for (auto &d : model["properties"]["definitions"])
-      if (d["id"] == "rate_hz")
-        d["value"] = "fast";
-    copy.set_model(model);
+    copy.set_default("rate_hz", "fast");
     ComponentProfileLoader loader;
     auto softpkg = loader.load(copy.spd);
     REQUIRE(softpkg.has_value());
