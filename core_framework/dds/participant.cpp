@@ -20,6 +20,22 @@ Error dds_error(dds_return_t result, std::string_view what) {
 
 namespace {
 
+// Cyclone's discovery port for a domain id is 7400 + 250 x id; past the first ephemeral port
+// (32768 on Linux) another process's socket may already hold it.
+std::string port_hint(std::uint32_t domain_id) {
+  constexpr std::uint64_t kFirstEphemeralPort = 32768;
+  constexpr std::uint64_t kLastPort = 65535;
+  const std::uint64_t port = 7400 + 250 * std::uint64_t{domain_id};
+  if (port > kLastPort)
+    return fmt::format(" (its discovery port would be {}, past {}; domain ids 0-101 work)", port,
+                       kLastPort);
+  if (port >= kFirstEphemeralPort)
+    return fmt::format(" (its discovery port {} is among the ephemeral ports another socket may "
+                       "hold; domain ids 0-101 avoid them)",
+                       port);
+  return {};
+}
+
 // Cyclone allows one explicit domain creation per id and process; participants share it.
 Expected<std::shared_ptr<Entity>> domain_for(const DdsSettings &settings) {
   static std::mutex mutex;
@@ -28,8 +44,9 @@ Expected<std::shared_ptr<Entity>> domain_for(const DdsSettings &settings) {
   if (auto existing = domains[settings.domain_id].lock())
     return existing;
   const std::string config = cyclone_config(settings);
-  auto domain = checked(dds_create_domain(settings.domain_id, config.c_str()),
-                        fmt::format("creating DDS domain {}", settings.domain_id));
+  auto domain = checked(
+      dds_create_domain(settings.domain_id, config.c_str()),
+      fmt::format("creating DDS domain {}{}", settings.domain_id, port_hint(settings.domain_id)));
   if (!domain)
     return tl::unexpected(domain.error());
   auto shared = std::make_shared<Entity>(std::move(*domain));

@@ -1,10 +1,17 @@
 // The project's Cyclone configuration as DdsSettings fill it in.
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
 #include <cstdlib>
 #include <regex>
 
 #include <catch2/catch.hpp>
 
 #include "dds/dds_settings.hpp"
+#include "dds/participant.hpp"
+#include "test_domain.hpp"
 
 using rsca::dds::cyclone_config;
 using rsca::dds::DdsSettings;
@@ -106,4 +113,38 @@ TEST_CASE("both timings come from the environment, and a child process keeps the
   CHECK(in_component.timing.lease == std::chrono::milliseconds(4000));
   CHECK(in_component.timing.heartbeat == std::chrono::milliseconds(200));
   CHECK(in_component.timing.writer_linger == std::chrono::milliseconds(40));
+}
+
+TEST_CASE("a domain id whose discovery port does not exist is refused with the reason", "[dds]") {
+  auto settings = rsca::test::isolated_settings();
+  settings.domain_id = 240; // 7400 + 250 x 240 = 67400
+  auto participant = rsca::dds::Participant::create(settings);
+  REQUIRE_FALSE(participant.has_value());
+  CHECK_THAT(participant.error().to_string(),
+             Catch::Contains("creating DDS domain 240 (its discovery port would be 67400, past "
+                             "65535; domain ids 0-101 work)"));
+}
+
+TEST_CASE("a domain whose discovery port another socket holds is refused with the likely reason",
+          "[dds]") {
+  // What failed a CI run: another process's socket held the port first (here, this test's).
+  int holder = ::socket(AF_INET, SOCK_DGRAM, 0);
+  REQUIRE(holder >= 0);
+  std::uint32_t domain_id = 0;
+  for (std::uint32_t id = 102; id <= 214 && domain_id == 0; ++id) {
+    sockaddr_in address{};
+    address.sin_family = AF_INET;
+    address.sin_port = htons(static_cast<std::uint16_t>(7400 + 250 * id));
+    address.sin_addr.s_addr = htonl(INADDR_ANY);
+    if (::bind(holder, reinterpret_cast<sockaddr *>(&address), sizeof address) == 0)
+      domain_id = id;
+  }
+  REQUIRE(domain_id != 0);
+  auto settings = rsca::test::isolated_settings();
+  settings.domain_id = domain_id;
+  auto participant = rsca::dds::Participant::create(settings);
+  ::close(holder);
+  REQUIRE_FALSE(participant.has_value());
+  CHECK_THAT(participant.error().to_string(),
+             Catch::Contains("is among the ephemeral ports another socket may hold"));
 }

@@ -14,11 +14,14 @@
 
 namespace rsca::test {
 
-// A domain id from 1 to 230 derived from the process id: ctest runs each test case in its own
-// process, so concurrent tests get different ids (Cyclone maps ids above 232 to invalid ports).
+// A domain id derived from the process id: ctest runs each test case in its own process, so
+// concurrent tests mostly get different ids, and the discovery tag below separates those that
+// do not. At most kMaxIsolatedDomainId: a domain's discovery ports (7400 + 250 x id) must stay
+// below the kernel's ephemeral ports (from 32768), or any socket another process opens may take
+// one first and the domain cannot be created ("address in use").
+inline constexpr std::uint32_t kMaxIsolatedDomainId = 101;
 inline std::uint32_t isolated_domain_id() {
-  // Up to 220: with 600 participant indexes, the discovery ports of ids from 228 pass 65535.
-  return 1 + static_cast<std::uint32_t>(::getpid()) % 220;
+  return 1 + static_cast<std::uint32_t>(::getpid()) % kMaxIsolatedDomainId;
 }
 
 // A discovery tag of this test process's own: two test processes whose domain ids collide
