@@ -250,7 +250,7 @@ Expected<void> DomainManager::Impl::load_installed() {
                    app.error().to_string());
       continue;
     }
-    write_runtime_models(*app); // an installation from before runtime models had none
+    write_runtime_models(*app); // anew: the files may have changed while the domain was down
     installed[r.name] = {r.name, sad,
                          std::make_shared<const profile::ResolvedApplication>(std::move(*app))};
   }
@@ -258,8 +258,8 @@ Expected<void> DomainManager::Impl::load_installed() {
   return {};
 }
 
-// Its components' processes then start without reading XML; one without a model still starts,
-// reading its profile (profile/runtime_model.hpp).
+// The application's components then start from their runtime models, without reading XML; a
+// component without one still starts, reading its profile (profile/runtime_model.hpp).
 void DomainManager::Impl::write_runtime_models(const profile::ResolvedApplication &app) {
   for (const auto &[id, softpkg] : app.component_files)
     if (auto ok = profile::write_runtime_model(*softpkg); !ok)

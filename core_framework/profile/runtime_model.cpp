@@ -365,8 +365,16 @@ std::shared_ptr<const SoftwareComponent> scd_from(const Json &json) {
 
 // --- the files a model came from ---
 
-std::int64_t modified(const fs::path &file, std::error_code &ec) {
-  return fs::last_write_time(file, ec).time_since_epoch().count();
+// What tells a file's content changed, short of reading it: its modification time (ns) and its
+// size. A copy that keeps both (cp -p) of other content goes unnoticed; rsca writes its
+// repository itself.
+Json stamp_of(const std::string &file) {
+  std::error_code ec;
+  const auto modified = fs::last_write_time(file, ec).time_since_epoch().count();
+  const auto size = ec ? 0 : fs::file_size(file, ec);
+  if (ec)
+    return nullptr;
+  return {modified, size};
 }
 
 std::vector<std::string> sources_of(const ResolvedSoftPkg &softpkg) {
@@ -381,13 +389,16 @@ std::vector<std::string> sources_of(const ResolvedSoftPkg &softpkg) {
   return files;
 }
 
-// Empty when every file the model came from is as it was; else which one changed.
-std::string changed_source(const Json &sources) {
+// Empty when the model was written for `spd_file` and every file it came from is as it was;
+// else what is not. A model copied along with its package still names the original's files.
+std::string stale_because(const Json &sources, const fs::path &spd_file) {
+  if (sources.empty() || sources.at(0).at(0).get<std::string>() != spd_file.string())
+    return "it was written for another SPD";
   for (const auto &source : sources) {
     const auto file = source.at(0).get<std::string>();
-    std::error_code ec;
-    if (modified(file, ec) != source.at(1).get<std::int64_t>() || ec)
-      return file;
+    const Json stamp = stamp_of(file);
+    if (stamp.is_null() || stamp != source.at(1))
+      return fmt::format("{} changed since it was written", file);
   }
   return {};
 }
@@ -404,10 +415,8 @@ fs::path runtime_model_path(const fs::path &spd_file) {
 
 Json to_runtime_model(const ResolvedSoftPkg &softpkg) {
   Json sources = Json::array();
-  for (const auto &file : sources_of(softpkg)) {
-    std::error_code ec;
-    sources.push_back({file, modified(file, ec)});
-  }
+  for (const auto &file : sources_of(softpkg))
+    sources.push_back({file, stamp_of(file)});
   Json implementations = Json::array();
   for (const auto &implementation : softpkg.implementations)
     if (implementation.properties)
@@ -440,11 +449,21 @@ Expected<std::shared_ptr<const ResolvedSoftPkg>> from_runtime_model(const Json &
 Expected<void> write_runtime_model(const ResolvedSoftPkg &softpkg) {
   const fs::path target = runtime_model_path(softpkg.spd_path);
   const fs::path temporary = fs::path(target).concat(fmt::format(".{}.tmp", ::getpid()));
+  std::string text;
+  try {
+    text = to_runtime_model(softpkg).dump();
+  } catch (const std::exception &e) { // e.g. a path that is not UTF-8
+    return model_error(target, e.what());
+  }
   {
     std::ofstream out(temporary, std::ios::trunc);
-    out << to_runtime_model(softpkg).dump();
-    if (!out.flush())
+    out << text;
+    out.close();
+    if (!out) {
+      std::error_code ignored;
+      fs::remove(temporary, ignored);
       return model_error(target, fmt::format("cannot write {}", temporary.string()));
+    }
   }
   std::error_code ec;
   fs::rename(temporary, target, ec);
@@ -464,8 +483,8 @@ Expected<std::shared_ptr<const ResolvedSoftPkg>> read_runtime_model(const fs::pa
   if (model.is_discarded() || !model.is_object())
     return model_error(file, "it is not JSON");
   try {
-    if (auto changed = changed_source(model.at("sources")); !changed.empty())
-      return model_error(file, fmt::format("{} changed since it was written", changed));
+    if (auto why = stale_because(model.at("sources"), spd_file); !why.empty())
+      return model_error(file, why);
   } catch (const std::exception &e) {
     return model_error(file, e.what());
   }
@@ -474,10 +493,10 @@ Expected<std::shared_ptr<const ResolvedSoftPkg>> read_runtime_model(const fs::pa
 
 Expected<std::shared_ptr<const ResolvedSoftPkg>>
 ComponentProfileLoader::load(const fs::path &spd_file) {
+  fallback_reason_.clear();
   if (auto it = loaded_.find(spd_file); it != loaded_.end())
     return it->second;
   auto softpkg = read_runtime_model(spd_file);
-  fallback_reason_.clear();
   if (!softpkg) {
     fallback_reason_ = softpkg.error().to_string();
     if (!xml_)

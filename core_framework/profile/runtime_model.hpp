@@ -1,9 +1,10 @@
 // A component's runtime model: what a component process needs of its software package (the
 // property definitions of its PRFs, the ports of its SCD) as JSON. The domain writes it next to
 // each SPD it installs, so that a component process need not load the XML reader and parse its
-// profile: that took about 12 ms of CPU, half of what a component process spends starting
-// (docs/architecture.md). The model lists the files it came from with their modification times;
-// one that no longer matches them is not used, and the profile is read from its XML instead.
+// profile: that took about half of what a component process spends starting (docs/
+// architecture.md, "Runtime models"). The model lists the files it came from with their
+// modification times and sizes; one written for another SPD or that no longer matches them is
+// not used, and the profile is read from its XML instead.
 #pragma once
 
 #include <filesystem>

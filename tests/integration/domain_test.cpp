@@ -107,35 +107,37 @@ TEST_CASE("ProducerConsumer: install, launch, data flows, configure, query, stop
 TEST_CASE("install writes each component's runtime model, and its process starts from it",
           "[integration][domain]") {
   TestDomain domain;
-  auto [rc, out] = domain.cli(
-      {"install",
-       (kSource / "profiles/dom/waveforms/ProducerConsumer/ProducerConsumer.sad.xml").string()});
+  // Producer_1's package in APP: as a process of its own, or hosted in a component host.
+  const auto [app, package] = GENERATE(std::pair{"ProducerConsumer", "Producer"},
+                                       std::pair{"ProducerConsumerHosted", "ProducerLib"});
+  INFO(app);
+  const fs::path sad =
+      kSource / fmt::format("profiles/dom/waveforms/{0}/{0}.sad.xml", std::string(app));
+  auto [rc, out] = domain.cli({"install", sad.string()});
   INFO(out);
   REQUIRE(rc == 0);
-  const fs::path components = domain.run_dir() / "repository/ProducerConsumer/dom/components";
-  const fs::path model = components / "Producer/Producer.spd.xml.model.json";
+  const fs::path model = domain.run_dir() / "repository" / app /
+                         fmt::format("dom/components/{0}/{0}.spd.xml.model.json", package);
   REQUIRE(fs::exists(model));
-  CHECK(fs::exists(components / "Consumer/Consumer.spd.xml.model.json"));
-  // A default changed in the model only (its sources untouched): the launched process has it,
-  // so it read the model, not the XML.
+  // A default changed in the model only (its sources untouched): the launched component has it,
+  // so its process read the model, not the XML.
   Json edited = Json::parse(std::ifstream(model));
   for (auto &d : edited["properties"]["definitions"])
     if (d["id"] == "message")
       d["value"] = "from the model";
   std::ofstream(model) << edited.dump();
 
-  auto [lrc, lout] = domain.cli({"launch", "ProducerConsumer"});
+  auto [lrc, lout] = domain.cli({"launch", app});
   INFO(lout);
   REQUIRE(lrc == 0);
-  auto q = domain.call(
-      "app.query",
-      Json{{"app", "ProducerConsumer"}, {"component", "Producer_1"}, {"ids", {"message"}}});
+  auto q = domain.call("app.query",
+                       Json{{"app", app}, {"component", "Producer_1"}, {"ids", {"message"}}});
   REQUIRE(q.has_value());
   CHECK(q->at("properties").at("message") == "from the model");
-  auto app = domain.call("app.show", Json{{"app", "ProducerConsumer"}});
-  REQUIRE(app.has_value());
-  const auto pids = pids_of(*app);
-  REQUIRE(domain.call("app.release", Json{{"app", "ProducerConsumer"}}).has_value());
+  auto shown = domain.call("app.show", Json{{"app", app}});
+  REQUIRE(shown.has_value());
+  const auto pids = pids_of(*shown);
+  REQUIRE(domain.call("app.release", Json{{"app", app}}).has_value());
   domain.require_clean(pids);
 }
 

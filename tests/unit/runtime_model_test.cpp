@@ -151,28 +151,53 @@ TEST_CASE("a component loader uses the runtime model while its sources are uncha
   CHECK(loader.fallback_reason().empty());
   REQUIRE(find(**softpkg, "message") != nullptr);
   CHECK(default_text(*find(**softpkg, "message")) == "from the model");
-  // Read once: a second instance of the package gets the same one.
+  // Read once: a second instance of the package gets the same one, and its reason to read XML
+  // is not the last other package's.
+  REQUIRE(loader.load(kOwn / "dom/components/Consumer/Consumer.spd.xml").has_value());
+  CHECK_THAT(loader.fallback_reason(), Contains("there is none"));
   auto again = loader.load(copy.spd);
   REQUIRE(again.has_value());
   CHECK(again->get() == softpkg->get());
+  CHECK(loader.fallback_reason().empty());
 }
 
 TEST_CASE("a runtime model older than a file it came from is not used: the XML is read",
           "[profile][runtime-model]") {
   ProducerCopy copy;
   copy.set_default("message", "from the model");
-  const fs::path prf = copy.dir / "Producer.prf.xml";
-  fs::last_write_time(prf, fs::last_write_time(prf) + std::chrono::seconds(1));
+  const std::string changed = GENERATE("Producer.prf.xml", "Producer.scd.xml", "Producer.spd.xml");
+  INFO(changed);
+  const fs::path file = copy.dir / changed;
+  SECTION("its modification time") {
+    fs::last_write_time(file, fs::last_write_time(file) + std::chrono::seconds(1));
+  }
+  SECTION("its size, at the same modification time") {
+    const auto when = fs::last_write_time(file);
+    std::ofstream(file, std::ios::app) << "\n";
+    fs::last_write_time(file, when);
+  }
 
   auto read = read_runtime_model(copy.spd);
   REQUIRE_FALSE(read.has_value());
-  CHECK_THAT(read.error().to_string(), Contains("Producer.prf.xml changed since it was written"));
+  CHECK_THAT(read.error().to_string(), Contains(changed + " changed since it was written"));
 
   ComponentProfileLoader loader;
   auto softpkg = loader.load(copy.spd);
   REQUIRE(softpkg.has_value());
   CHECK_THAT(loader.fallback_reason(), Contains("changed since it was written"));
   CHECK(default_text(*find(**softpkg, "message")) == "hello"); // the PRF's own default
+}
+
+TEST_CASE("a runtime model copied along with its package is not used for the copy",
+          "[profile][runtime-model]") {
+  ProducerCopy copy;
+  const fs::path elsewhere = copy.root / "dom/components/ProducerCopy";
+  fs::copy(copy.dir, elsewhere);
+  const fs::path spd = elsewhere / "Producer.spd.xml";
+  REQUIRE(fs::exists(runtime_model_path(spd)));
+  auto read = read_runtime_model(spd);
+  REQUIRE_FALSE(read.has_value());
+  CHECK_THAT(read.error().to_string(), Contains("it was written for another SPD"));
 }
 
 TEST_CASE("a missing or broken runtime model makes the component loader read the XML",
