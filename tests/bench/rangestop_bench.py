@@ -39,7 +39,6 @@ import select
 import statistics
 import subprocess
 import sys
-import tempfile
 import time
 
 from local_domain import Domain, Processes
@@ -260,7 +259,10 @@ def main():
         if w not in WAYS:
             parser.error(f"unknown way {w} (known: {', '.join(WAYS)})")
 
-    logs = tempfile.mkdtemp(prefix="rsca-rangestop-bench-")
+    # The processes' logs go beside the results they explain, not into a folder of /tmp of their
+    # own that every run would leave behind.
+    logs = os.path.splitext(os.path.abspath(args.out))[0] + "-logs"
+    os.makedirs(logs, exist_ok=True)
     started = time.time()
     results = {"settings": {"speed": args.speed, "threshold": args.threshold,
                             "period_ms": args.period_ms, "wall_distance": args.wall_distance,

@@ -78,14 +78,27 @@ void check_same(const ResolvedSoftPkg &xml, const ResolvedSoftPkg &model) {
   }
 }
 
+// A folder removed with it, also when the test fails while filling it.
+struct TemporaryFolder {
+  fs::path path;
+  explicit TemporaryFolder(fs::path p) : path(std::move(p)) { fs::remove_all(path); }
+  ~TemporaryFolder() {
+    std::error_code ignored;
+    fs::remove_all(path, ignored);
+  }
+  TemporaryFolder(const TemporaryFolder &) = delete;
+  TemporaryFolder &operator=(const TemporaryFolder &) = delete;
+};
+
 // A copy of the project's Producer package in an SDR root of its own, with its runtime model.
 struct ProducerCopy {
-  fs::path root = fs::temp_directory_path() / ("rsca-runtime-model-" + std::to_string(::getpid()));
+  TemporaryFolder folder{fs::temp_directory_path() /
+                         ("rsca-runtime-model-" + std::to_string(::getpid()))};
+  fs::path root = folder.path;
   fs::path dir = root / "dom/components/Producer";
   fs::path spd = dir / "Producer.spd.xml";
 
   ProducerCopy() {
-    fs::remove_all(root);
     fs::create_directories(dir);
     for (const auto &entry : fs::directory_iterator(kOwn / "dom/components/Producer"))
       fs::copy_file(entry.path(), dir / entry.path().filename());
@@ -94,7 +107,6 @@ struct ProducerCopy {
     REQUIRE(softpkg.has_value());
     REQUIRE(write_runtime_model(**softpkg).has_value());
   }
-  ~ProducerCopy() { fs::remove_all(root); }
 
   Json model() const { return Json::parse(std::ifstream(runtime_model_path(spd))); }
   void set_model(const Json &json) const { std::ofstream(runtime_model_path(spd)) << json.dump(); }
