@@ -14,7 +14,7 @@ namespace fs = std::filesystem;
 using Json = nlohmann::json;
 
 // Bumped whenever the layout changes: a model of another format is not used.
-constexpr int kFormat = 1;
+constexpr int kFormat = 2; // 2: sources stamped with modification time and size
 
 // A model that does not read back is reported as one error (the caller reads the XML instead),
 // so reading throws within this file and from_runtime_model turns that into the error.
