@@ -55,10 +55,6 @@ std::vector<profile::PropertyDefinition> definitions_of(const profile::ResolvedS
   return out;
 }
 
-std::string_view direction_name(profile::PortDirection direction) {
-  return direction == profile::PortDirection::Uses ? "uses" : "provides";
-}
-
 CallResult<std::string> string_field(const Json &body, const char *key) {
   auto it = body.find(key);
   if (it == body.end() || !it->is_string() || it->get_ref<const std::string &>().empty())
@@ -101,7 +97,7 @@ Expected<void> Host::check_ports() const {
     const auto *definition = scd ? scd->find_port(port->name(), port->direction()) : nullptr;
     if (definition == nullptr) {
       fail(fmt::format("the component has {} port \"{}\", which its SCD does not declare",
-                       direction_name(port->direction()), port->name()));
+                       profile::to_string(port->direction()), port->name()));
       continue;
     }
     const auto type = port::port_type_for_repid(definition->repid);
@@ -232,7 +228,7 @@ Json Host::ports_json() const {
         softpkg_->scd ? softpkg_->scd->find_port(port->name(), port->direction()) : nullptr;
     ports.push_back(
         {{"name", port->name()},
-         {"direction", direction_name(port->direction())},
+         {"direction", profile::to_string(port->direction())},
          {"repid", definition ? definition->repid : std::string(port::repid_of(port->type()))}});
   }
   return ports;
@@ -442,10 +438,10 @@ CallResult<Json> Host::op_connect(const Json &body, const control::RequestContex
   PortBase *port = find_port(*port_name);
   if (port == nullptr)
     return control::call_error(Status::NotFound, fmt::format("no port \"{}\"", *port_name));
-  if (*direction != direction_name(port->direction()))
+  if (*direction != profile::to_string(port->direction()))
     return control::call_error(Status::BadRequest,
                                fmt::format("port \"{}\" is a {} port, not {}", *port_name,
-                                           direction_name(port->direction()), *direction));
+                                           profile::to_string(port->direction()), *direction));
   if (port::port_type_for_repid(*repid) != port->type())
     return control::call_error(Status::BadRequest,
                                fmt::format("port \"{}\" carries {}, which {} does not", *port_name,
@@ -560,7 +556,7 @@ CallResult<Json> Host::op_status(const Json &, const control::RequestContext &) 
                              {"deadline_missed", s.deadline_missed},
                              {"in_host", s.in_host}});
     ports.push_back({{"name", port->name()},
-                     {"direction", direction_name(port->direction())},
+                     {"direction", profile::to_string(port->direction())},
                      {"connections", std::move(connections)}});
   }
   return Json{{"state", to_string(c().state())}, {"ports", std::move(ports)}};

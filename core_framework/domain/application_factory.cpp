@@ -402,7 +402,7 @@ private:
 
   CallResult<ConnectionEnd> device_end(ConnectionInstance &ci, const std::string &device,
                                        const std::string &port, profile::PortDirection direction) {
-    const char *wanted = direction == profile::PortDirection::Uses ? "uses" : "provides";
+    const auto wanted = profile::to_string(direction);
     auto ports = s_.device_ports ? s_.device_ports(device) : std::nullopt;
     const Json *found = nullptr;
     if (ports)

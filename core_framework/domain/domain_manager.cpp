@@ -789,7 +789,7 @@ DomainManager::Impl::resolve_component_end(const PortRef &ref, profile::PortDire
     if (external == nullptr)
       return control::call_error(Status::NotFound,
                                  fmt::format("{} is not an external {} port", ref.to_string(),
-                                             uses ? "uses" : "provides"));
+                                             profile::to_string(direction)));
     component = external->component_ref;
     port = external->port;
   }
@@ -804,13 +804,13 @@ DomainManager::Impl::resolve_component_end(const PortRef &ref, profile::PortDire
       pkg != nullptr && pkg->scd ? pkg->scd->find_port(port, direction) : nullptr;
   if (definition == nullptr)
     return control::call_error(Status::NotFound, fmt::format("{} is not a {} port", ref.to_string(),
-                                                             uses ? "uses" : "provides"));
+                                                             profile::to_string(direction)));
   return ResolvedEnd{instance->address, port, definition->repid};
 }
 
 CallResult<ResolvedEnd> DomainManager::Impl::resolve_device_end(const PortRef &ref,
                                                                 profile::PortDirection direction) {
-  const char *wanted = direction == profile::PortDirection::Uses ? "uses" : "provides";
+  const auto wanted = profile::to_string(direction);
   std::lock_guard lock(mutex);
   const std::string node = ref.owner.substr(0, ref.owner.find(':'));
   if (nodes.count(node) == 0)

@@ -85,7 +85,7 @@ private:
     for (const auto &p : scd->ports)
       if (p.direction == direction)
         names.push_back(p.name);
-    const char *kind = direction == PortDirection::Uses ? "uses" : "provides";
+    const auto kind = to_string(direction);
     warn(where, "unknown-port",
          fmt::format("{}: component \"{}\" has no {} port \"{}\" ({} ports: {})", what, instance,
                      kind, port, kind,

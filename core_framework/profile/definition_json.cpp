@@ -22,25 +22,6 @@ Enum enum_from(const Json &json, std::optional<Enum> (*from_name)(std::string_vi
   throw ReadError(fmt::format("unknown name \"{}\"", name));
 }
 
-std::optional<AccessMode> access_mode_from_name(std::string_view name) {
-  for (auto mode : {AccessMode::ReadWrite, AccessMode::ReadOnly, AccessMode::WriteOnly})
-    if (to_string(mode) == name)
-      return mode;
-  return std::nullopt;
-}
-
-std::optional<PortDirection> direction_from_name(std::string_view name) {
-  if (name == "uses")
-    return PortDirection::Uses;
-  if (name == "provides")
-    return PortDirection::Provides;
-  return std::nullopt;
-}
-
-std::string_view to_string(PortDirection direction) {
-  return direction == PortDirection::Uses ? "uses" : "provides";
-}
-
 // --- values: as their profile text, read back with the declared type ---
 
 Json scalar_json(const Scalar &value) {
@@ -306,7 +287,7 @@ SoftwareComponent software_component_from(const Json &json) {
     scd.supported_interfaces.push_back({s.at(0).get<std::string>(), s.at(1).get<std::string>()});
   for (const auto &p : json.at("ports"))
     scd.ports.push_back({p.at("name").get<std::string>(), p.at("repid").get<std::string>(),
-                         enum_from(p.at("direction"), &direction_from_name),
+                         enum_from(p.at("direction"), &port_direction_from_name),
                          p.at("types").get<std::vector<std::string>>(),
                          p.at("description").get<std::string>(), where_from(p.at("where"))});
   for (const auto &i : json.at("interfaces"))

@@ -73,6 +73,24 @@ std::string_view to_string(AccessMode mode) {
   return "readwrite";
 }
 
+std::optional<AccessMode> access_mode_from_name(std::string_view name) {
+  for (auto mode : {AccessMode::ReadWrite, AccessMode::ReadOnly, AccessMode::WriteOnly})
+    if (to_string(mode) == name)
+      return mode;
+  return std::nullopt;
+}
+
+std::string_view to_string(PortDirection direction) {
+  return direction == PortDirection::Uses ? "uses" : "provides";
+}
+
+std::optional<PortDirection> port_direction_from_name(std::string_view name) {
+  for (auto direction : {PortDirection::Uses, PortDirection::Provides})
+    if (to_string(direction) == name)
+      return direction;
+  return std::nullopt;
+}
+
 std::string format_value(const PropertyValue &value) {
   return std::visit(Overloaded{[](const Scalar &s) { return format_scalar(s); },
                                [](const std::vector<Scalar> &s) { return format_sequence(s); },

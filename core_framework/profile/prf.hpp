@@ -4,6 +4,7 @@
 
 #include <optional>
 #include <string>
+#include <string_view>
 #include <variant>
 #include <vector>
 
@@ -27,6 +28,7 @@ enum class AccessMode : std::uint8_t { ReadWrite, ReadOnly, WriteOnly };
 std::optional<PropertyKind> property_kind_from_name(std::string_view name);
 std::string_view to_string(PropertyKind kind);
 std::string_view to_string(AccessMode mode);
+std::optional<AccessMode> access_mode_from_name(std::string_view name);
 
 // A value of a struct: each member by id, a scalar or a sequence.
 using MemberValue = std::variant<Scalar, std::vector<Scalar>>;

@@ -6,13 +6,9 @@ namespace {
 
 using detail::ReadContext;
 
+// The schema admits only the three names; none given is SCA's default, readwrite.
 AccessMode read_mode(const XmlElement &e) {
-  const std::string &mode = e.attr("mode");
-  if (mode == "readonly")
-    return AccessMode::ReadOnly;
-  if (mode == "writeonly")
-    return AccessMode::WriteOnly;
-  return AccessMode::ReadWrite;
+  return access_mode_from_name(e.attr("mode")).value_or(AccessMode::ReadWrite);
 }
 
 void read_common(ReadContext &ctx, const XmlElement &e, PropertyCommon &p) {

@@ -10,10 +10,11 @@ using detail::ReadContext;
 void read_ports(ReadContext &ctx, const XmlElement &ports, SoftwareComponent &scd) {
   std::set<std::string> names;
   for (const auto &p : ports.children) {
-    if (p.name != "uses" && p.name != "provides")
+    const auto direction = port_direction_from_name(p.name);
+    if (!direction)
       continue;
     PortDefinition port;
-    port.direction = p.name == "uses" ? PortDirection::Uses : PortDirection::Provides;
+    port.direction = *direction;
     port.name = p.attr(p.name == "uses" ? "usesname" : "providesname");
     port.repid = p.attr("repid");
     port.description = p.child_text("description");

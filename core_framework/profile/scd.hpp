@@ -3,6 +3,7 @@
 
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "common/diagnostic.hpp"
@@ -10,6 +11,9 @@
 namespace rsca::profile {
 
 enum class PortDirection : std::uint8_t { Uses, Provides };
+// "uses" and "provides", as the SCD's elements are named.
+std::string_view to_string(PortDirection direction);
+std::optional<PortDirection> port_direction_from_name(std::string_view name);
 
 struct PortDefinition {
   std::string name;
