@@ -274,12 +274,23 @@ TEST_CASE("a restarted domain daemon sees every node again and keeps what was in
           "[integration][domain][recovery]") {
   TestDomain domain;
   domain.install("Healthy");
+  // Models lost while the domain was down are written again when it starts.
+  std::vector<fs::path> models;
+  for (const auto &entry : fs::recursive_directory_iterator(domain.run_dir() / "repository"))
+    if (entry.path().string().ends_with(".model.json"))
+      models.push_back(entry.path());
+  REQUIRE_FALSE(models.empty());
+  for (const auto &model : models)
+    fs::remove(model);
   domain.restart_domaind();
   // The nodes do nothing: their durable announcements reach the new domain daemon.
   CHECK(TestDomain::wait_for([&] {
     auto nodes = domain.call("domain.nodes", Json::object(), 2s);
     return nodes && nodes->at("nodes").size() == 2;
   }));
+  // It answers only once it has loaded what was installed.
+  for (const auto &model : models)
+    CHECK(fs::exists(model));
   auto installed = domain.call("domain.installed");
   REQUIRE(installed.has_value());
   REQUIRE(installed->at("applications").size() == 1);

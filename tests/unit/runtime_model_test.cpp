@@ -244,3 +244,17 @@ TEST_CASE("a missing or broken runtime model makes the component loader read the
     CHECK_THAT(loader.fallback_reason(), Contains("format 99"));
   }
 }
+
+TEST_CASE("a runtime model that cannot be written is an error naming it, and nothing is left",
+          "[profile][runtime-model]") {
+  ProducerCopy copy;
+  auto softpkg = ProfileLoader().load_softpkg(copy.spd);
+  REQUIRE(softpkg.has_value());
+  ResolvedSoftPkg elsewhere = **softpkg;
+  elsewhere.spd_path = copy.root / "no such folder" / "Producer.spd.xml";
+  auto written = write_runtime_model(elsewhere);
+  REQUIRE_FALSE(written.has_value());
+  CHECK_THAT(written.error().to_string(), Contains("Producer.spd.xml.model.json"));
+  CHECK_THAT(written.error().to_string(), Contains("cannot write"));
+  CHECK_FALSE(fs::exists(copy.root / "no such folder"));
+}
