@@ -93,11 +93,6 @@ ComponentRegistry::wait_registered(const std::vector<std::string> &addresses,
   std::size_t registered = 0;
   // Counts the registered addresses; false as soon as one has exited or the wait is cancelled.
   auto count = [&] {
-    if (cancelled != nullptr && cancelled->load()) {
-      failure =
-          fmt::format("cancelled while {} of {} had registered", registered, addresses.size());
-      return false;
-    }
     registered = 0;
     for (const auto &a : addresses) {
       auto it = entries_.find(a);
@@ -106,6 +101,12 @@ ComponentRegistry::wait_registered(const std::vector<std::string> &addresses,
         return false;
       }
       registered += it != entries_.end() && it->second.registered ? 1 : 0;
+    }
+    // Checked after counting so that the message gives the count at the moment of cancelling.
+    if (cancelled != nullptr && cancelled->load()) {
+      failure =
+          fmt::format("cancelled while {} of {} had registered", registered, addresses.size());
+      return false;
     }
     return true;
   };

@@ -116,6 +116,17 @@ TEST_CASE("a cancelled wait ends when interrupted, long before its quiet interva
   CHECK(std::chrono::steady_clock::now() - began < 1h);
 }
 
+TEST_CASE("a wait cancelled before it began still counts who had registered", "[unit][registry]") {
+  // The interrupt may come before the wait's first look (CI saw "0 of 2" here).
+  ComponentRegistry registry;
+  auto addresses = expect_all(registry, 2);
+  registry.announced(addresses[0], nlohmann::json::object());
+  std::atomic<bool> cancelled{true};
+  auto ok = registry.wait_registered(addresses, 1h, &cancelled);
+  REQUIRE_FALSE(ok.has_value());
+  CHECK_THAT(ok.error().message, Catch::Contains("cancelled while 1 of 2 had registered"));
+}
+
 TEST_CASE("an interrupt without a cancellation leaves a wait waiting", "[unit][registry]") {
   ComponentRegistry registry;
   auto addresses = expect_all(registry, 1);
