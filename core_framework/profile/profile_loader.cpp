@@ -102,6 +102,7 @@ ProfileLoader::cached_descriptor(const fs::path &file, const SourceLocation &ref
                       fmt::format("the file named here does not exist: {}", key.string()));
   auto it = files_.find(key);
   if (it == files_.end()) {
+    stamps_[key] = stamp_of(key);
     auto read = read_descriptor(key).map(
         [](Descriptor d) { return std::make_shared<const Descriptor>(std::move(d)); });
     it = files_.emplace(key, std::move(read)).first;
@@ -109,6 +110,12 @@ ProfileLoader::cached_descriptor(const fs::path &file, const SourceLocation &ref
   if (!it->second)
     return tl::unexpected(with_reference_note(it->second.error(), referenced_at, key));
   return *it->second;
+}
+
+SourceFile ProfileLoader::source_file(const fs::path &file) const {
+  const fs::path key = fs::absolute(file).lexically_normal();
+  auto it = stamps_.find(key);
+  return {key.string(), it == stamps_.end() ? std::nullopt : it->second};
 }
 
 template <typename T>
@@ -162,21 +169,28 @@ ProfileLoader::softpkg(const fs::path &spd_file, const SourceLocation &reference
   auto resolved = std::make_shared<ResolvedSoftPkg>();
   resolved->spd_path = key;
   resolved->spd = *spd;
+  resolved->sources.push_back(source_file(key));
   const SdrTree own_tree = tree_of(*root, key);
   auto file_of = [&](const LocalFile &f) { return root->resolve(f.name, key, own_tree); };
   if (const auto &pf = (*spd)->property_file) {
     auto prf = cached<Properties>(file_of(*pf), pf->where);
     prf ? void(resolved->properties = *prf) : errors.append(prf.error());
+    if (prf)
+      resolved->sources.push_back(source_file(file_of(*pf)));
   }
   if (const auto &d = (*spd)->descriptor) {
     auto scd = cached<SoftwareComponent>(file_of(*d), d->where);
     scd ? void(resolved->scd = *scd) : errors.append(scd.error());
+    if (scd)
+      resolved->sources.push_back(source_file(file_of(*d)));
   }
   for (const auto &impl : (*spd)->implementations) {
     ResolvedImplementation ri{&impl, nullptr, {}};
     if (impl.property_file) {
       auto prf = cached<Properties>(file_of(*impl.property_file), impl.property_file->where);
       prf ? void(ri.properties = *prf) : errors.append(prf.error());
+      if (prf)
+        resolved->sources.push_back(source_file(file_of(*impl.property_file)));
     }
     for (const auto &ref : impl.softpkg_dependencies) {
       // Shared libraries live in dom/deps whichever tree the package is in, as in REDHAWK.

@@ -13,6 +13,7 @@
 
 #include "common/diagnostic.hpp"
 #include "profile/descriptor.hpp"
+#include "profile/file_stamp.hpp"
 #include "profile/sdr_root.hpp"
 #include "profile/xml_reader.hpp"
 
@@ -37,6 +38,8 @@ struct ResolvedSoftPkg {
   std::shared_ptr<const Properties> properties; // may be null
   std::shared_ptr<const SoftwareComponent> scd; // may be null (libraries have none)
   std::vector<ResolvedImplementation> implementations;
+  // The files it was read from (its SPD, PRFs and SCD), each stamped before it was read.
+  std::vector<SourceFile> sources;
 
   // The definition of property `id` in the SPD's PRF or any implementation's PRF.
   const PropertyDefinition *find_property(std::string_view id) const;
@@ -92,12 +95,15 @@ private:
                                                            const SourceLocation &referenced_at);
   Expected<std::shared_ptr<const Descriptor>>
   cached_descriptor(const std::filesystem::path &file, const SourceLocation &referenced_at);
+  // `file` as read, with the stamp taken before reading it.
+  SourceFile source_file(const std::filesystem::path &file) const;
   template <typename T>
   Expected<std::shared_ptr<const T>> cached(const std::filesystem::path &file,
                                             const SourceLocation &referenced_at);
 
   std::optional<std::filesystem::path> sdrroot_;
   std::map<std::filesystem::path, Expected<std::shared_ptr<const Descriptor>>> files_;
+  std::map<std::filesystem::path, std::optional<FileStamp>> stamps_; // taken before each read
   std::map<std::filesystem::path, Expected<std::shared_ptr<const ResolvedSoftPkg>>> softpkgs_;
   std::vector<std::filesystem::path> resolving_; // SPDs being resolved, to find cycles
   // Held from the first file read to the loader's end: its files share one load of the reader.

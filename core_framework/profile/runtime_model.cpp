@@ -36,41 +36,39 @@ nullable_from(const Json &json, tl::expected<T, std::string> (*read)(const Json 
 
 // --- the files a model came from ---
 
-// What tells a file's content changed, short of reading it: its modification time (ns) and its
-// size. A copy that keeps both (cp -p) of other content goes unnoticed; rsca writes its
-// repository itself.
-Json stamp_of(const std::string &file) {
-  std::error_code ec;
-  const auto modified = fs::last_write_time(file, ec).time_since_epoch().count();
-  const auto size = ec ? 0 : fs::file_size(file, ec);
-  if (ec)
-    return nullptr;
-  return {modified, size};
+Json stamp_json(const std::optional<FileStamp> &stamp) {
+  return stamp ? Json{stamp->modified_ns, stamp->size} : Json();
 }
 
-std::vector<std::string> sources_of(const ResolvedSoftPkg &softpkg) {
-  std::vector<std::string> files{softpkg.spd_path.string()};
-  if (softpkg.properties)
-    files.push_back(softpkg.properties->file);
-  for (const auto &implementation : softpkg.implementations)
-    if (implementation.properties)
-      files.push_back(implementation.properties->file);
-  if (softpkg.scd)
-    files.push_back(softpkg.scd->file);
-  return files;
+Json sources_json(const std::vector<SourceFile> &sources) {
+  Json json = Json::array();
+  for (const auto &source : sources)
+    json.push_back({source.path, stamp_json(source.stamp)});
+  return json;
 }
 
-// Empty when the model was written for `spd_file` and every file it came from is as it was;
-// else what is not. A model copied along with its package still names the original's files.
-std::string stale_because(const Json &sources, const fs::path &spd_file) {
-  if (sources.empty() || sources.at(0).at(0).get<std::string>() != spd_file.string())
-    return "it was written for another SPD";
-  for (const auto &source : sources) {
-    const auto file = source.at(0).get<std::string>();
-    const Json stamp = stamp_of(file);
-    if (stamp.is_null() || stamp != source.at(1))
-      return fmt::format("{} changed since it was written", file);
+std::vector<SourceFile> sources_from(const Json &json) {
+  std::vector<SourceFile> sources;
+  for (const auto &source : json) {
+    const Json &stamp = source.at(1);
+    sources.push_back(
+        {source.at(0).get<std::string>(),
+         stamp.is_null() ? std::nullopt
+                         : std::optional<FileStamp>(FileStamp{stamp.at(0).get<std::int64_t>(),
+                                                              stamp.at(1).get<std::uintmax_t>()})});
   }
+  return sources;
+}
+
+// Empty when the model was written for `spd_file` and every file it came from is as it was
+// before the domain read it; else what is not. A model copied along with its package still
+// names the original's files.
+std::string stale_because(const std::vector<SourceFile> &sources, const fs::path &spd_file) {
+  if (sources.empty() || sources.front().path != spd_file.string())
+    return "it was written for another SPD";
+  for (const auto &source : sources)
+    if (!source.stamp || stamp_of(source.path) != source.stamp)
+      return fmt::format("{} changed since it was written", source.path);
   return {};
 }
 
@@ -85,15 +83,12 @@ fs::path runtime_model_path(const fs::path &spd_file) {
 }
 
 Json to_runtime_model(const ResolvedSoftPkg &softpkg) {
-  Json sources = Json::array();
-  for (const auto &file : sources_of(softpkg))
-    sources.push_back({file, stamp_of(file)});
   Json implementations = Json::array();
   for (const auto &implementation : softpkg.implementations)
     if (implementation.properties)
       implementations.push_back(to_json(*implementation.properties));
   return {{"format", kFormat},
-          {"sources", sources},
+          {"sources", sources_json(softpkg.sources)},
           {"properties", nullable_json(softpkg.properties)},
           {"implementation_properties", implementations},
           {"scd", nullable_json(softpkg.scd)}};
@@ -107,6 +102,7 @@ Expected<std::shared_ptr<const ResolvedSoftPkg>> from_runtime_model(const Json &
                          fmt::format("format {} is not {}", model.at("format").dump(), kFormat));
     auto softpkg = std::make_shared<ResolvedSoftPkg>();
     softpkg->spd_path = spd_file;
+    softpkg->sources = sources_from(model.at("sources"));
     auto properties = nullable_from(model.at("properties"), &properties_from_json);
     if (!properties)
       return model_error(spd_file, properties.error());
@@ -164,13 +160,12 @@ Expected<std::shared_ptr<const ResolvedSoftPkg>> read_runtime_model(const fs::pa
   const Json model = Json::parse(in, nullptr, /*allow_exceptions=*/false);
   if (model.is_discarded() || !model.is_object())
     return model_error(file, "it is not JSON");
-  try {
-    if (auto why = stale_because(model.at("sources"), spd_file); !why.empty())
-      return model_error(file, why);
-  } catch (const std::exception &e) {
-    return model_error(file, e.what());
-  }
-  return from_runtime_model(model, spd_file);
+  auto softpkg = from_runtime_model(model, spd_file);
+  if (!softpkg)
+    return softpkg;
+  if (auto why = stale_because((*softpkg)->sources, spd_file); !why.empty())
+    return model_error(file, why);
+  return softpkg;
 }
 
 Expected<std::shared_ptr<const ResolvedSoftPkg>>

@@ -3,8 +3,9 @@
 // each SPD it installs, so that a component process need not load the XML reader and parse its
 // profile: that took about half of what a component process spends starting (docs/
 // architecture.md, "Runtime models"). The model lists the files it came from with their
-// modification times and sizes; one written for another SPD or that no longer matches them is
-// not used, and the profile is read from its XML instead.
+// modification times and sizes as they were before the domain read them (an edit racing the read
+// makes the model stale, never wrongly current); one written for another SPD or that no longer
+// matches them is not used, and the profile is read from its XML instead.
 #pragma once
 
 #include <filesystem>

@@ -200,6 +200,24 @@ TEST_CASE("a runtime model older than a file it came from is not used: the XML i
   CHECK(default_text(*find(**softpkg, "message")) == "hello"); // the PRF's own default
 }
 
+TEST_CASE("a file edited after it was read but before the model was written makes the model stale",
+          "[profile][runtime-model]") {
+  // The model's stamps are those from before the read: stamps taken when writing would make a
+  // model of the old content pass for the new file.
+  ProducerCopy copy;
+  auto softpkg = ProfileLoader().load_softpkg(copy.spd);
+  REQUIRE(softpkg.has_value());
+  const fs::path prf = copy.dir / "Producer.prf.xml";
+  const auto when = fs::last_write_time(prf);
+  std::ofstream(prf, std::ios::app) << "\n"; // the edit, between the read and the write
+  fs::last_write_time(prf, when + std::chrono::seconds(1));
+  REQUIRE(write_runtime_model(**softpkg).has_value());
+
+  auto read = read_runtime_model(copy.spd);
+  REQUIRE_FALSE(read.has_value());
+  CHECK_THAT(read.error().to_string(), Contains("Producer.prf.xml changed since it was written"));
+}
+
 TEST_CASE("a runtime model copied along with its package is not used for the copy",
           "[profile][runtime-model]") {
   ProducerCopy copy;
