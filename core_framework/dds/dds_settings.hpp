@@ -10,6 +10,17 @@
 
 namespace rsca::dds {
 
+// Cyclone's discovery port for domain id d is 7400 + 250 x d. Up to this id it lies below the
+// kernel's ephemeral ports (from 32768), which any other process's socket may hold first. Tests,
+// benchmarks and the demo pick their ids up to it (tests/bench/local_domain.py and tools/demo
+// say the same in their languages).
+inline constexpr std::uint32_t kFirstDiscoveryPort = 7400;
+inline constexpr std::uint32_t kDiscoveryPortsPerDomain = 250;
+inline constexpr std::uint32_t kFirstEphemeralPort = 32768;
+inline constexpr std::uint32_t kLastPortSafeDomainId =
+    (kFirstEphemeralPort - 1 - kFirstDiscoveryPort) / kDiscoveryPortsPerDomain;
+static_assert(kLastPortSafeDomainId == 101);
+
 struct DdsSettings {
   std::uint32_t domain_id = 0;
   std::string interface_name = "lo";

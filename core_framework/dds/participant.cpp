@@ -20,19 +20,18 @@ Error dds_error(dds_return_t result, std::string_view what) {
 
 namespace {
 
-// Cyclone's discovery port for a domain id is 7400 + 250 x id; past the first ephemeral port
-// (32768 on Linux) another process's socket may already hold it.
+// Why a domain could not be created, when its discovery port is the likely reason.
 std::string port_hint(std::uint32_t domain_id) {
-  constexpr std::uint64_t kFirstEphemeralPort = 32768;
   constexpr std::uint64_t kLastPort = 65535;
-  const std::uint64_t port = 7400 + 250 * std::uint64_t{domain_id};
+  const std::uint64_t port =
+      kFirstDiscoveryPort + std::uint64_t{kDiscoveryPortsPerDomain} * domain_id;
   if (port > kLastPort)
-    return fmt::format(" (its discovery port would be {}, past {}; domain ids 0-101 work)", port,
-                       kLastPort);
+    return fmt::format(" (its discovery port would be {}, past {}; domain ids 0-{} work)", port,
+                       kLastPort, kLastPortSafeDomainId);
   if (port >= kFirstEphemeralPort)
     return fmt::format(" (its discovery port {} is among the ephemeral ports another socket may "
-                       "hold; domain ids 0-101 avoid them)",
-                       port);
+                       "hold; domain ids 0-{} avoid them)",
+                       port, kLastPortSafeDomainId);
   return {};
 }
 

@@ -81,9 +81,9 @@ def wait_gone(pids, timeout):
 def dds_env():
     """The environment of a benchmark run's DDS programs: a DDS domain id and discovery tag of
     the run's own, so that nothing else on the host takes part."""
-    # DDS domain ids up to 101: a domain's discovery ports (7400 + 250 x id) must stay below the
-    # kernel's ephemeral ports (from 32768), which any socket may take first; the tag separates
-    # runs whose ids collide.
+    # DDS domain ids up to 101 (dds::kLastPortSafeDomainId, core_framework/dds/dds_settings.hpp):
+    # a domain's discovery port must stay below the kernel's ephemeral ports, which any socket
+    # may take first; the tag separates runs whose ids collide.
     return dict(os.environ, RSCA_DDS_DOMAIN=str(1 + os.getpid() % 101),
                 RSCA_DDS_TAG=f"bench-{os.getpid()}")
 

@@ -16,12 +16,10 @@ namespace rsca::test {
 
 // A domain id derived from the process id: ctest runs each test case in its own process, so
 // concurrent tests mostly get different ids, and the discovery tag below separates those that
-// do not. At most kMaxIsolatedDomainId: a domain's discovery ports (7400 + 250 x id) must stay
-// below the kernel's ephemeral ports (from 32768), or any socket another process opens may take
-// one first and the domain cannot be created ("address in use").
-inline constexpr std::uint32_t kMaxIsolatedDomainId = 101;
+// do not. At most dds::kLastPortSafeDomainId, or any socket another process opens may take the
+// domain's discovery port first and the domain cannot be created ("address in use").
 inline std::uint32_t isolated_domain_id() {
-  return 1 + static_cast<std::uint32_t>(::getpid()) % kMaxIsolatedDomainId;
+  return 1 + static_cast<std::uint32_t>(::getpid()) % dds::kLastPortSafeDomainId;
 }
 
 // A discovery tag of this test process's own: two test processes whose domain ids collide
