@@ -14,7 +14,6 @@
 #include "component/in_process.hpp"
 #include "component/process.hpp"
 #include "component/runtime.hpp"
-#include "profile/runtime_model.hpp"
 
 namespace rsca::component {
 
@@ -68,25 +67,6 @@ tl::expected<Factory, std::string> load_factory(const fs::path &library) {
   return factory;
 }
 
-// The profiles of every component, read with one loader: each SPD once, from its runtime model
-// where the domain wrote one; the XML reader, when needed at all, is unloaded before any
-// component runs.
-tl::expected<std::vector<std::shared_ptr<const profile::ResolvedSoftPkg>>, std::string>
-load_profiles(const std::vector<HostedComponent> &hosted, spdlog::logger &log) {
-  profile::ComponentProfileLoader loader;
-  std::vector<std::shared_ptr<const profile::ResolvedSoftPkg>> softpkgs;
-  for (const auto &h : hosted) {
-    auto softpkg = loader.load(h.params.profile);
-    if (!softpkg)
-      return tl::unexpected(fmt::format("cannot load the profile {}:\n{}", h.params.profile,
-                                        softpkg.error().to_string()));
-    if (!loader.fallback_reason().empty())
-      log.debug("{} read from its XML: {}", h.params.profile, loader.fallback_reason());
-    softpkgs.push_back(*softpkg);
-  }
-  return softpkgs;
-}
-
 Context context_of(const ExecParams &p) {
   return Context{p.identifier,
                  p.name_binding,
@@ -114,7 +94,10 @@ open_endpoint(const HostParams &host, std::shared_ptr<dds::Participant> particip
 
 int serve_hosted(const HostParams &host, const ExitEvents &events, spdlog::logger &log) {
   const auto &hosted = host.components;
-  auto softpkgs = load_profiles(hosted, log);
+  std::vector<std::string> spds;
+  for (const auto &h : hosted)
+    spds.push_back(h.params.profile);
+  auto softpkgs = detail::load_component_profiles(spds, log);
   if (!softpkgs) {
     log.error("{}", softpkgs.error());
     return kExitProfile;

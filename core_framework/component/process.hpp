@@ -15,6 +15,7 @@
 #include <string>
 #include <string_view>
 #include <utility>
+#include <vector>
 
 #include <fmt/format.h>
 #include <poll.h>
@@ -24,6 +25,7 @@
 #include <tl/expected.hpp>
 
 #include "component/runtime.hpp"
+#include "profile/profile_loader.hpp"
 
 namespace rsca::component::detail {
 
@@ -111,6 +113,13 @@ inline std::shared_ptr<spdlog::logger> make_logger(const std::string &name) {
 // from the node's loss. The node may die before this runs, its orphan adopted by another
 // process: the node's pid in the environment tells them apart. False: the node is already gone.
 bool die_with_node();
+
+// The profiles of a process's components, in the order of `spds`, read with one loader: each SPD
+// once, from its runtime model where the domain wrote one, else from its XML (said at debug
+// level). The loader goes on return: an XML reader it needed is unloaded before any component
+// runs. An error names the profile that cannot be read.
+tl::expected<std::vector<std::shared_ptr<const profile::ResolvedSoftPkg>>, std::string>
+load_component_profiles(const std::vector<std::string> &spds, spdlog::logger &log);
 
 // Waits for a signal or `released`; true for a signal (`signal` says which).
 bool wait_for_signal_or_release(const ExitEvents &events, int &signal);

@@ -23,7 +23,6 @@
 #include "common/exec_environment.hpp"
 #include "component/host.hpp"
 #include "component/process.hpp"
-#include "profile/runtime_model.hpp"
 
 namespace rsca::component {
 
@@ -121,26 +120,14 @@ void wait_for_exit(const ExitEvents &events, detail::Host &host, spdlog::logger 
   host.shutdown(name);
 }
 
-// The component's profile, or null when it cannot be read (said in the log). The loader goes at
-// once: the XML reader it may have needed is unloaded before the component runs.
-std::shared_ptr<const profile::ResolvedSoftPkg> load_profile(const std::string &spd,
-                                                             spdlog::logger &log) {
-  profile::ComponentProfileLoader loader;
-  auto softpkg = loader.load(spd);
-  if (!softpkg) {
-    log.error("cannot load the profile {}:\n{}", spd, softpkg.error().to_string());
-    return nullptr;
-  }
-  if (!loader.fallback_reason().empty())
-    log.debug("{} read from its XML: {}", spd, loader.fallback_reason());
-  return *softpkg;
-}
-
 int run_host(const ExecParams &params, const ExitEvents &events, const Factory &factory,
              std::shared_ptr<spdlog::logger> logger) {
-  auto softpkg = load_profile(params.profile, *logger);
-  if (!softpkg)
+  auto softpkgs = detail::load_component_profiles({params.profile}, *logger);
+  if (!softpkgs) {
+    logger->error("{}", softpkgs.error());
     return kExitProfile;
+  }
+  const auto softpkg = softpkgs->front();
   Context context{params.identifier,
                   params.name_binding,
                   params.application,
