@@ -17,6 +17,7 @@
 #include "common/elapsed.hpp"
 #include "control/domain_events.hpp"
 #include "domain/connection_manager.hpp"
+#include "domain/launch_tracker.hpp"
 #include "profile/profile_loader.hpp"
 #include "profile/property_binding.hpp"
 #include "profile/property_json.hpp"
@@ -40,12 +41,6 @@ struct NodeRecord {
   std::string name;
   std::string address;
   Json body;
-};
-
-struct LaunchProgress {
-  std::vector<LaunchStep> steps;
-  bool done = false;
-  std::atomic<bool> cancelled{false}; // app.cancel: the launch stops and rolls back
 };
 
 Json steps_json(const std::vector<LaunchStep> &steps) {
@@ -161,7 +156,7 @@ struct DomainManager::Impl {
   std::map<std::string, NodeRecord> nodes;
   std::map<std::string, InstalledApplication> installed;
   std::map<std::string, std::shared_ptr<Application>> applications;
-  std::map<std::string, std::shared_ptr<LaunchProgress>> launches;
+  LaunchTracker launches;
   std::atomic<std::uint64_t> launch_counter{0};
 
   ApplicationFactory factory() {
@@ -210,10 +205,6 @@ struct DomainManager::Impl {
   CallResult<Json> create_application(const Json &body);
   CallResult<Json> progress(const Json &body);
   CallResult<Json> cancel_launch(const Json &body);
-  CallResult<std::shared_ptr<LaunchProgress>> find_launch(const Json &body);
-  // Marks the launch done, unless a cancel came after its last step: then false, and the caller
-  // releases what was launched.
-  bool finish_launch(LaunchProgress &progress, bool launched);
   CallResult<std::shared_ptr<Application>> find_application(const Json &body);
   CallResult<Json> release(const Json &body);
   CallResult<Json> configure(const Json &body);
@@ -364,7 +355,6 @@ CallResult<Json> DomainManager::Impl::create_application(const Json &body) {
   if (!installed_name)
     return tl::unexpected(installed_name.error());
   LaunchRequest request;
-  std::shared_ptr<LaunchProgress> progress = std::make_shared<LaunchProgress>();
   {
     std::lock_guard lock(mutex);
     auto it = installed.find(*installed_name);
@@ -380,24 +370,37 @@ CallResult<Json> DomainManager::Impl::create_application(const Json &body) {
     request.name = unique_name(wanted);
     // Reserve the name while launching.
     applications[request.name] = nullptr;
-    launches[body.value("launch_id", request.name)] = progress;
   }
-  request.start = body.value("start", true);
-  request.cancelled = std::shared_ptr<const std::atomic<bool>>(progress, &progress->cancelled);
-  auto placement = placement_options(body);
-  if (!placement) {
+  auto unreserve = [this, &request] {
     std::lock_guard lock(mutex);
     applications.erase(request.name);
+  };
+  const std::string launch_id = body.value("launch_id", request.name);
+  request.cancelled = launches.begin(launch_id);
+  if (!request.cancelled) {
+    unreserve();
+    spdlog::info("launch {} of {} not begun: its caller cancelled it first", launch_id,
+                 request.installed);
+    return control::call_error(
+        Status::Failed,
+        fmt::format("the launch of {} was cancelled before it began", request.installed));
+  }
+  request.start = body.value("start", true);
+  auto placement = placement_options(body);
+  if (!placement) {
+    unreserve();
+    launches.finish(launch_id, false);
     return tl::unexpected(placement.error());
   }
   std::tie(request.assignments, request.strategy) = *placement;
-  auto record = [this, progress](const LaunchStep &step) {
-    std::lock_guard lock(mutex);
-    progress->steps.push_back(step);
+  std::vector<LaunchStep> steps; // for the reply: the tracker may forget a finished launch
+  auto record = [this, &launch_id, &steps](const LaunchStep &step) {
+    steps.push_back(step);
+    launches.record(launch_id, step);
   };
   const auto began = std::chrono::steady_clock::now();
   auto app = factory().create(request, record);
-  if (!finish_launch(*progress, app.has_value())) {
+  if (!launches.finish(launch_id, app.has_value())) {
     // Cancelled after its last step: its caller was told it would not run.
     if (auto released = factory().release(**app); !released)
       spdlog::warn("application {} launched as its cancel came; releasing it failed: {}",
@@ -407,7 +410,7 @@ CallResult<Json> DomainManager::Impl::create_application(const Json &body) {
     app = control::call_error(
         Status::Failed,
         fmt::format("launch of {} cancelled after its last step; released", request.name));
-    finish_launch(*progress, false);
+    launches.finish(launch_id, false);
   }
   std::lock_guard lock(mutex);
   if (!app) {
@@ -425,54 +428,34 @@ CallResult<Json> DomainManager::Impl::create_application(const Json &body) {
   applications[request.name] = *app;
   runtime_connections->endpoints_changed(); // connections waiting for it
   Json reply = to_json(**app);
-  reply["launch"] = {{"steps", steps_json(progress->steps)}, {"ms", ms_since(began)}};
+  reply["launch"] = {{"steps", steps_json(steps)}, {"ms", ms_since(began)}};
   return reply;
 }
 
-CallResult<std::shared_ptr<LaunchProgress>> DomainManager::Impl::find_launch(const Json &body) {
+CallResult<Json> DomainManager::Impl::progress(const Json &body) {
   auto id = required<std::string>(body, "launch_id");
   if (!id)
     return tl::unexpected(id.error());
-  std::lock_guard lock(mutex);
-  auto it = launches.find(*id);
-  if (it == launches.end())
+  auto progress = launches.progress(*id);
+  if (!progress)
     return control::call_error(Status::NotFound, fmt::format("no launch {}", *id));
-  return it->second;
-}
-
-CallResult<Json> DomainManager::Impl::progress(const Json &body) {
-  auto launch = find_launch(body);
-  if (!launch)
-    return tl::unexpected(launch.error());
-  std::lock_guard lock(mutex);
-  return Json{{"steps", steps_json((*launch)->steps)}, {"done", (*launch)->done}};
+  return Json{{"steps", steps_json(progress->steps)}, {"done", progress->done}};
 }
 
 // A caller that stops waiting for its launch (the CLI's own deadline) cancels it, so that no
 // application it gave up on appears later: the launch rolls back at its next step, or at once
-// when it is waiting for registrations.
+// when it is waiting for registrations. A cancel that overtook its create is kept: that launch
+// never begins.
 CallResult<Json> DomainManager::Impl::cancel_launch(const Json &body) {
-  auto launch = find_launch(body);
-  if (!launch)
-    return tl::unexpected(launch.error());
-  {
-    std::lock_guard lock(mutex);
-    if ((*launch)->done)
-      return Json{{"cancelled", false}, {"done", true}};
-    (*launch)->cancelled = true;
-  }
-  spdlog::info("launch {} cancelled by its caller", body.value("launch_id", ""));
+  auto id = required<std::string>(body, "launch_id");
+  if (!id)
+    return tl::unexpected(id.error());
+  const auto outcome = launches.cancel(*id);
+  if (!outcome.cancelled)
+    return Json{{"cancelled", false}, {"done", true}};
+  spdlog::info("launch {} cancelled by its caller", *id);
   components.interrupt();
   return Json{{"cancelled", true}, {"done", false}};
-}
-
-// Under the mutex, so that a cancel either finds the launch done (and says so) or is seen here.
-bool DomainManager::Impl::finish_launch(LaunchProgress &progress, bool launched) {
-  std::lock_guard lock(mutex);
-  if (launched && progress.cancelled)
-    return false;
-  progress.done = true;
-  return true;
 }
 
 CallResult<std::shared_ptr<Application>> DomainManager::Impl::find_application(const Json &body) {
@@ -491,15 +474,16 @@ CallResult<Json> DomainManager::Impl::release(const Json &body) {
   auto app = find_application(body);
   if (!app)
     return tl::unexpected(app.error());
-  // Its runtime connections wait for it again; their other ends are disconnected.
   const std::string name = (*app)->name;
+  {
+    std::lock_guard lock(mutex);
+    applications.erase(name);
+  }
+  // Its runtime connections wait for it again; their other ends are disconnected. Only now that
+  // it can no longer be found: a retry of pending connections in between would wire them to it.
   runtime_connections->owner_gone([&name](const PortRef &ref) {
     return ref.kind != PortRef::Kind::Device && ref.owner == name;
   });
-  {
-    std::lock_guard lock(mutex);
-    applications.erase((*app)->name);
-  }
   auto unconfirmed = factory().release(**app);
   spdlog::info("application {} released", (*app)->name);
   events->publish("application.released", {{"application", (*app)->name}});
