@@ -160,7 +160,7 @@ struct Endpoint::Impl {
     Clock::time_point deadline;
     std::string target;
     std::string operation;
-    bool sent = false; // written: the addressee exists, so silence is a timeout
+    bool sent = false; // the addressee was found: silence is a timeout
   };
 
   std::shared_ptr<dds::Participant> participant;
@@ -549,6 +549,15 @@ void Endpoint::Impl::send_request(std::string id, std::string target, std::strin
     complete(id, tl::unexpected(writer.error()));
     return;
   }
+  {
+    // The addressee is matched: from here silence is a timeout, also when the deadline passes
+    // during the write, and never "nobody serves" for a request it may well have received.
+    std::lock_guard lock(state_mutex);
+    auto it = pending.find(id);
+    if (it == pending.end())
+      return; // expired while its addressee was awaited
+    it->second.sent = true;
+  }
   rsca_ctl_Request request{};
   request.id = id.data();
   request.sender = address.data();
@@ -560,9 +569,6 @@ void Endpoint::Impl::send_request(std::string id, std::string target, std::strin
                             fmt::format("sending to {} failed: {}", target, dds_strretcode(rc))));
     return;
   }
-  std::lock_guard lock(state_mutex);
-  if (auto it = pending.find(id); it != pending.end())
-    it->second.sent = true;
 }
 
 std::string Endpoint::Impl::route_of(const std::string &target) {

@@ -157,7 +157,9 @@ TEST_CASE("a slow handler times out the caller but does not block other calls", 
   server->on("slow", [&](const Json &, const control::RequestContext &) { return gate.wait(); });
   server->on("fast", fast);
   auto client = open(pp, "test/client");
-  auto slow = client->call("test/server", "slow", Json::object(), 300ms);
+  // The server found first, so that the slow call's deadline can only pass after it was sent.
+  REQUIRE(client->call_sync("test/server", "fast", Json::object(), 5s).has_value());
+  auto slow = client->call("test/server", "slow", Json::object(), 1s);
   auto fast_reply = client->call_sync("test/server", "fast", Json::object(), 5s);
   CHECK(fast_reply.has_value());
   auto slow_result = slow.get();
