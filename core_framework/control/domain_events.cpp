@@ -89,6 +89,25 @@ std::optional<DomainEvent> DomainEventFollower::take() {
   }
 }
 
+bool DomainEventFollower::wait_for_domain(std::chrono::milliseconds timeout) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  // The waitset wakes on a match only while waiting here; next() wakes on data alone.
+  dds_set_status_mask(reader_.get(), DDS_DATA_AVAILABLE_STATUS | DDS_SUBSCRIPTION_MATCHED_STATUS);
+  bool matched = false;
+  for (;;) {
+    dds_subscription_matched_status_t status{};
+    matched = dds_get_subscription_matched_status(reader_.get(), &status) == 0 &&
+              status.current_count > 0;
+    const auto left = deadline - std::chrono::steady_clock::now();
+    if (matched || left <= std::chrono::steady_clock::duration::zero())
+      break;
+    dds_waitset_wait(waitset_.get(), nullptr, 0,
+                     std::chrono::duration_cast<std::chrono::nanoseconds>(left).count());
+  }
+  dds_set_status_mask(reader_.get(), DDS_DATA_AVAILABLE_STATUS);
+  return matched;
+}
+
 std::optional<DomainEvent> DomainEventFollower::next(std::chrono::milliseconds timeout) {
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   for (;;) {

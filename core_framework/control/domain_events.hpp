@@ -53,6 +53,9 @@ class DomainEventFollower {
 public:
   static Expected<std::unique_ptr<DomainEventFollower>>
   open(std::shared_ptr<dds::Participant> participant, const std::string &domain);
+  // Waits until the domain's event writer is found; false when `timeout` passes first. The
+  // domain's last events arrive soon after.
+  bool wait_for_domain(std::chrono::milliseconds timeout);
   // The next event, or nothing when `timeout` passes first.
   std::optional<DomainEvent> next(std::chrono::milliseconds timeout);
 

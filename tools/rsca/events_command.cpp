@@ -39,7 +39,8 @@ void add_events_command(CLI::App &app, const GlobalOptions &global, int &exit_co
   auto count = std::make_shared<int>(0);
   auto wait_ms = std::make_shared<int>(0);
   cmd->add_option("--count", *count, "Stop after this many events");
-  cmd->add_option("--wait-ms", *wait_ms, "Stop when no event came for this long");
+  cmd->add_option("--wait-ms", *wait_ms,
+                  "Stop when no event came for this long (counted from when the domain is found)");
   cmd->callback([count, wait_ms, &global, &exit_code] {
     auto settings = dds::DdsSettings::from_environment();
     settings.trace = "none";
@@ -55,6 +56,11 @@ void add_events_command(CLI::App &app, const GlobalOptions &global, int &exit_co
       exit_code = kFailed;
       return;
     }
+    // The quiet interval of --wait-ms counts from when the domain is found, so that a slow
+    // discovery does not pass for a quiet domain.
+    if (!(*follower)->wait_for_domain(std::chrono::milliseconds(global.timeout_ms)))
+      fmt::print(stderr, "rsca events: no domain {} found within {} ms; waiting for its events\n",
+                 global.domain, global.timeout_ms);
     const auto wait =
         *wait_ms > 0 ? std::chrono::milliseconds(*wait_ms) : std::chrono::hours(24 * 365);
     for (int seen = 0; *count == 0 || seen < *count; ++seen) {
