@@ -169,6 +169,7 @@ public:
     property("latency_mean_us", latency_mean_us_);
     property("latency_p50_us", latency_p50_us_);
     property("latency_p99_us", latency_p99_us_);
+    property("latency_max_us", latency_max_us_);
     property("latency_samples", latency_samples_);
   }
 
@@ -199,12 +200,20 @@ private:
       log().warn("command {} refused: {}", c.name, set.error().to_string());
   }
 
+  // The percentiles are over the last kLatencyWindow commands: a drive that runs for days keeps
+  // a bounded window (80 KB), not every command it ever received.
+  static constexpr std::size_t kLatencyWindow = 10000;
+
   void record_latency(double us) {
-    latencies_.push_back(us);
-    latency_samples_ = latencies_.size();
+    if (latencies_.size() < kLatencyWindow)
+      latencies_.push_back(us);
+    else
+      latencies_[latency_samples_ % kLatencyWindow] = us;
+    ++latency_samples_;
     latency_sum_us_ += us;
-    latency_mean_us_ = latency_sum_us_ / static_cast<double>(latencies_.size());
-    if (latencies_.size() % 10 != 1)
+    latency_mean_us_ = latency_sum_us_ / static_cast<double>(latency_samples_);
+    latency_max_us_ = std::max(latency_max_us_, us);
+    if (latency_samples_ % 10 != 1)
       return; // percentiles are refreshed every 10 commands
     auto sorted = latencies_;
     std::sort(sorted.begin(), sorted.end());
@@ -234,6 +243,7 @@ private:
   double latency_mean_us_ = 0;
   double latency_p50_us_ = 0;
   double latency_p99_us_ = 0;
+  double latency_max_us_ = 0;
   std::uint64_t latency_samples_ = 0;
   std::vector<double> latencies_;
   double latency_sum_us_ = 0;
