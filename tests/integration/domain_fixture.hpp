@@ -44,11 +44,16 @@ inline bool process_exists(long pid) {
 // A domain daemon and `nodes` node daemons, stopped (nodes first, gracefully) when it goes.
 class TestDomain {
 public:
-  explicit TestDomain(int nodes = 2, int registration_timeout_ms = 3000)
+  // Twice the product's default: a dozen component processes under ASan on a loaded 2-core CI
+  // host may take seconds to register. Tests of the timeout itself give their own.
+  static constexpr int kRegistrationTimeoutMs = 20000;
+
+  explicit TestDomain(int nodes = 2, int registration_timeout_ms = kRegistrationTimeoutMs)
       : TestDomain(shipped_nodes(nodes), registration_timeout_ms) {}
 
   // One node daemon per DCD.
-  explicit TestDomain(const std::vector<fs::path> &dcds, int registration_timeout_ms = 3000)
+  explicit TestDomain(const std::vector<fs::path> &dcds,
+                      int registration_timeout_ms = kRegistrationTimeoutMs)
       : run_(fs::temp_directory_path() /
              fmt::format("rsca-it-{}-{}", getpid(), std::random_device{}())) {
     fs::create_directories(run_ / "logs");
@@ -175,7 +180,7 @@ public:
   }
 
   // Stops the domain daemon and starts a new one on the same repository.
-  void restart_domaind(int registration_timeout_ms = 3000) {
+  void restart_domaind(int registration_timeout_ms = kRegistrationTimeoutMs) {
     domaind_->signal(SIGTERM);
     REQUIRE(domaind_->wait_exit(5s).has_value());
     start_domaind(registration_timeout_ms);
