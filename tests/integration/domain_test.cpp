@@ -520,6 +520,24 @@ TEST_CASE("the domain publishes what happens to it, and rsca events follows it",
   domain.require_clean(pids_of(*app));
 }
 
+// The details of the latest "connection.problem" domain event saying `problem`, as `rsca events`
+// shows them; null when none came within wait_for's limit.
+Json connection_problem(TestDomain &domain, const std::string &problem) {
+  Json found;
+  TestDomain::wait_for([&] {
+    auto [rc, events] = domain.cli({"--json", "events", "--wait-ms", "300"});
+    std::istringstream lines(events);
+    for (std::string line; std::getline(lines, line);) {
+      const Json event = Json::parse(line, nullptr, false);
+      if (!event.is_discarded() && event.value("kind", "") == "connection.problem" &&
+          event.at("details").value("problem", "") == problem)
+        found = event.at("details");
+    }
+    return !found.is_null();
+  });
+  return found;
+}
+
 TEST_CASE("a deadline the writer stops meeting is reported as a domain event",
           "[integration][domain][events]") {
   // Over DDS between two processes, and in-host between two components of one component host.
@@ -534,18 +552,9 @@ TEST_CASE("a deadline the writer stops meeting is reported as a domain event",
   REQUIRE(app.has_value());
   // The connection asks for a sample every 100 ms at least; at 2 Hz the producer misses it.
   REQUIRE(domain.cli({"configure", name + "/Producer_1", "rate_hz=2"}).first == 0);
-  Json problem;
-  CHECK(TestDomain::wait_for([&] {
-    auto [erc, events] = domain.cli({"--json", "events", "--wait-ms", "300"});
-    std::istringstream lines(events);
-    for (std::string line; std::getline(lines, line);) {
-      const Json event = Json::parse(line, nullptr, false);
-      if (!event.is_discarded() && event.value("kind", "") == "connection.problem")
-        problem = event.at("details");
-    }
-    return !problem.is_null();
-  }));
+  const Json problem = connection_problem(domain, "deadline missed");
   INFO(problem.dump());
+  REQUIRE_FALSE(problem.is_null());
   CHECK(problem.value("application", "") == name);
   CHECK(problem.value("component", "") == "Consumer_1");
   CHECK(problem.value("connection", "") == "samples");
@@ -559,5 +568,34 @@ TEST_CASE("a deadline the writer stops meeting is reported as a domain event",
   CHECK(samples.at("provides_state").at("deadline_missed").get<int>() > 0);
   CHECK(samples.at("provides_state").at("in_host") == (name == "ProducerConsumerHosted"));
   REQUIRE(domain.call("app.release", Json{{"app", name}}).has_value());
+  domain.require_clean(pids_of(*app));
+}
+
+TEST_CASE("a writer that stops asserting its liveliness is reported as a domain event",
+          "[integration][domain][events]") {
+  // The connection asks the producer's writer to be alive every 300 ms. A frozen process (here
+  // SIGSTOP; in life a hung one) has not exited, so only the connection's liveliness tells.
+  TestDomain domain;
+  domain.install("Lively");
+  auto [rc, out] = domain.cli({"launch", "Lively"});
+  INFO(out);
+  REQUIRE(rc == 0);
+  auto app = domain.call("app.show", Json{{"app", "Lively"}});
+  REQUIRE(app.has_value());
+  long producer = 0;
+  for (const auto &c : app->at("components"))
+    if (c.at("id") == "Producer_1")
+      producer = c.at("pid").get<long>();
+  REQUIRE(producer > 0);
+  REQUIRE(::kill(static_cast<pid_t>(producer), SIGSTOP) == 0);
+  const Json problem = connection_problem(domain, "liveliness lost");
+  ::kill(static_cast<pid_t>(producer), SIGCONT);
+  INFO(problem.dump());
+  REQUIRE_FALSE(problem.is_null());
+  CHECK(problem.value("application", "") == "Lively");
+  CHECK(problem.value("component", "") == "Consumer_1");
+  CHECK(problem.value("connection", "") == "samples");
+  CHECK(problem.value("count", 0) > 0);
+  REQUIRE(domain.call("app.release", Json{{"app", "Lively"}}).has_value());
   domain.require_clean(pids_of(*app));
 }
