@@ -37,6 +37,7 @@
 #include "component/port_types.hpp"
 #include "component/ports.hpp"
 #include "component/properties.hpp"
+#include "component/resource_port.hpp"
 #include "control/endpoint.hpp"
 
 namespace rsca::component {
@@ -142,6 +143,14 @@ protected:
     return add_port(std::make_unique<ProvidesPort<T>>(std::move(name), std::move(on_sample)));
   }
 
+  // A uses port of a CF control interface (its SCD repid IDL:CF/Resource:1.0 or one it
+  // inherits), for connections to other components' supported interface; lives as long as the
+  // component.
+  ResourceUsesPort &resource_port(std::string name) {
+    resource_ports_.push_back(std::make_unique<ResourceUsesPort>(std::move(name)));
+    return *resource_ports_.back();
+  }
+
   // ---- Hooks, run by the runtime with the property lock held.
 
   // component.initialize: once, after the PRF defaults and execparams are applied.
@@ -172,6 +181,7 @@ private:
   mutable std::recursive_mutex properties_mutex_;
   PropertySet properties_;
   std::vector<std::unique_ptr<PortBase>> ports_;
+  std::vector<std::unique_ptr<ResourceUsesPort>> resource_ports_;
   std::atomic<State> state_{State::Loaded};
 };
 

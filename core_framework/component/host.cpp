@@ -105,10 +105,20 @@ Expected<void> Host::check_ports() const {
       fail(fmt::format("port \"{}\" carries {}, but its SCD repid is {}", port->name(),
                        port::to_string(port->type()), definition->repid));
   }
+  for (const auto &port : c().resource_ports_) {
+    const auto *definition =
+        scd ? scd->find_port(port->name(), profile::PortDirection::Uses) : nullptr;
+    if (definition == nullptr)
+      fail(fmt::format("the component has uses port \"{}\", which its SCD does not declare",
+                       port->name()));
+    else if (!profile::is_control_interface(definition->repid))
+      fail(fmt::format("port \"{}\" calls a component's CF interface, but its SCD repid is {}",
+                       port->name(), definition->repid));
+  }
   if (!error.empty())
     return tl::unexpected(std::move(error));
   for (const auto &definition : scd ? scd->ports : std::vector<profile::PortDefinition>{})
-    if (find_port(definition.name) == nullptr)
+    if (find_port(definition.name) == nullptr && find_resource_port(definition.name) == nullptr)
       log().warn("SCD port \"{}\" has no implementation in the component: it cannot be connected",
                  definition.name);
   return {};
@@ -426,7 +436,35 @@ CallResult<Json> Host::op_query(const Json &body, const control::RequestContext 
   return Json{{"properties", std::move(*values)}};
 }
 
+// A connection of a uses port of a CF control interface to another component's supported
+// interface: the port keeps that component's control address ("target").
+CallResult<Json> Host::connect_resource_port(ResourceUsesPort &port, const Json &body) {
+  auto connection = string_field(body, "connection");
+  auto target = string_field(body, "target");
+  for (const auto *field : {&connection, &target})
+    if (!*field)
+      return tl::unexpected(field->error());
+  if (body.value("direction", "uses") != "uses")
+    return control::call_error(Status::BadRequest,
+                               fmt::format("port \"{}\" is a uses port", port.name()));
+  std::lock_guard lock(lifecycle_);
+  if (c().state() == State::Released)
+    return control::call_error(Status::Unavailable, "the component is released");
+  port.connect(*connection, *target, endpoint_);
+  log().info("port {}: connection {} to the component at {}", port.name(), *connection, *target);
+  return Json::object();
+}
+
+ResourceUsesPort *Host::find_resource_port(const std::string &name) const {
+  for (const auto &port : c().resource_ports_)
+    if (port->name() == name)
+      return port.get();
+  return nullptr;
+}
+
 CallResult<Json> Host::op_connect(const Json &body, const control::RequestContext &) {
+  if (auto *resource = find_resource_port(body.value("port", "")))
+    return connect_resource_port(*resource, body);
   auto connection = string_field(body, "connection");
   auto port_name = string_field(body, "port");
   auto direction = string_field(body, "direction");
@@ -483,6 +521,14 @@ CallResult<Json> Host::op_disconnect(const Json &body, const control::RequestCon
   auto port_name = string_field(body, "port");
   if (!port_name)
     return tl::unexpected(port_name.error());
+  if (auto *resource = find_resource_port(*port_name)) {
+    if (!resource->disconnect(*connection))
+      return control::call_error(
+          Status::NotFound,
+          fmt::format("port \"{}\" has no connection \"{}\"", *port_name, *connection));
+    log().info("port {}: connection {} removed", *port_name, *connection);
+    return Json::object();
+  }
   PortBase *port = find_port(*port_name);
   if (port == nullptr)
     return control::call_error(Status::NotFound, fmt::format("no port \"{}\"", *port_name));
@@ -559,6 +605,16 @@ CallResult<Json> Host::op_status(const Json &, const control::RequestContext &) 
                      {"direction", profile::to_string(port->direction())},
                      {"connections", std::move(connections)}});
   }
+  for (const auto &port : c().resource_ports_) {
+    Json connections = Json::array();
+    for (const auto &[connection, target] : port->targets())
+      connections.push_back({{"connection", connection},
+                             {"target", target.address},
+                             {"matched", 1},
+                             {"samples", target.calls}});
+    ports.push_back(
+        {{"name", port->name()}, {"direction", "uses"}, {"connections", std::move(connections)}});
+  }
   return Json{{"state", to_string(c().state())}, {"ports", std::move(ports)}};
 }
 
@@ -633,6 +689,8 @@ void Host::shutdown(std::string_view why) {
         log().error("release failed: {}", ok.error().message);
     }
     for (const auto &port : c().ports_)
+      port->disconnect_all();
+    for (const auto &port : c().resource_ports_)
       port->disconnect_all();
     set_state(State::Released);
   }

@@ -65,6 +65,8 @@ private:
   Json announcement() const;
   void set_state(State state);
   PortBase *find_port(const std::string &name) const;
+  ResourceUsesPort *find_resource_port(const std::string &name) const;
+  CallResult<Json> connect_resource_port(ResourceUsesPort &port, const Json &body);
   void poll_ports();
   void watch_connections();
   std::string domain_address() const;

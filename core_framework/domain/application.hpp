@@ -39,8 +39,12 @@ struct ConnectionEnd {
   std::string device;  // the device's id, for a device port
   std::string address; // where the port's owner is served
   bool empty() const { return component.empty() && device.empty(); }
+  // "owner.port"; the owner alone for a component's supported interface (no port).
   std::string name() const {
-    return empty() ? std::string() : (device.empty() ? component : device) + "." + port;
+    if (empty())
+      return {};
+    const std::string &owner = device.empty() ? component : device;
+    return port.empty() ? owner : owner + "." + port;
   }
 };
 
@@ -52,6 +56,9 @@ struct ConnectionInstance {
   std::string topic;
   nlohmann::json qos;
   std::string filter; // a channel subscriber's content filter
+  // A uses port's connection to a component's supported interface: no topic, the provides end
+  // is the component itself.
+  bool is_interface() const { return topic.empty() && !provides.empty() && provides.port.empty(); }
 };
 
 // The id an end's owner knows the connection by: a device serves many applications, so its

@@ -169,9 +169,10 @@ private:
             "connection {}: a device port cannot be an event channel member yet: connect it "
             "to a component port",
             id));
-      if (c.provides.kind == profile::ProvidesEnd::Kind::SupportedInterface)
-        out.push_back(fmt::format("connection {}: connections to a component's supported interface "
-                                  "are not supported yet",
+      if (c.provides.kind == profile::ProvidesEnd::Kind::SupportedInterface &&
+          c.uses.target.kind != Kind::ComponentInstantiation)
+        out.push_back(fmt::format("connection {}: only a component's uses port can call another "
+                                  "component's supported interface yet, not a device's",
                                   id));
     }
     return out;
@@ -338,6 +339,15 @@ private:
       if (!uses)
         return tl::unexpected(uses.error());
       ci.uses = std::move(*uses);
+      if (c.provides.kind == profile::ProvidesEnd::Kind::SupportedInterface) {
+        // The component itself, at its control address: no topic, nothing to make on its side.
+        ci.topic.clear();
+        ci.provides = {c.provides.target.refid, "", "",
+                       component_of(c.provides.target.refid)->address};
+        uses_side.push_back(interface_call(ci));
+        app_->connections.push_back(std::move(ci));
+        continue;
+      }
       if (c.provides.kind == profile::ProvidesEnd::Kind::Port) {
         auto provides =
             resolve_end(ci, c.provides.target, c.provides.port, profile::PortDirection::Provides);
@@ -436,6 +446,8 @@ private:
           {{"port", end.port}, {"connection", end_key(ci, end)}, {"peers", peers}});
     };
     for (const auto &ci : app_->connections) {
+      if (ci.is_interface())
+        continue; // a control address: nothing to discover
       const bool channel = ci.uses.empty() || ci.provides.empty();
       await(ci, ci.uses, channel ? members_on(ci.topic, /*subscribers=*/true) : 1);
       await(ci, ci.provides, channel ? members_on(ci.topic, /*subscribers=*/false) : 1);
@@ -502,6 +514,18 @@ private:
             fmt::format("{} ({})", ci.id, end.name())};
   }
 
+  // A uses port's connection to a component's supported interface: it calls the component's
+  // control address.
+  Call interface_call(const ConnectionInstance &ci) {
+    return {ci.uses.address, "component.connect",
+            Json{{"connection", end_key(ci, ci.uses)},
+                 {"port", ci.uses.port},
+                 {"direction", "uses"},
+                 {"repid", ci.repid},
+                 {"target", ci.provides.address}},
+            fmt::format("{} ({} -> {})", ci.id, ci.uses.name(), ci.provides.name())};
+  }
+
   // Both ends are components of one component host: the connection bypasses DDS.
   bool in_one_host(const ConnectionInstance &ci) const {
     if (ci.uses.component.empty() || ci.provides.component.empty())
@@ -523,6 +547,8 @@ private:
       if (pkg == nullptr || !pkg->scd)
         continue;
       const bool uses = end == &c.uses.target;
+      if (!uses && c.provides.kind != profile::ProvidesEnd::Kind::Port)
+        continue; // a supported interface's repid, not a port
       const auto *port = pkg->scd->find_port(uses ? c.uses.port : c.provides.port,
                                              uses ? profile::PortDirection::Uses
                                                   : profile::PortDirection::Provides);

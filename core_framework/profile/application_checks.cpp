@@ -104,6 +104,8 @@ private:
       return;
     if (c.provides.kind == ProvidesEnd::Kind::SupportedInterface) {
       check_supported_interface(c.provides.target.refid, c.provides.port, c.provides.where, what);
+      if (uses != nullptr)
+        check_interface_call(c, *uses, what);
       return;
     }
     const PortDefinition *provides = check_port(c.provides.target.refid, c.provides.port,
@@ -133,6 +135,27 @@ private:
       warn(
           where, "unknown-interface",
           fmt::format("{}: component \"{}\" does not support interface {}", what, instance, repid));
+  }
+
+  // A uses port connected to a component's supported interface calls it through the control
+  // plane: its repid must be a CF interface rsca serves, and one the component supports.
+  void check_interface_call(const Connection &c, const PortDefinition &uses,
+                            const std::string &what) {
+    if (!is_control_interface(uses.repid)) {
+      warn(c.where, "port-type",
+           fmt::format("{}: uses port {}.{} is of {}, which cannot call a component's supported "
+                       "interface (a port of IDL:CF/Resource:1.0 or an interface it inherits can)",
+                       what, c.uses.target.refid, uses.name, uses.repid));
+      return;
+    }
+    const ComponentPlacement *placement = nullptr;
+    if (app_.sad->find_instantiation(c.provides.target.refid, &placement) == nullptr)
+      return;
+    const ResolvedSoftPkg *pkg = app_.softpkg_of(*placement);
+    if (pkg != nullptr && pkg->scd && !pkg->scd->supports(uses.repid))
+      warn(c.where, "port-type",
+           fmt::format("{}: uses port {}.{} calls {}, which component \"{}\" does not support",
+                       what, c.uses.target.refid, uses.name, uses.repid, c.provides.target.refid));
   }
 
   void check_external_property(const ExternalProperty &p) {

@@ -1,4 +1,7 @@
 // Look-ups and names of the profile model's types.
+#include <algorithm>
+#include <array>
+
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
@@ -170,6 +173,13 @@ const PortDefinition *SoftwareComponent::find_port(std::string_view port_name,
     if (p.name == port_name && p.direction == direction)
       return &p;
   return nullptr;
+}
+
+bool is_control_interface(std::string_view repid) {
+  static constexpr std::array<std::string_view, 6> kServed{
+      "IDL:CF/Resource:1.0",        "IDL:CF/PropertySet:1.0",    "IDL:CF/LifeCycle:1.0",
+      "IDL:CF/PropertyEmitter:1.0", "IDL:CF/TestableObject:1.0", "IDL:CF/PortSupplier:1.0"};
+  return std::find(kServed.begin(), kServed.end(), repid) != kServed.end();
 }
 
 bool SoftwareComponent::supports(std::string_view repid) const {

@@ -15,6 +15,11 @@ enum class PortDirection : std::uint8_t { Uses, Provides };
 std::string_view to_string(PortDirection direction);
 std::optional<PortDirection> port_direction_from_name(std::string_view name);
 
+// Whether `repid` is one of the CF interfaces every component serves on its control endpoint
+// (Resource and those it inherits: PropertySet, LifeCycle, ...): a uses port of one of them is
+// connected to another component's supported interface and calls it (component/resource_port.hpp).
+bool is_control_interface(std::string_view repid);
+
 struct PortDefinition {
   std::string name;
   std::string repid;

@@ -289,3 +289,47 @@ TEST_CASE("a connection rsca cannot make is refused before anything runs, not le
                                   "findby; \"Elsewhere\" is not one"));
   domain.require_clean({});
 }
+
+TEST_CASE("a uses port of CF::Resource connected to a component's supported interface calls it",
+          "[integration][connections]") {
+  // componentsupportedinterface: Supervisor_1's port "managed" holds Producer_1's control
+  // address; once started, Supervisor_1 configures Producer_1 through it and reads back.
+  TestDomain domain;
+  domain.install("Supervised");
+  auto [rc, out] = domain.cli({"launch", "Supervised"});
+  INFO(out);
+  REQUIRE(rc == 0);
+  auto query = [&](const std::string &component, const std::string &id) {
+    auto q = domain.call("app.query",
+                         Json{{"app", "Supervised"}, {"component", component}, {"ids", {id}}});
+    return q ? q->at("properties").at(id) : Json();
+  };
+  CHECK(TestDomain::wait_for([&] { return query("Supervisor_1", "supervised") == 1; }));
+  CHECK(query("Supervisor_1", "confirmed_message") == "set by Supervisor_1");
+  CHECK(query("Producer_1", "message") == "set by Supervisor_1");
+  // The connection, its kind and the calls made through it.
+  auto [lrc, listed] = domain.cli({"ls", "connections", "Supervised"});
+  INFO(listed);
+  CHECK(lrc == 0);
+  CHECK_THAT(listed, Catch::Contains("Supervised/supervision: Supervisor_1.managed -> Producer_1  "
+                                     "[calls IDL:CF/Resource:1.0]"));
+  CHECK_THAT(listed, Catch::Contains("uses: 1 matched, 2 samples"));
+  auto app = domain.call("app.show", Json{{"app", "Supervised"}});
+  REQUIRE(app.has_value());
+  REQUIRE(domain.call("app.release", Json{{"app", "Supervised"}}).has_value());
+  domain.require_clean(pids_of(*app));
+}
+
+TEST_CASE("a data port connected to a component's supported interface is refused before "
+          "anything runs",
+          "[integration][connections][failure]") {
+  TestDomain domain;
+  domain.install("SupervisedByData");
+  auto [rc, out] = domain.cli({"launch", "SupervisedByData"});
+  INFO(out);
+  CHECK(rc != 0);
+  CHECK_THAT(out, Catch::Contains("connection \"supervision\": uses port Producer_1.samples_out is "
+                                  "of IDL:rsca/SampleSeq:1.0, which cannot call a component's "
+                                  "supported interface"));
+  domain.require_clean({});
+}

@@ -337,6 +337,18 @@ TEST_CASE("the schedule admission decided arrives as exec parameters", "[compone
   CHECK_FALSE(parse_exec_params(7, none)->schedule.has_value());
 }
 
+TEST_CASE("CF control interfaces are called, not carried as data", "[component]") {
+  // A uses port of one of these is a ResourceUsesPort, connected to a supported interface.
+  for (const char *repid :
+       {"IDL:CF/Resource:1.0", "IDL:CF/PropertySet:1.0", "IDL:CF/LifeCycle:1.0"}) {
+    INFO(repid);
+    CHECK(rsca::profile::is_control_interface(repid));
+    CHECK_FALSE(port::port_type_for_repid(repid).has_value());
+  }
+  for (const char *repid : {"IDL:rsca/SampleSeq:1.0", "IDL:CF/Device:1.0", "IDL:CF/Resource:2.0"})
+    CHECK_FALSE(rsca::profile::is_control_interface(repid));
+}
+
 TEST_CASE("repids map to the port types of ports.idl", "[component]") {
   CHECK(port::port_type_for_repid("IDL:rsca/SampleSeq:1.0") == port::PortType::Samples);
   CHECK(port::port_type_for_repid("IDL:BULKIO/dataFloat:1.0") == port::PortType::Samples);

@@ -75,9 +75,15 @@ std::string end_state(const Json &state) {
 void print_connections(const Json &r) {
   for (const auto &c : r.at("connections")) {
     const std::string uses = c.value("uses", ""), provides = c.value("provides", "");
+    const std::string topic = c.value("topic", "");
     fmt::print("{}/{}: {} -> {}  [{}]\n", c.value("application", ""), c.value("id", ""),
                uses.empty() ? "(channel)" : uses, provides.empty() ? "(channel)" : provides,
-               c.value("topic", ""));
+               topic.empty() ? "calls " + c.value("repid", "") : topic);
+    if (topic.empty()) {
+      // A uses port calling a component's supported interface: control calls, no DDS QoS.
+      fmt::print("  uses: {} (samples: calls made)\n", end_state(c.at("uses_state")));
+      continue;
+    }
     const auto &q = c.at("qos");
     fmt::print("  qos {} {} {}{}\n", q.value("reliability", ""), q.value("durability", ""),
                q.value("history", ""),

@@ -1,0 +1,87 @@
+#include "component/resource_port.hpp"
+
+#include <fmt/format.h>
+
+namespace rsca::component {
+
+std::map<std::string, ResourceUsesPort::Target> ResourceUsesPort::targets() const {
+  std::lock_guard lock(mutex_);
+  return targets_;
+}
+
+void ResourceUsesPort::connect(const std::string &connection, const std::string &target,
+                               std::weak_ptr<control::Endpoint> endpoint) {
+  std::lock_guard lock(mutex_);
+  targets_[connection] = Target{target, 0};
+  endpoint_ = std::move(endpoint);
+}
+
+bool ResourceUsesPort::disconnect(const std::string &connection) {
+  std::lock_guard lock(mutex_);
+  return targets_.erase(connection) != 0;
+}
+
+void ResourceUsesPort::disconnect_all() {
+  std::lock_guard lock(mutex_);
+  targets_.clear();
+}
+
+control::CallResult<std::map<std::string, nlohmann::json>>
+ResourceUsesPort::call_each(const std::string &operation, const nlohmann::json &body,
+                            std::chrono::milliseconds timeout) {
+  std::map<std::string, Target> targets;
+  std::shared_ptr<control::Endpoint> endpoint;
+  {
+    // The calls run without the lock: a disconnect meanwhile does not wait for them.
+    std::lock_guard lock(mutex_);
+    targets = targets_;
+    endpoint = endpoint_.lock();
+  }
+  std::map<std::string, nlohmann::json> replies;
+  if (targets.empty())
+    return replies;
+  if (!endpoint)
+    return control::call_error(control::Status::Unavailable,
+                               fmt::format("port {}: the component is shutting down", name_));
+  for (const auto &[connection, target] : targets) {
+    auto reply = endpoint->call_sync(target.address, operation, body, timeout);
+    {
+      std::lock_guard lock(mutex_);
+      if (auto it = targets_.find(connection); it != targets_.end())
+        ++it->second.calls;
+    }
+    if (!reply)
+      return control::call_error(reply.error().status,
+                                 fmt::format("port {}, connection {}: {} to {}: {}", name_,
+                                             connection, operation, target.address,
+                                             reply.error().message));
+    replies.emplace(connection, std::move(*reply));
+  }
+  return replies;
+}
+
+control::CallResult<void> ResourceUsesPort::configure(const nlohmann::json &properties,
+                                                      std::chrono::milliseconds timeout) {
+  return call_each("component.configure", {{"properties", properties}}, timeout).map([](auto &&) {
+  });
+}
+
+control::CallResult<std::map<std::string, nlohmann::json>>
+ResourceUsesPort::query(const std::vector<std::string> &ids, std::chrono::milliseconds timeout) {
+  auto replies = call_each("component.query", {{"ids", ids}}, timeout);
+  if (!replies)
+    return replies;
+  for (auto &[connection, reply] : *replies)
+    reply = reply.value("properties", nlohmann::json::object());
+  return replies;
+}
+
+control::CallResult<void> ResourceUsesPort::start(std::chrono::milliseconds timeout) {
+  return call_each("component.start", nlohmann::json::object(), timeout).map([](auto &&) {});
+}
+
+control::CallResult<void> ResourceUsesPort::stop(std::chrono::milliseconds timeout) {
+  return call_each("component.stop", nlohmann::json::object(), timeout).map([](auto &&) {});
+}
+
+} // namespace rsca::component
