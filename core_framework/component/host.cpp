@@ -106,6 +106,8 @@ Expected<void> Host::check_ports() const {
                        port::to_string(port->type()), definition->repid));
   }
   for (const auto &port : c().resource_ports_) {
+    if (find_resource_port(port->name()) != port.get() || find_port(port->name()) != nullptr)
+      fail(fmt::format("the component declares port \"{}\" twice", port->name()));
     const auto *definition =
         scd ? scd->find_port(port->name(), profile::PortDirection::Uses) : nullptr;
     if (definition == nullptr)
@@ -608,10 +610,8 @@ CallResult<Json> Host::op_status(const Json &, const control::RequestContext &) 
   for (const auto &port : c().resource_ports_) {
     Json connections = Json::array();
     for (const auto &[connection, target] : port->targets())
-      connections.push_back({{"connection", connection},
-                             {"target", target.address},
-                             {"matched", 1},
-                             {"samples", target.calls}});
+      connections.push_back(
+          {{"connection", connection}, {"target", target.address}, {"calls", target.calls}});
     ports.push_back(
         {{"name", port->name()}, {"direction", "uses"}, {"connections", std::move(connections)}});
   }
@@ -677,6 +677,10 @@ void Host::shutdown(std::string_view why) {
     if (c().state() == State::Released)
       return;
     log().info("releasing ({})", why);
+    // First, so that a call through them under way makes no further ones: the components it
+    // would call are likely being released too.
+    for (const auto &port : c().resource_ports_)
+      port->disconnect_all();
     if (c().state() == State::Started) {
       stop_component();
       auto properties = c().lock_properties();
@@ -689,8 +693,6 @@ void Host::shutdown(std::string_view why) {
         log().error("release failed: {}", ok.error().message);
     }
     for (const auto &port : c().ports_)
-      port->disconnect_all();
-    for (const auto &port : c().resource_ports_)
       port->disconnect_all();
     set_state(State::Released);
   }

@@ -44,12 +44,15 @@ ResourceUsesPort::call_each(const std::string &operation, const nlohmann::json &
     return control::call_error(control::Status::Unavailable,
                                fmt::format("port {}: the component is shutting down", name_));
   for (const auto &[connection, target] : targets) {
-    auto reply = endpoint->call_sync(target.address, operation, body, timeout);
     {
+      // Removed since the snapshot (a disconnect, the component's release): not called.
       std::lock_guard lock(mutex_);
-      if (auto it = targets_.find(connection); it != targets_.end())
-        ++it->second.calls;
+      auto it = targets_.find(connection);
+      if (it == targets_.end())
+        continue;
+      ++it->second.calls;
     }
+    auto reply = endpoint->call_sync(target.address, operation, body, timeout);
     if (!reply)
       return control::call_error(reply.error().status,
                                  fmt::format("port {}, connection {}: {} to {}: {}", name_,

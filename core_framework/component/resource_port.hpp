@@ -3,8 +3,11 @@
 // (`componentsupportedinterface`). Over DDS a component's own interface is its control endpoint,
 // so a connection holds the connected component's control address, and the port's calls go
 // there through the control plane: what a REDHAWK uses port of CF::Resource does with the object
-// references it holds. Calls are safe from any thread (a port callback, the service thread, a
-// lifecycle hook) and each has a timeout.
+// references it holds. Each call waits for the reply, up to its timeout. The runtime holds the
+// component's property lock around service(), port callbacks and lifecycle hooks, and a component
+// serves configure and query under that lock: so a component may call others from there, but two
+// components must not call each other (each would wait for the other's lock until the timeout),
+// and a component cannot call itself (the SAD check refuses that).
 #pragma once
 
 #include <chrono>
@@ -24,7 +27,9 @@ namespace rsca::component {
 
 class ResourceUsesPort {
 public:
-  static constexpr std::chrono::milliseconds kDefaultTimeout{5000};
+  // Below the domain's call timeout (5 s): a component whose call is stuck still answers the
+  // domain's release in time.
+  static constexpr std::chrono::milliseconds kDefaultTimeout{2000};
 
   explicit ResourceUsesPort(std::string name) : name_(std::move(name)) {}
   ResourceUsesPort(const ResourceUsesPort &) = delete;
@@ -39,7 +44,8 @@ public:
   std::map<std::string, Target> targets() const;
 
   // Each call goes to every connected component in turn and stops at the first failure, which
-  // names the component. Without connections they do nothing.
+  // names the component; a connection removed meanwhile is skipped. Without connections they do
+  // nothing.
   control::CallResult<void> configure(const nlohmann::json &properties,
                                       std::chrono::milliseconds timeout = kDefaultTimeout);
   // One {"id": value} object per connected component, by connection id.

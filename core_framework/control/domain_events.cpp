@@ -91,8 +91,9 @@ std::optional<DomainEvent> DomainEventFollower::take() {
 
 bool DomainEventFollower::wait_for_domain(std::chrono::milliseconds timeout) {
   const auto deadline = std::chrono::steady_clock::now() + timeout;
-  // The waitset wakes on a match only while waiting here; next() wakes on data alone.
-  dds_set_status_mask(reader_.get(), DDS_DATA_AVAILABLE_STATUS | DDS_SUBSCRIPTION_MATCHED_STATUS);
+  // The waitset wakes on a match alone while waiting here (data already there would wake it at
+  // once, over and over), and on data alone in next().
+  dds_set_status_mask(reader_.get(), DDS_SUBSCRIPTION_MATCHED_STATUS);
   bool matched = false;
   for (;;) {
     dds_subscription_matched_status_t status{};

@@ -170,9 +170,12 @@ private:
             "to a component port",
             id));
       if (c.provides.kind == profile::ProvidesEnd::Kind::SupportedInterface &&
-          c.uses.target.kind != Kind::ComponentInstantiation)
-        out.push_back(fmt::format("connection {}: only a component's uses port can call another "
-                                  "component's supported interface yet, not a device's",
+          (c.uses.target.kind != Kind::ComponentInstantiation ||
+           c.provides.target.kind != Kind::ComponentInstantiation))
+        out.push_back(fmt::format("connection {}: a supported interface connects a component's "
+                                  "uses port to another component of the application "
+                                  "(componentinstantiationref on both sides), not to a device "
+                                  "or a channel",
                                   id));
     }
     return out;

@@ -79,13 +79,17 @@ Json end_state(const std::map<std::string, Json> &status_of, const std::string &
   for (const auto &port : it->second.value("ports", Json::array())) {
     if (port.value("name", "") != port_name)
       continue;
-    for (const auto &c : port.value("connections", Json::array()))
-      if (c.value("connection", "") == connection)
-        return Json{{"matched", c.value("matched", 0)},
-                    {"samples", c.value("samples", 0)},
-                    {"filtered", c.value("filtered", 0)},
-                    {"deadline_missed", c.value("deadline_missed", 0)},
-                    {"in_host", c.value("in_host", false)}};
+    for (const auto &c : port.value("connections", Json::array())) {
+      if (c.value("connection", "") != connection)
+        continue;
+      if (c.contains("calls"))
+        return Json{{"calls", c.value("calls", 0)}}; // a caller of a supported interface
+      return Json{{"matched", c.value("matched", 0)},
+                  {"samples", c.value("samples", 0)},
+                  {"filtered", c.value("filtered", 0)},
+                  {"deadline_missed", c.value("deadline_missed", 0)},
+                  {"in_host", c.value("in_host", false)}};
+    }
   }
   return nullptr;
 }
@@ -453,9 +457,13 @@ CallResult<Json> DomainManager::Impl::cancel_launch(const Json &body) {
   const auto outcome = launches.cancel(*id);
   if (!outcome.cancelled)
     return Json{{"cancelled", false}, {"done", true}};
+  if (!outcome.begun) {
+    spdlog::info("launch {} cancelled by its caller before it began", *id);
+    return Json{{"cancelled", true}, {"done", false}, {"begun", false}};
+  }
   spdlog::info("launch {} cancelled by its caller", *id);
   components.interrupt();
-  return Json{{"cancelled", true}, {"done", false}};
+  return Json{{"cancelled", true}, {"done", false}, {"begun", true}};
 }
 
 CallResult<std::shared_ptr<Application>> DomainManager::Impl::find_application(const Json &body) {

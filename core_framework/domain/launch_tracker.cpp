@@ -48,7 +48,7 @@ LaunchTracker::Cancelled LaunchTracker::cancel(const std::string &id) {
   it->second.cancelled->store(true);
   if (first)
     retire(id); // a launch that may never come: bounded like the finished ones
-  return {true, false};
+  return {true, false, !first};
 }
 
 void LaunchTracker::retire(const std::string &id) {

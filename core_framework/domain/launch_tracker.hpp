@@ -40,6 +40,7 @@ public:
   struct Cancelled {
     bool cancelled = false; // false: it had finished
     bool done = false;
+    bool begun = true; // false: not seen yet (its create may still come, and is then refused)
   };
   Cancelled cancel(const std::string &id);
 

@@ -141,6 +141,13 @@ private:
   // plane: its repid must be a CF interface rsca serves, and one the component supports.
   void check_interface_call(const Connection &c, const PortDefinition &uses,
                             const std::string &what) {
+    if (c.uses.target.refid == c.provides.target.refid) {
+      // Its calls would wait for its own property lock, held while it calls.
+      warn(c.where, "self-call",
+           fmt::format("{}: component \"{}\" cannot call its own supported interface", what,
+                       c.uses.target.refid));
+      return;
+    }
     if (!is_control_interface(uses.repid)) {
       warn(c.where, "port-type",
            fmt::format("{}: uses port {}.{} is of {}, which cannot call a component's supported "

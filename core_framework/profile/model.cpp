@@ -176,9 +176,8 @@ const PortDefinition *SoftwareComponent::find_port(std::string_view port_name,
 }
 
 bool is_control_interface(std::string_view repid) {
-  static constexpr std::array<std::string_view, 6> kServed{
-      "IDL:CF/Resource:1.0",        "IDL:CF/PropertySet:1.0",    "IDL:CF/LifeCycle:1.0",
-      "IDL:CF/PropertyEmitter:1.0", "IDL:CF/TestableObject:1.0", "IDL:CF/PortSupplier:1.0"};
+  static constexpr std::array<std::string_view, 3> kServed{
+      "IDL:CF/Resource:1.0", "IDL:CF/PropertySet:1.0", "IDL:CF/LifeCycle:1.0"};
   return std::find(kServed.begin(), kServed.end(), repid) != kServed.end();
 }
 

@@ -15,9 +15,10 @@ enum class PortDirection : std::uint8_t { Uses, Provides };
 std::string_view to_string(PortDirection direction);
 std::optional<PortDirection> port_direction_from_name(std::string_view name);
 
-// Whether `repid` is one of the CF interfaces every component serves on its control endpoint
-// (Resource and those it inherits: PropertySet, LifeCycle, ...): a uses port of one of them is
-// connected to another component's supported interface and calls it (component/resource_port.hpp).
+// Whether `repid` is a CF interface whose operations a ResourceUsesPort calls on a component's
+// control endpoint (component/resource_port.hpp): Resource (start, stop) and the PropertySet
+// (configure, query) and LifeCycle it inherits. A uses port of one of them is connected to
+// another component's supported interface.
 bool is_control_interface(std::string_view repid);
 
 struct PortDefinition {

@@ -233,6 +233,7 @@ TEST_CASE("a cancel that overtakes its launch's request keeps the launch from be
   auto cancelled = domain.call("app.cancel", Json{{"launch_id", "overtaken-1"}});
   REQUIRE(cancelled.has_value());
   CHECK(cancelled->at("cancelled") == true);
+  CHECK(cancelled->at("begun") == false);
   auto created =
       domain.call("app.create", Json{{"application", "Healthy"}, {"launch_id", "overtaken-1"}});
   REQUIRE_FALSE(created.has_value());

@@ -84,7 +84,6 @@ TEST_CASE("RangeStop through the domain: StopCrash on node1 stops the robot at t
   CHECK(distance < threshold);
   CHECK(distance > threshold - tolerance);
   CHECK(d.at("latency_samples").get<long>() > 50);
-  CHECK(d.at("latency_max_us").get<double>() >= d.at("latency_p99_us").get<double>());
   CHECK(d.at("latency_p50_us").get<double>() > 0);
   CHECK(d.at("safety_stops") == 0);
 

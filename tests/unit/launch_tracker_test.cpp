@@ -30,6 +30,7 @@ TEST_CASE("a cancel reaches a running launch; after its end it says so", "[unit]
   REQUIRE(cancelled != nullptr);
   const auto outcome = launches.cancel("l1");
   CHECK(outcome.cancelled);
+  CHECK(outcome.begun);
   CHECK(cancelled->load());
   // It launched all the same (the cancel came after its last step): not done, to be released.
   CHECK_FALSE(launches.finish("l1", true));
@@ -50,6 +51,7 @@ TEST_CASE("a cancel that overtook its launch keeps that launch from beginning",
   const auto outcome = launches.cancel("l1");
   CHECK(outcome.cancelled);
   CHECK_FALSE(outcome.done);
+  CHECK_FALSE(outcome.begun);
   CHECK(launches.begin("l1") == nullptr);
   CHECK(launches.progress("l1")->done);
   // Another launch is not affected.

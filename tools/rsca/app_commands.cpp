@@ -182,6 +182,8 @@ std::string cancel_launch(const DomainClient &client, const std::string &launch_
                        cancelled.error().message);
   if (!cancelled->value("cancelled", false))
     return "it finished meanwhile (see `rsca ls apps`)";
+  if (!cancelled->value("begun", true))
+    return "the launch is cancelled before it began: the domain will not start it";
   return "the launch is cancelled: the domain rolls back what it did (see `rsca ls apps`)";
 }
 

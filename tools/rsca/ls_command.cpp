@@ -81,7 +81,9 @@ void print_connections(const Json &r) {
                topic.empty() ? "calls " + c.value("repid", "") : topic);
     if (topic.empty()) {
       // A uses port calling a component's supported interface: control calls, no DDS QoS.
-      fmt::print("  uses: {} (samples: calls made)\n", end_state(c.at("uses_state")));
+      const Json &state = c.at("uses_state");
+      fmt::print("  uses: {}\n",
+                 state.is_null() ? "-" : fmt::format("{} calls", state.value("calls", 0)));
       continue;
     }
     const auto &q = c.at("qos");
