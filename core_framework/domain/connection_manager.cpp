@@ -98,7 +98,9 @@ CallResult<RuntimeConnection> ConnectionManager::connect(const PortRef &uses,
   {
     std::lock_guard lock(mutex_);
     if (c.id.empty())
-      c.id = fmt::format("runtime_{}", ++next_);
+      do // past the ids of connections restored from the domain's store
+        c.id = fmt::format("runtime_{}", ++next_);
+      while (connections_.count(c.id) != 0);
     if (connections_.count(c.id) != 0)
       return control::call_error(Status::Rejected, fmt::format("a connection {} exists", c.id));
   }

@@ -223,6 +223,8 @@ struct DomainManager::Impl {
   CallResult<Json> create_connection(const Json &body);
   Json runtime_end_state(const ResolvedEnd &end, const std::string &connection);
   CallResult<Json> destroy_connection(const Json &body);
+  CallResult<RuntimeConnection> make_connection(const Json &body);
+  void restore_connections();
   CallResult<Json> component_exited(const Json &body);
   // Marks the running components `which` selects as exited (the caller holds `mutex`).
   void mark_exited(const std::function<bool(const ComponentInstance &)> &which,
@@ -828,18 +830,51 @@ Json DomainManager::Impl::runtime_end_state(const ResolvedEnd &end, const std::s
   return end_state({{end.address, *status}}, end.address, end.port, connection);
 }
 
-CallResult<Json> DomainManager::Impl::create_connection(const Json &body) {
+CallResult<RuntimeConnection> DomainManager::Impl::make_connection(const Json &body) {
   auto uses = port_ref(body, "uses");
   if (!uses)
     return tl::unexpected(uses.error());
   auto provides = port_ref(body, "provides");
   if (!provides)
     return tl::unexpected(provides.error());
-  auto made = runtime_connections->connect(*uses, *provides, body.value("id", ""),
-                                           body.value("qos", Json::object()));
+  return runtime_connections->connect(*uses, *provides, body.value("id", ""),
+                                      body.value("qos", Json::object()));
+}
+
+// A runtime connection lasts until `rsca disconnect`, also over a restart of the domain daemon:
+// it is kept in the domain's store as its request.
+CallResult<Json> DomainManager::Impl::create_connection(const Json &body) {
+  auto made = make_connection(body);
   if (!made)
     return tl::unexpected(made.error());
+  const Json request{{"id", made->id},
+                     {"uses", body.at("uses")},
+                     {"provides", body.at("provides")},
+                     {"qos", made->qos}};
+  if (auto kept = store->put_connection({made->id, request.dump()}); !kept)
+    spdlog::warn("runtime connection {} will not outlast a restart of the domain daemon: {}",
+                 made->id, kept.error().to_string());
   return to_json(*made);
+}
+
+// The runtime connections of before a restart, made again: pending until their ends appear.
+void DomainManager::Impl::restore_connections() {
+  auto records = store->connections();
+  if (!records) {
+    spdlog::warn("runtime connections not restored: {}", records.error().to_string());
+    return;
+  }
+  for (const auto &r : *records) {
+    const Json request = Json::parse(r.request, nullptr, /*allow_exceptions=*/false);
+    auto made = request.is_object() ? make_connection(request)
+                                    : control::call_error(Status::BadRequest, "not JSON");
+    if (!made) {
+      spdlog::warn("runtime connection {} not restored: {}", r.id, made.error().message);
+      continue;
+    }
+    spdlog::info("runtime connection {} restored: {} -> {}{}", r.id, made->uses.to_string(),
+                 made->provides.to_string(), made->connected() ? "" : " (pending)");
+  }
 }
 
 CallResult<Json> DomainManager::Impl::destroy_connection(const Json &body) {
@@ -848,6 +883,10 @@ CallResult<Json> DomainManager::Impl::destroy_connection(const Json &body) {
     return tl::unexpected(id.error());
   if (auto ok = runtime_connections->disconnect(*id); !ok)
     return tl::unexpected(ok.error());
+  if (auto forgotten = store->remove_connection(*id); !forgotten)
+    spdlog::warn("runtime connection {} removed, but it will come back after a restart of the "
+                 "domain daemon: {}",
+                 *id, forgotten.error().to_string());
   return Json{{"id", *id}};
 }
 
@@ -1085,6 +1124,7 @@ DomainManager::create(std::shared_ptr<dds::Participant> participant, DomainOptio
     return tl::unexpected(endpoint.error());
   impl->endpoint = std::move(*endpoint);
   impl->serve();
+  impl->restore_connections();
   spdlog::info("domain {} serving at {}", impl->options.name, impl->endpoint->address());
   return std::unique_ptr<DomainManager>(new DomainManager(std::move(impl)));
 }

@@ -24,12 +24,14 @@ Expected<DomainStore> DomainStore::open(const std::filesystem::path &file) {
   if (rc != SQLITE_OK)
     return sqlite_error(db.get(), fmt::format("opening {}", file.string()));
   DomainStore store(std::move(db));
-  auto ok = store.exec("CREATE TABLE IF NOT EXISTS installed ("
-                       " name TEXT PRIMARY KEY, sad TEXT NOT NULL,"
-                       " installed_at TEXT NOT NULL DEFAULT CURRENT_TIMESTAMP)",
-                       {});
-  if (!ok)
-    return tl::unexpected(ok.error());
+  for (const char *table : {"CREATE TABLE IF NOT EXISTS installed ("
+                            " name TEXT PRIMARY KEY, sad TEXT NOT NULL,"
+                            " installed_at TEXT NOT NULL DEFAULT CURRENT_TIMESTAMP)",
+                            "CREATE TABLE IF NOT EXISTS runtime_connections ("
+                            " id TEXT PRIMARY KEY, request TEXT NOT NULL,"
+                            " made_at TEXT NOT NULL DEFAULT CURRENT_TIMESTAMP)"})
+    if (auto ok = store.exec(table, {}); !ok)
+      return tl::unexpected(ok.error());
   return store;
 }
 
@@ -55,16 +57,46 @@ Expected<void> DomainStore::remove_installed(const std::string &name) {
   return exec("DELETE FROM installed WHERE name = ?", {name});
 }
 
-Expected<std::vector<InstalledRecord>> DomainStore::installed() const {
+Expected<std::vector<std::pair<std::string, std::string>>>
+DomainStore::pairs(const char *sql, std::string_view what) const {
   sqlite3_stmt *raw = nullptr;
-  if (sqlite3_prepare_v2(db_.get(), "SELECT name, sad FROM installed ORDER BY name", -1, &raw,
-                         nullptr) != SQLITE_OK)
-    return sqlite_error(db_.get(), "reading installed applications");
+  if (sqlite3_prepare_v2(db_.get(), sql, -1, &raw, nullptr) != SQLITE_OK)
+    return sqlite_error(db_.get(), fmt::format("reading {}", what));
   Statement statement(raw);
-  std::vector<InstalledRecord> records;
+  std::vector<std::pair<std::string, std::string>> rows;
   while (sqlite3_step(raw) == SQLITE_ROW)
-    records.push_back({reinterpret_cast<const char *>(sqlite3_column_text(raw, 0)),
-                       reinterpret_cast<const char *>(sqlite3_column_text(raw, 1))});
+    rows.emplace_back(reinterpret_cast<const char *>(sqlite3_column_text(raw, 0)),
+                      reinterpret_cast<const char *>(sqlite3_column_text(raw, 1)));
+  return rows;
+}
+
+Expected<std::vector<InstalledRecord>> DomainStore::installed() const {
+  auto rows = pairs("SELECT name, sad FROM installed ORDER BY name", "installed applications");
+  if (!rows)
+    return tl::unexpected(rows.error());
+  std::vector<InstalledRecord> records;
+  for (auto &[name, sad] : *rows)
+    records.push_back({std::move(name), std::move(sad)});
+  return records;
+}
+
+Expected<void> DomainStore::put_connection(const ConnectionRecord &record) {
+  return exec("INSERT OR REPLACE INTO runtime_connections (id, request) VALUES (?, ?)",
+              {record.id, record.request});
+}
+
+Expected<void> DomainStore::remove_connection(const std::string &id) {
+  return exec("DELETE FROM runtime_connections WHERE id = ?", {id});
+}
+
+Expected<std::vector<ConnectionRecord>> DomainStore::connections() const {
+  auto rows = pairs("SELECT id, request FROM runtime_connections ORDER BY made_at, id",
+                    "runtime connections");
+  if (!rows)
+    return tl::unexpected(rows.error());
+  std::vector<ConnectionRecord> records;
+  for (auto &[id, request] : *rows)
+    records.push_back({std::move(id), std::move(request)});
   return records;
 }
 

@@ -277,6 +277,66 @@ TEST_CASE("runtime connections between running applications: made, checked, carr
   domain.require_clean(pids);
 }
 
+TEST_CASE("a runtime connection outlasts a restart of the domain daemon until disconnected",
+          "[integration][connections]") {
+  TestDomain domain;
+  const auto sad =
+      (kSource / "profiles/dom/waveforms/ProducerConsumer/ProducerConsumer.sad.xml").string();
+  REQUIRE(domain.cli({"install", sad}).first == 0);
+  // Made while neither application runs: pending, and kept by the domain.
+  auto [rc, out] = domain.cli({"connect", "a/Producer_1.samples_out", "b/Consumer_1.samples_in",
+                               "--id", "kept", "--qos", "depth=4"});
+  INFO(out);
+  REQUIRE(rc == 0);
+  auto restart = [&] {
+    domain.restart_domaind();
+    REQUIRE(TestDomain::wait_for([&] {
+      auto nodes = domain.call("domain.nodes", Json::object(), 2s);
+      return nodes && nodes->at("nodes").size() == 2;
+    }));
+  };
+  restart();
+  const Json kept = runtime_connection(domain, "kept");
+  REQUIRE_FALSE(kept.is_null());
+  CHECK(kept.at("state") == "pending");
+  CHECK(kept.at("qos").at("depth") == 4);
+  // A new connection does not take a restored one's id.
+  auto [nrc, nout] = domain.cli({"connect", "a/Producer_1.samples_out", "b/Consumer_1.samples_in"});
+  INFO(nout);
+  REQUIRE(nrc == 0);
+  // Completed when its applications come, carrying data.
+  for (const char *name : {"a", "b"})
+    REQUIRE(domain.cli({"launch", "ProducerConsumer", "--name", name}).first == 0);
+  CHECK(TestDomain::wait_for([&] { return delivered(domain, "kept") > 10; }));
+  std::vector<long> pids;
+  for (const char *name : {"a", "b"}) {
+    auto app = domain.call("app.show", Json{{"app", name}});
+    REQUIRE(app.has_value());
+    for (long pid : pids_of(*app))
+      pids.push_back(pid);
+  }
+  // Disconnected, it stays gone after the next restart.
+  auto made = domain.call("connection.list");
+  REQUIRE(made.has_value());
+  int runtime = 0;
+  for (const auto &c : made->at("connections")) {
+    if (c.at("application") != "(runtime)")
+      continue;
+    ++runtime;
+    REQUIRE(domain.cli({"disconnect", c.at("id").get<std::string>()}).first == 0);
+  }
+  CHECK(runtime == 2);
+  for (const char *name : {"a", "b"})
+    REQUIRE(domain.call("app.release", Json{{"app", name}}).has_value());
+  domain.require_clean(pids);
+  restart();
+  CHECK(runtime_connection(domain, "kept").is_null());
+  auto list = domain.call("connection.list");
+  REQUIRE(list.has_value());
+  for (const auto &c : list->at("connections"))
+    CHECK(c.at("application") != "(runtime)"); // no runtime connection came back
+}
+
 TEST_CASE("a connection rsca cannot make is refused before anything runs, not left out",
           "[integration][connections][failure]") {
   TestDomain domain;
