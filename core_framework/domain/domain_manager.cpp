@@ -155,6 +155,7 @@ struct DomainManager::Impl {
   std::optional<ConnectionManager> runtime_connections; // made before the endpoint opens
   std::optional<EventChannelManager> channels;          // made when the domain's name is known
   std::optional<DomainStore> store;
+  std::mutex kept_connections; // a runtime connection and its record in the store change together
 
   std::mutex mutex; // guards everything below
   std::map<std::string, NodeRecord> nodes;
@@ -844,17 +845,25 @@ CallResult<RuntimeConnection> DomainManager::Impl::make_connection(const Json &b
 // A runtime connection lasts until `rsca disconnect`, also over a restart of the domain daemon:
 // it is kept in the domain's store as its request.
 CallResult<Json> DomainManager::Impl::create_connection(const Json &body) {
+  // Made and kept as one step, so that a disconnect of the same id cannot come in between.
+  std::lock_guard kept_lock(kept_connections);
   auto made = make_connection(body);
   if (!made)
     return tl::unexpected(made.error());
-  const Json request{{"id", made->id},
+  // The request as given (the QoS asked for, not today's defaults), with the id it got.
+  const Json request{{"format", 1},
+                     {"id", made->id},
                      {"uses", body.at("uses")},
                      {"provides", body.at("provides")},
-                     {"qos", made->qos}};
-  if (auto kept = store->put_connection({made->id, request.dump()}); !kept)
+                     {"qos", body.value("qos", Json::object())}};
+  Json reply = to_json(*made);
+  reply["persisted"] = true;
+  if (auto kept = store->put_connection({made->id, request.dump()}); !kept) {
     spdlog::warn("runtime connection {} will not outlast a restart of the domain daemon: {}",
                  made->id, kept.error().to_string());
-  return to_json(*made);
+    reply["persisted"] = false;
+  }
+  return reply;
 }
 
 // The runtime connections of before a restart, made again: pending until their ends appear.
@@ -866,10 +875,13 @@ void DomainManager::Impl::restore_connections() {
   }
   for (const auto &r : *records) {
     const Json request = Json::parse(r.request, nullptr, /*allow_exceptions=*/false);
-    auto made = request.is_object() ? make_connection(request)
-                                    : control::call_error(Status::BadRequest, "not JSON");
+    auto made = !request.is_object() ? control::call_error(Status::BadRequest, "not JSON")
+                : request.value("format", 0) != 1
+                    ? control::call_error(Status::BadRequest, "kept in another format")
+                    : make_connection(request);
     if (!made) {
-      spdlog::warn("runtime connection {} not restored: {}", r.id, made.error().message);
+      spdlog::warn("runtime connection {} not restored ({}); `rsca disconnect {}` forgets it", r.id,
+                   made.error().message, r.id);
       continue;
     }
     spdlog::info("runtime connection {} restored: {} -> {}{}", r.id, made->uses.to_string(),
@@ -881,12 +893,15 @@ CallResult<Json> DomainManager::Impl::destroy_connection(const Json &body) {
   auto id = required<std::string>(body, "id");
   if (!id)
     return tl::unexpected(id.error());
+  std::lock_guard kept_lock(kept_connections);
+  // Forgotten also when not made now: a kept request that no longer restores is removed so.
+  auto forgotten = store->remove_connection(*id);
+  if (!forgotten)
+    spdlog::warn("runtime connection {}: it may come back after a restart of the domain daemon: "
+                 "{}",
+                 *id, forgotten.error().to_string());
   if (auto ok = runtime_connections->disconnect(*id); !ok)
     return tl::unexpected(ok.error());
-  if (auto forgotten = store->remove_connection(*id); !forgotten)
-    spdlog::warn("runtime connection {} removed, but it will come back after a restart of the "
-                 "domain daemon: {}",
-                 *id, forgotten.error().to_string());
   return Json{{"id", *id}};
 }
 
@@ -1123,8 +1138,9 @@ DomainManager::create(std::shared_ptr<dds::Participant> participant, DomainOptio
   if (!endpoint)
     return tl::unexpected(endpoint.error());
   impl->endpoint = std::move(*endpoint);
-  impl->serve();
+  // Before serving: a connection requested meanwhile could take a restored one's id.
   impl->restore_connections();
+  impl->serve();
   spdlog::info("domain {} serving at {}", impl->options.name, impl->endpoint->address());
   return std::unique_ptr<DomainManager>(new DomainManager(std::move(impl)));
 }

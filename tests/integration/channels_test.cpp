@@ -283,9 +283,10 @@ TEST_CASE("a runtime connection outlasts a restart of the domain daemon until di
   const auto sad =
       (kSource / "profiles/dom/waveforms/ProducerConsumer/ProducerConsumer.sad.xml").string();
   REQUIRE(domain.cli({"install", sad}).first == 0);
-  // Made while neither application runs: pending, and kept by the domain.
-  auto [rc, out] = domain.cli({"connect", "a/Producer_1.samples_out", "b/Consumer_1.samples_in",
-                               "--id", "kept", "--qos", "depth=4"});
+  // Made while neither application runs: pending, and kept by the domain. Its id is the first
+  // the domain gives (runtime_1).
+  auto [rc, out] = domain.cli(
+      {"connect", "a/Producer_1.samples_out", "b/Consumer_1.samples_in", "--qos", "depth=4"});
   INFO(out);
   REQUIRE(rc == 0);
   auto restart = [&] {
@@ -296,18 +297,19 @@ TEST_CASE("a runtime connection outlasts a restart of the domain daemon until di
     }));
   };
   restart();
-  const Json kept = runtime_connection(domain, "kept");
+  const Json kept = runtime_connection(domain, "runtime_1");
   REQUIRE_FALSE(kept.is_null());
   CHECK(kept.at("state") == "pending");
   CHECK(kept.at("qos").at("depth") == 4);
-  // A new connection does not take a restored one's id.
+  // A new connection does not take the restored one's id, which a restarted counter would give.
   auto [nrc, nout] = domain.cli({"connect", "a/Producer_1.samples_out", "b/Consumer_1.samples_in"});
   INFO(nout);
   REQUIRE(nrc == 0);
+  CHECK_FALSE(runtime_connection(domain, "runtime_2").is_null());
   // Completed when its applications come, carrying data.
   for (const char *name : {"a", "b"})
     REQUIRE(domain.cli({"launch", "ProducerConsumer", "--name", name}).first == 0);
-  CHECK(TestDomain::wait_for([&] { return delivered(domain, "kept") > 10; }));
+  CHECK(TestDomain::wait_for([&] { return delivered(domain, "runtime_1") > 10; }));
   std::vector<long> pids;
   for (const char *name : {"a", "b"}) {
     auto app = domain.call("app.show", Json{{"app", name}});
@@ -330,7 +332,7 @@ TEST_CASE("a runtime connection outlasts a restart of the domain daemon until di
     REQUIRE(domain.call("app.release", Json{{"app", name}}).has_value());
   domain.require_clean(pids);
   restart();
-  CHECK(runtime_connection(domain, "kept").is_null());
+  CHECK(runtime_connection(domain, "runtime_1").is_null());
   auto list = domain.call("connection.list");
   REQUIRE(list.has_value());
   for (const auto &c : list->at("connections"))
