@@ -50,7 +50,14 @@ double braking_distance(const RobotParams &robot, double friction, double speed)
 }
 
 double stop_tolerance(const RobotParams &robot, double friction, double speed, double latency) {
-  return std::abs(speed) * latency + braking_distance(robot, friction, speed);
+  return stop_tolerance_terms(robot, friction, speed, latency, 0.0, 0.0).total();
+}
+
+StopTolerance stop_tolerance_terms(const RobotParams &robot, double friction, double speed,
+                                   double reaction_time, double transport_time,
+                                   double noise_sigma) {
+  return {std::abs(speed) * reaction_time, std::abs(speed) * transport_time,
+          braking_distance(robot, friction, speed), 2.0 * noise_sigma};
 }
 
 } // namespace rsca::sim

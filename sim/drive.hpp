@@ -37,4 +37,20 @@ double braking_distance(const RobotParams &robot, double friction, double speed)
 // update period + the one step before a command takes effect), then brakes.
 double stop_tolerance(const RobotParams &robot, double friction, double speed, double latency);
 
+// The same bound term by term, for a controller reading a real sensor through middleware: how
+// far the robot drives at `speed` while a reading waits to be acted on (`reaction_time`: control
+// period, sensor update, a world step) and while the command travels to the drive
+// (`transport_time`), how far it then brakes, and two sigmas of the sensor's noise, by which the
+// reading itself may come early. The RangeStop report, the robot tests and rsca-sim-run all
+// take the terms from here.
+struct StopTolerance {
+  double reaction = 0.0;
+  double transport = 0.0;
+  double braking = 0.0;
+  double sensor_noise = 0.0;
+  double total() const { return reaction + transport + braking + sensor_noise; }
+};
+StopTolerance stop_tolerance_terms(const RobotParams &robot, double friction, double speed,
+                                   double reaction_time, double transport_time, double noise_sigma);
+
 } // namespace rsca::sim

@@ -18,6 +18,13 @@ nlohmann::ordered_json to_json(const rsca::sim::Pose2 &pose) {
   return {{"x", pose.position.x()}, {"y", pose.position.y()}, {"heading", pose.heading}};
 }
 
+nlohmann::ordered_json tolerance_json(const rsca::sim::StopTolerance &t) {
+  return {{"reaction", t.reaction},
+          {"transport", t.transport},
+          {"braking", t.braking},
+          {"sensor_noise", t.sensor_noise}};
+}
+
 } // namespace
 
 int main(int argc, char **argv) {
@@ -88,6 +95,11 @@ int main(int argc, char **argv) {
       // What the exact range used here leaves out, and a controller reading the real sensor
       // (the one rsca's IRSensor device serves) has to allow for.
       {"sensor_noise_sigma", scenario.sensors.front().noise_sigma},
+      // The terms of the tolerance through middleware, with no transport time: the caller adds
+      // its own (speed x the latency it measured).
+      {"tolerance_terms", tolerance_json(rsca::sim::stop_tolerance_terms(
+                              scenario.robot, scenario.friction, outcome->speed,
+                              outcome->reaction_time, 0.0, scenario.sensors.front().noise_sigma))},
       {"within_tolerance",
        outcome->overshoot >= 0.0 && outcome->overshoot <= outcome->predicted_tolerance},
       {"sim_time", state.time},

@@ -90,6 +90,7 @@ Expected<StopOutcome> run_stop_trial(Pacer &pacer, const StopTrial &trial) {
   outcome.distance_to_wall = *distance;
   outcome.overshoot = trial.threshold - *distance;
   outcome.braking_distance = braking_distance(scenario.robot, scenario.friction, speed);
+  outcome.reaction_time = latency;
   outcome.predicted_tolerance = stop_tolerance(scenario.robot, scenario.friction, speed, latency);
   return outcome;
 }

@@ -33,6 +33,7 @@ struct StopOutcome {
   double distance_to_wall = 0.0; // exact, along the sensor's ray, at rest
   double overshoot = 0.0;        // threshold - distance_to_wall: how far past the threshold
   double braking_distance = 0.0; // analytic, from the commanded speed
+  double reaction_time = 0.0;    // period + sensor update period + one step (s)
   // Speed × (period + sensor update period + one step) + braking distance: the bound the
   // overshoot should stay under, give or take the sensor's noise.
   double predicted_tolerance = 0.0;

@@ -74,13 +74,14 @@ TEST_CASE("RangeStop through the domain: StopCrash on node1 stops the robot at t
   // loaded host delays the stop, and the physics must still explain where the robot rests.
   const Json d = drive(domain);
   const auto scenario = rsca::sim::default_scenario();
-  const double latency = 0.020 + d.at("latency_max_us").get<double>() * 1e-6 + scenario.time_step;
-  const double tolerance =
-      rsca::sim::stop_tolerance(scenario.robot, scenario.friction, speed, latency) +
-      2 * scenario.sensors.front().noise_sigma;
+  const double transport = d.at("latency_max_us").get<double>() * 1e-6;
+  const double tolerance = rsca::sim::stop_tolerance_terms(scenario.robot, scenario.friction, speed,
+                                                           0.020 + scenario.time_step, transport,
+                                                           scenario.sensors.front().noise_sigma)
+                               .total();
   const double distance = robot(domain, "distance_to_wall");
   INFO("rested " << distance << " m from the wall; tolerance " << tolerance << " with "
-                 << latency * 1e3 << " ms before the stop took effect");
+                 << transport * 1e3 << " ms of sensor-to-command latency");
   CHECK(distance < threshold);
   CHECK(distance > threshold - tolerance);
   CHECK(d.at("latency_samples").get<long>() > 50);
