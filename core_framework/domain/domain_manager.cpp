@@ -400,13 +400,11 @@ CallResult<Json> DomainManager::Impl::create_application(const Json &body) {
     return tl::unexpected(placement.error());
   }
   std::tie(request.assignments, request.strategy) = *placement;
-  std::vector<LaunchStep> steps; // for the reply: the tracker may forget a finished launch
-  auto record = [this, &launch_id, &steps](const LaunchStep &step) {
-    steps.push_back(step);
-    launches.record(launch_id, step);
-  };
+  auto record = [this, &launch_id](const LaunchStep &step) { launches.record(launch_id, step); };
   const auto began = std::chrono::steady_clock::now();
   auto app = factory().create(request, record);
+  // Taken before finish: a finished launch may be forgotten.
+  const auto recorded = launches.progress(launch_id);
   if (!launches.finish(launch_id, app.has_value())) {
     // Cancelled after its last step: its caller was told it would not run.
     if (auto released = factory().release(**app); !released)
@@ -435,7 +433,8 @@ CallResult<Json> DomainManager::Impl::create_application(const Json &body) {
   applications[request.name] = *app;
   runtime_connections->endpoints_changed(); // connections waiting for it
   Json reply = to_json(**app);
-  reply["launch"] = {{"steps", steps_json(steps)}, {"ms", ms_since(began)}};
+  reply["launch"] = {{"steps", steps_json(recorded ? recorded->steps : std::vector<LaunchStep>{})},
+                     {"ms", ms_since(began)}};
   return reply;
 }
 

@@ -88,7 +88,7 @@ ProfileLoader::cached_descriptor(const fs::path &file, const SourceLocation &ref
       return tl::unexpected(reader.error());
     xml_reader_ = std::move(*reader);
   }
-  const fs::path key = fs::absolute(file).lexically_normal();
+  const fs::path key = key_of(file);
   std::error_code ec;
   if (!referenced_at.file.empty()) {
     auto root = root_for(referenced_at.file);
@@ -112,10 +112,24 @@ ProfileLoader::cached_descriptor(const fs::path &file, const SourceLocation &ref
   return *it->second;
 }
 
+fs::path ProfileLoader::key_of(const fs::path &file) {
+  return fs::absolute(file).lexically_normal();
+}
+
 SourceFile ProfileLoader::source_file(const fs::path &file) const {
-  const fs::path key = fs::absolute(file).lexically_normal();
+  const fs::path key = key_of(file);
   auto it = stamps_.find(key);
   return {key.string(), it == stamps_.end() ? std::nullopt : it->second};
+}
+
+template <typename T>
+Expected<std::shared_ptr<const T>> ProfileLoader::cached_source(const fs::path &file,
+                                                                const SourceLocation &referenced_at,
+                                                                std::vector<SourceFile> &sources) {
+  auto part = cached<T>(file, referenced_at);
+  if (part)
+    sources.push_back(source_file(file));
+  return part;
 }
 
 template <typename T>
@@ -141,7 +155,7 @@ ProfileLoader::load_softpkg(const fs::path &spd_file) {
 
 Expected<std::shared_ptr<const ResolvedSoftPkg>>
 ProfileLoader::softpkg(const fs::path &spd_file, const SourceLocation &referenced_at) {
-  const fs::path key = fs::absolute(spd_file).lexically_normal();
+  const fs::path key = key_of(spd_file);
   if (auto cycle = std::find(resolving_.begin(), resolving_.end(), key);
       cycle != resolving_.end()) {
     std::vector<std::string> chain;
@@ -173,24 +187,19 @@ ProfileLoader::softpkg(const fs::path &spd_file, const SourceLocation &reference
   const SdrTree own_tree = tree_of(*root, key);
   auto file_of = [&](const LocalFile &f) { return root->resolve(f.name, key, own_tree); };
   if (const auto &pf = (*spd)->property_file) {
-    auto prf = cached<Properties>(file_of(*pf), pf->where);
+    auto prf = cached_source<Properties>(file_of(*pf), pf->where, resolved->sources);
     prf ? void(resolved->properties = *prf) : errors.append(prf.error());
-    if (prf)
-      resolved->sources.push_back(source_file(file_of(*pf)));
   }
   if (const auto &d = (*spd)->descriptor) {
-    auto scd = cached<SoftwareComponent>(file_of(*d), d->where);
+    auto scd = cached_source<SoftwareComponent>(file_of(*d), d->where, resolved->sources);
     scd ? void(resolved->scd = *scd) : errors.append(scd.error());
-    if (scd)
-      resolved->sources.push_back(source_file(file_of(*d)));
   }
   for (const auto &impl : (*spd)->implementations) {
     ResolvedImplementation ri{&impl, nullptr, {}};
     if (impl.property_file) {
-      auto prf = cached<Properties>(file_of(*impl.property_file), impl.property_file->where);
+      auto prf = cached_source<Properties>(file_of(*impl.property_file), impl.property_file->where,
+                                           resolved->sources);
       prf ? void(ri.properties = *prf) : errors.append(prf.error());
-      if (prf)
-        resolved->sources.push_back(source_file(file_of(*impl.property_file)));
     }
     for (const auto &ref : impl.softpkg_dependencies) {
       // Shared libraries live in dom/deps whichever tree the package is in, as in REDHAWK.

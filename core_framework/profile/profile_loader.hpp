@@ -95,8 +95,15 @@ private:
                                                            const SourceLocation &referenced_at);
   Expected<std::shared_ptr<const Descriptor>>
   cached_descriptor(const std::filesystem::path &file, const SourceLocation &referenced_at);
+  // Files are known by their absolute, normal path.
+  static std::filesystem::path key_of(const std::filesystem::path &file);
   // `file` as read, with the stamp taken before reading it.
   SourceFile source_file(const std::filesystem::path &file) const;
+  // cached<T>, and on success `file` as read added to `sources`.
+  template <typename T>
+  Expected<std::shared_ptr<const T>> cached_source(const std::filesystem::path &file,
+                                                   const SourceLocation &referenced_at,
+                                                   std::vector<SourceFile> &sources);
   template <typename T>
   Expected<std::shared_ptr<const T>> cached(const std::filesystem::path &file,
                                             const SourceLocation &referenced_at);

@@ -69,6 +69,19 @@ long property(TestDomain &domain, const std::string &target, const std::string &
   return q ? q->at("properties").at(id).get<long>() : -1;
 }
 
+// The component processes of the running applications `names`.
+std::vector<long> pids_of_applications(TestDomain &domain,
+                                       std::initializer_list<const char *> names) {
+  std::vector<long> pids;
+  for (const char *name : names) {
+    auto app = domain.call("app.show", Json{{"app", name}});
+    REQUIRE(app.has_value());
+    for (long pid : pids_of(*app))
+      pids.push_back(pid);
+  }
+  return pids;
+}
+
 Json channel(TestDomain &domain, const std::string &name) {
   auto list = domain.call("channel.list");
   REQUIRE(list.has_value());
@@ -209,13 +222,7 @@ TEST_CASE("runtime connections between running applications: made, checked, carr
   REQUIRE(arc == 0);
   auto [brc, bout] = domain.cli({"launch", "ProducerConsumer", "--name", "b"});
   REQUIRE(brc == 0);
-  std::vector<long> pids;
-  for (const char *name : {"a", "b"}) {
-    auto app = domain.call("app.show", Json{{"app", name}});
-    REQUIRE(app.has_value());
-    for (long pid : pids_of(*app))
-      pids.push_back(pid);
-  }
+  const std::vector<long> pids = pids_of_applications(domain, {"a", "b"});
 
   // a's producer feeds b's consumer too, with the QoS asked for.
   auto [rc, out] =
@@ -285,10 +292,11 @@ TEST_CASE("a runtime connection outlasts a restart of the domain daemon until di
   REQUIRE(domain.cli({"install", sad}).first == 0);
   // Made while neither application runs: pending, and kept by the domain. Its id is the first
   // the domain gives (runtime_1).
-  auto [rc, out] = domain.cli(
-      {"connect", "a/Producer_1.samples_out", "b/Consumer_1.samples_in", "--qos", "depth=4"});
+  auto [rc, out] = domain.cli({"--json", "connect", "a/Producer_1.samples_out",
+                               "b/Consumer_1.samples_in", "--qos", "depth=4"});
   INFO(out);
   REQUIRE(rc == 0);
+  CHECK_THAT(out, Catch::Contains("\"persisted\": true"));
   auto restart = [&] {
     domain.restart_domaind();
     REQUIRE(TestDomain::wait_for([&] {
@@ -310,13 +318,7 @@ TEST_CASE("a runtime connection outlasts a restart of the domain daemon until di
   for (const char *name : {"a", "b"})
     REQUIRE(domain.cli({"launch", "ProducerConsumer", "--name", name}).first == 0);
   CHECK(TestDomain::wait_for([&] { return delivered(domain, "runtime_1") > 10; }));
-  std::vector<long> pids;
-  for (const char *name : {"a", "b"}) {
-    auto app = domain.call("app.show", Json{{"app", name}});
-    REQUIRE(app.has_value());
-    for (long pid : pids_of(*app))
-      pids.push_back(pid);
-  }
+  const std::vector<long> pids = pids_of_applications(domain, {"a", "b"});
   // Disconnected, it stays gone after the next restart.
   auto made = domain.call("connection.list");
   REQUIRE(made.has_value());
@@ -337,19 +339,6 @@ TEST_CASE("a runtime connection outlasts a restart of the domain daemon until di
   REQUIRE(list.has_value());
   for (const auto &c : list->at("connections"))
     CHECK(c.at("application") != "(runtime)"); // no runtime connection came back
-}
-
-TEST_CASE("a connection rsca cannot make is refused before anything runs, not left out",
-          "[integration][connections][failure]") {
-  TestDomain domain;
-  domain.install("FoundByName");
-  auto [rc, out] = domain.cli({"launch", "FoundByName"});
-  INFO(out);
-  CHECK(rc == 1);
-  CHECK_THAT(out, Catch::Contains("failed at step 'check'"));
-  CHECK_THAT(out, Catch::Contains("connection elsewhere: only event channels can be found by "
-                                  "findby; \"Elsewhere\" is not one"));
-  domain.require_clean({});
 }
 
 TEST_CASE("a uses port of CF::Resource connected to a component's supported interface calls it",
@@ -382,11 +371,13 @@ TEST_CASE("a uses port of CF::Resource connected to a component's supported inte
   domain.require_clean(pids_of(*app));
 }
 
-TEST_CASE("a supported-interface connection rsca cannot make is refused before anything runs",
+TEST_CASE("a connection rsca cannot make is refused before anything runs, not left out",
           "[integration][connections][failure]") {
   using Case = std::pair<std::string, std::string>;
   const auto [name, message] =
-      GENERATE(Case{"SupervisedByData",
+      GENERATE(Case{"FoundByName", "connection elsewhere: only event channels can be found by "
+                                   "findby; \"Elsewhere\" is not one"},
+               Case{"SupervisedByData",
                     "connection \"supervision\": uses port Producer_1.samples_out is of "
                     "IDL:rsca/SampleSeq:1.0, which cannot call a component's supported interface"},
                Case{"SupervisesItself",
@@ -398,7 +389,7 @@ TEST_CASE("a supported-interface connection rsca cannot make is refused before a
   domain.install(name);
   auto [rc, out] = domain.cli({"launch", name});
   INFO(out);
-  CHECK(rc != 0);
+  CHECK(rc == 1);
   CHECK_THAT(out, Catch::Contains("failed at step 'check'"));
   CHECK_THAT(out, Catch::Contains(message));
   domain.require_clean({});
