@@ -136,6 +136,18 @@ CallResult<Json> result_of(const Json &reply) {
   return reply.value("body", Json::object());
 }
 
+// Runs a handler. A request is untrusted: a handler that reads a field of the wrong type (JSON's
+// type errors) answers BadRequest instead of ending the process.
+CallResult<Json> run_handler(const Handler &handler, const Json &body,
+                             const RequestContext &context) {
+  try {
+    return handler(body, context);
+  } catch (const Json::exception &e) {
+    return call_error(Status::BadRequest,
+                      fmt::format("malformed \"{}\" request: {}", context.operation, e.what()));
+  }
+}
+
 // A writer into one partition, with the publisher that carries the partition.
 struct PartitionWriter {
   Entity publisher;
@@ -338,7 +350,7 @@ CallResult<Json> Endpoint::Impl::dispatch(const RequestContext &context, const J
     handler = it->second;
     ++running[context.target];
   }
-  auto result = handler(body, context);
+  CallResult<Json> result = run_handler(handler, body, context);
   {
     std::lock_guard lock(state_mutex);
     if (--running[context.target] == 0)

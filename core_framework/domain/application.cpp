@@ -32,6 +32,18 @@ const ComponentInstance *Application::find_component(std::string_view id) const 
   return nullptr;
 }
 
+std::vector<std::string> exited_components(const Application &app) {
+  std::vector<std::string> ids;
+  for (const auto &c : app.components)
+    if (c.state == "exited")
+      ids.push_back(c.id);
+  return ids;
+}
+
+std::string state_of(const Application &app) {
+  return exited_components(app).empty() ? std::string(to_string(app.state)) : "degraded";
+}
+
 nlohmann::json to_json(const Application &app) {
   nlohmann::json components = nlohmann::json::array();
   for (const auto &c : app.components) {
@@ -57,9 +69,10 @@ nlohmann::json to_json(const Application &app) {
                            {"repid", c.repid},
                            {"topic", c.topic},
                            {"qos", c.qos}});
-  return {{"name", app.name},         {"installed", app.installed},
-          {"sad", app.sad},           {"state", to_string(app.state)},
-          {"components", components}, {"connections", connections}};
+  return {
+      {"name", app.name},          {"installed", app.installed},       {"sad", app.sad},
+      {"state", state_of(app)},    {"exited", exited_components(app)}, {"components", components},
+      {"connections", connections}};
 }
 
 } // namespace rsca::domain

@@ -81,6 +81,12 @@ struct Application {
   const ComponentInstance *find_component(std::string_view id) const;
 };
 
+// The ids of the components that exited while the application ran.
+std::vector<std::string> exited_components(const Application &app);
+// The application's state as users see it: "degraded" once a component has exited (until it is
+// released), else its lifecycle state.
+std::string state_of(const Application &app);
+
 nlohmann::json to_json(const Application &app);
 
 } // namespace rsca::domain

@@ -1,6 +1,7 @@
 #include "domain/application_factory.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <filesystem>
 #include <future>
 #include <map>
@@ -83,12 +84,43 @@ std::string ApplicationFactory::topic_name(const std::string &domain, const std:
   return fmt::format("rsca_{}_{}_{}", dds_name(domain), dds_name(app), dds_name(connection));
 }
 
+std::string to_string(const LaunchIdentity &launch) {
+  return fmt::format("{}.{}", launch.incarnation, launch.number);
+}
+
+// Addresses are DOMAIN/component/APP.INCARNATION.NUMBER/INSTANCE and
+// DOMAIN/host/APP.INCARNATION.NUMBER/DEVICE (see build_components); the application's name may
+// itself hold dots, the launch's two numbers never do.
+std::optional<std::uint64_t> incarnation_of(std::string_view address) {
+  for (std::string_view kind : {"/component/", "/host/"}) {
+    const auto at = address.find(kind);
+    if (at == std::string_view::npos)
+      continue;
+    std::string_view launch = address.substr(at + kind.size());
+    launch = launch.substr(0, launch.find('/'));
+    const auto last = launch.rfind('.');
+    if (last == std::string_view::npos || last == 0)
+      return std::nullopt;
+    const auto before = launch.rfind('.', last - 1);
+    if (before == std::string_view::npos)
+      return std::nullopt;
+    const std::string_view number = launch.substr(before + 1, last - before - 1);
+    std::uint64_t incarnation = 0;
+    const auto [end, ec] =
+        std::from_chars(number.data(), number.data() + number.size(), incarnation);
+    if (ec != std::errc() || end != number.data() + number.size())
+      return std::nullopt;
+    return incarnation;
+  }
+  return std::nullopt;
+}
+
 // The state of one launch, step by step, and how to undo it.
 class ApplicationFactory::Launch {
 public:
   Launch(const DomainServices &services, const LaunchRequest &request, const ProgressSink &progress)
       : s_(services), request_(request), progress_(progress), app_(std::make_shared<Application>()),
-        launch_(s_.next_launch ? s_.next_launch() : 0) {
+        launch_(to_string(s_.next_launch ? s_.next_launch() : LaunchIdentity{})) {
     app_->name = request.name;
     app_->installed = request.installed;
     app_->profile = request.profile;
@@ -488,7 +520,8 @@ private:
 
   CallResult<void> start() {
     ApplicationFactory factory(s_);
-    auto ok = factory.start(*app_);
+    // The application is the launch's own until it returns: changes need no lock.
+    auto ok = factory.start(*app_, [this](const auto &change) { change(*app_); });
     if (ok)
       detail_ = fmt::format("{} components running", app_->components.size());
     return ok;
@@ -757,7 +790,7 @@ private:
   std::shared_ptr<Application> app_;
   bool allocated_ = false;
   bool joined_channels_ = false;
-  std::uint64_t launch_ = 0;
+  std::string launch_; // LaunchIdentity as addresses and topics carry it
   std::string detail_;
 };
 
@@ -766,12 +799,28 @@ CallResult<std::shared_ptr<Application>> ApplicationFactory::create(const Launch
   return Launch(services_, request, progress).run();
 }
 
-CallResult<void> ApplicationFactory::start(Application &app) {
+namespace {
+
+bool exited(const ComponentInstance &c) {
+  return c.state == "exited";
+}
+
+// Marks the components `ids` names as `state`, except those that exited meanwhile.
+void mark(Application &app, const std::vector<std::string> &ids, const char *state) {
+  for (const auto &id : ids)
+    if (auto *c = app.find_component(id); c != nullptr && !exited(*c))
+      c->state = state;
+}
+
+} // namespace
+
+CallResult<void> ApplicationFactory::start(const Application &app, const ApplyChange &apply) {
   // In start order (the assembly controller first among equals, on its own); the components of
-  // one start order at once.
-  std::vector<ComponentInstance *> order;
-  for (auto &c : app.components)
-    order.push_back(&c);
+  // one start order at once. A component that exited is not called: it cannot answer.
+  std::vector<const ComponentInstance *> order;
+  for (const auto &c : app.components)
+    if (!exited(c))
+      order.push_back(&c);
   std::stable_sort(order.begin(), order.end(), [](const auto *a, const auto *b) {
     if (a->start_order != b->start_order)
       return a->start_order < b->start_order;
@@ -783,26 +832,38 @@ CallResult<void> ApplicationFactory::start(Application &app) {
       end = std::find_if(end, order.end(),
                          [&](const auto *c) { return c->start_order != (*group)->start_order; });
     std::vector<Call> calls;
-    for (auto it = group; it != end; ++it)
-      calls.push_back({(*it)->address, "component.start", Json::object(), (*it)->id});
+    std::vector<std::string> ids;
+    for (; group != end; ++group) {
+      calls.push_back({(*group)->address, "component.start", Json::object(), (*group)->id});
+      ids.push_back((*group)->id);
+    }
     if (auto ok = call_all(*services_.endpoint, calls, services_.call_timeout); !ok)
       return ok;
-    for (; group != end; ++group)
-      (*group)->state = "running";
+    apply([&ids](Application &a) { mark(a, ids, "running"); });
   }
-  app.state = ApplicationState::Running;
+  apply([](Application &a) { a.state = ApplicationState::Running; });
   return {};
 }
 
-CallResult<void> ApplicationFactory::stop(Application &app) {
+CallResult<void> ApplicationFactory::stop(const Application &app, const ApplyChange &apply) {
   std::vector<Call> calls;
-  for (auto &c : app.components)
-    calls.push_back({c.address, "component.stop", Json::object(), c.id});
-  auto ok = call_all(*services_.endpoint, calls, services_.call_timeout);
-  for (auto &c : app.components)
-    c.state = "stopped";
-  app.state = ApplicationState::Stopped;
-  return ok;
+  std::vector<std::string> ids;
+  for (const auto &c : app.components)
+    if (!exited(c)) {
+      calls.push_back({c.address, "component.stop", Json::object(), c.id});
+      ids.push_back(c.id);
+    }
+  const auto replies = call_each_of(*services_.endpoint, calls, services_.call_timeout);
+  // Those that confirmed are stopped; the state of those that did not answer is not known.
+  std::vector<std::string> stopped;
+  for (std::size_t i = 0; i < replies.size(); ++i)
+    if (replies[i])
+      stopped.push_back(ids[i]);
+  apply([&stopped](Application &a) {
+    mark(a, stopped, "stopped");
+    a.state = ApplicationState::Stopped;
+  });
+  return first_failure(calls, replies);
 }
 
 // Devices outlive the application: their ends of its connections go first.

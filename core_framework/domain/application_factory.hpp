@@ -46,6 +46,18 @@ struct DevicePorts {
   nlohmann::json ports; // [{"name", "direction", "repid"}]
 };
 
+// A launch's identity: the domain daemon's incarnation (counted in its store, one more at each
+// start) and the launch's number within it.
+struct LaunchIdentity {
+  std::uint64_t incarnation = 0;
+  std::uint64_t number = 0;
+};
+// "INCARNATION.NUMBER", as component addresses and topics carry it.
+std::string to_string(const LaunchIdentity &launch);
+// The incarnation of the domain daemon that launched the component or component host at
+// `address`; nothing when the address is not one a launch makes.
+std::optional<std::uint64_t> incarnation_of(std::string_view address);
+
 // What the factory uses of the domain.
 struct DomainServices {
   std::string domain_name;
@@ -55,9 +67,10 @@ struct DomainServices {
   EventChannelManager *channels = nullptr;
   std::function<std::optional<std::string>(const std::string &node)> node_address;
   std::function<std::optional<DevicePorts>(const std::string &device)> device_ports;
-  // A number unique to each launch in this domain: component addresses and topics carry it, so
-  // an application re-launched under the same name never meets its predecessor's leftovers.
-  std::function<std::uint64_t()> next_launch;
+  // An identity unique to each launch in this domain, also across restarts of the domain daemon:
+  // component addresses and topics carry it, so an application re-launched under the same name
+  // never meets its predecessor's leftovers, not even those of a domain daemon that was killed.
+  std::function<LaunchIdentity()> next_launch;
   std::chrono::milliseconds call_timeout{5000};
   std::chrono::milliseconds registration_timeout{10000};
   allocator::Strategy strategy = allocator::Strategy::Pack;
@@ -69,8 +82,12 @@ public:
 
   control::CallResult<std::shared_ptr<Application>> create(const LaunchRequest &request,
                                                            const ProgressSink &progress);
-  control::CallResult<void> start(Application &app);
-  control::CallResult<void> stop(Application &app);
+  // Start and stop work from a copy of the application (its components that exited are left
+  // alone) and change its state only through `apply`, which runs a change under its owner's
+  // lock (ApplicationRegistry::update).
+  using ApplyChange = std::function<void(const std::function<void(Application &)> &change)>;
+  control::CallResult<void> start(const Application &app, const ApplyChange &apply);
+  control::CallResult<void> stop(const Application &app, const ApplyChange &apply);
   // Stops, releases and terminates every component, and frees the allocation. Best effort: a
   // component that does not confirm its release is terminated by its node all the same, and
   // named in the result.

@@ -29,7 +29,9 @@ Expected<DomainStore> DomainStore::open(const std::filesystem::path &file) {
                             " installed_at TEXT NOT NULL DEFAULT CURRENT_TIMESTAMP)",
                             "CREATE TABLE IF NOT EXISTS runtime_connections ("
                             " id TEXT PRIMARY KEY, request TEXT NOT NULL,"
-                            " made_at TEXT NOT NULL DEFAULT CURRENT_TIMESTAMP)"})
+                            " made_at TEXT NOT NULL DEFAULT CURRENT_TIMESTAMP)",
+                            "CREATE TABLE IF NOT EXISTS counters ("
+                            " name TEXT PRIMARY KEY, value INTEGER NOT NULL)"})
     if (auto ok = store.exec(table, {}); !ok)
       return tl::unexpected(ok.error());
   return store;
@@ -46,6 +48,22 @@ Expected<void> DomainStore::exec(const std::string &sql,
   if (sqlite3_step(raw) != SQLITE_DONE)
     return sqlite_error(db_.get(), "writing");
   return {};
+}
+
+Expected<std::uint64_t> DomainStore::next_incarnation() {
+  if (auto counted = exec("INSERT INTO counters (name, value) VALUES ('incarnation', 1)"
+                          " ON CONFLICT (name) DO UPDATE SET value = value + 1",
+                          {});
+      !counted)
+    return tl::unexpected(counted.error());
+  sqlite3_stmt *raw = nullptr;
+  if (sqlite3_prepare_v2(db_.get(), "SELECT value FROM counters WHERE name = 'incarnation'", -1,
+                         &raw, nullptr) != SQLITE_OK)
+    return sqlite_error(db_.get(), "reading the incarnation");
+  Statement statement(raw);
+  if (sqlite3_step(raw) != SQLITE_ROW)
+    return sqlite_error(db_.get(), "reading the incarnation");
+  return static_cast<std::uint64_t>(sqlite3_column_int64(raw, 0));
 }
 
 Expected<void> DomainStore::put_installed(const InstalledRecord &record) {

@@ -2,6 +2,7 @@
 // connections an operator made, so that a domain daemon that restarts still has them.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -27,6 +28,10 @@ struct ConnectionRecord {
 class DomainStore {
 public:
   static Expected<DomainStore> open(const std::filesystem::path &file);
+
+  // Counts one more start of the domain daemon and returns the count: launch identities carry
+  // it, so that no two runs of the daemon give out the same one.
+  Expected<std::uint64_t> next_incarnation();
 
   Expected<void> put_installed(const InstalledRecord &record);
   Expected<void> remove_installed(const std::string &name);

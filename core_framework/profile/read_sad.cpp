@@ -1,4 +1,5 @@
 // SAD reader: the application and the references between its own parts.
+#include "common/names.hpp"
 #include "profile/read_context.hpp"
 #include "profile/sad.hpp"
 
@@ -111,6 +112,10 @@ Expected<SoftwareAssembly> read_sad(const XmlDocument &document) {
   sad.id = root.attr("id");
   sad.name = root.attr("name");
   sad.version = root.attr("version");
+  // The name the application is installed and runs under (the id when it has none) becomes a
+  // folder of the domain's repository and part of control addresses: it must be a name.
+  if (auto named = check_name("application name", sad.name.empty() ? sad.id : sad.name); !named)
+    ctx.fail(root, "application-name", named.error());
   sad.description = root.child_text("description");
   sad.component_files = detail::read_component_files(ctx, root.child("componentfiles"));
   for (const auto &c : root.children) {

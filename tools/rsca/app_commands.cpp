@@ -14,6 +14,7 @@
 #include <fmt/ranges.h>
 
 #include "commands.hpp"
+#include "common/names.hpp"
 #include "domain_client.hpp"
 #include "exit_codes.hpp"
 #include "profile/profile_loader.hpp"
@@ -86,6 +87,11 @@ Expected<Json> install_request(const fs::path &sad, const GlobalOptions &global,
 
 int install(const std::string &sad, const std::string &name, const GlobalOptions &global,
             std::string *installed_name) {
+  if (!name.empty())
+    if (auto named = check_name("--name", name); !named) {
+      fmt::print(stderr, "rsca install: {}\n", named.error());
+      return kUsage;
+    }
   auto request = install_request(sad, global, name);
   if (!request) {
     fmt::print(stderr, "rsca install: {}\n", request.error().to_string());
@@ -346,8 +352,10 @@ std::string scalar_text(const Json &v) {
 
 int show_application(const std::string &name, const GlobalOptions &global) {
   return simple_call("show", "app.show", Json{{"app", name}}, global, [](const Json &app) {
-    fmt::print("application {} ({}) {}\n", app.value("name", ""), app.value("installed", ""),
-               app.value("state", ""));
+    const Json exited = app.value("exited", Json::array());
+    fmt::print("application {} ({}) {}{}\n", app.value("name", ""), app.value("installed", ""),
+               app.value("state", ""),
+               exited.empty() ? "" : fmt::format(": exited {}", fmt::join(exited, ", ")));
     fmt::print("  components:\n");
     for (const auto &c : app.at("components"))
       fmt::print("    {:<20} {:<16} pid {:<8} {}{}\n", c.value("id", ""), c.value("device", ""),

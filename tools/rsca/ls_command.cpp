@@ -1,5 +1,6 @@
 // rsca ls apps|nodes|devices|installed
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "commands.hpp"
 #include "domain_client.hpp"
@@ -12,9 +13,22 @@ using control::Json;
 
 void print_apps(const Json &r) {
   fmt::print("{:<24} {:<24} {:<10} {}\n", "APPLICATION", "INSTALLED AS", "STATE", "COMPONENTS");
-  for (const auto &a : r.at("applications"))
-    fmt::print("{:<24} {:<24} {:<10} {}\n", a.value("name", ""), a.value("installed", ""),
-               a.value("state", ""), a.value("components", 0));
+  for (const auto &a : r.at("applications")) {
+    const Json exited = a.value("exited", Json::array());
+    fmt::print("{:<24} {:<24} {:<10} {}{}\n", a.value("name", ""), a.value("installed", ""),
+               a.value("state", ""), a.value("components", 0),
+               exited.empty() ? "" : fmt::format("  (exited: {})", fmt::join(exited, ", ")));
+  }
+  // Left by an earlier run of the domain daemon (one that was killed): the domain cannot release
+  // them, the operator can.
+  const Json unknown = r.value("unknown", Json::array());
+  if (unknown.empty())
+    return;
+  fmt::print("\n{} component process(es) run that no application of this domain launched (an "
+             "earlier run of the domain daemon did):\n",
+             unknown.size());
+  for (const auto &u : unknown)
+    fmt::print("  pid {:<8} {}\n", u.value("pid", 0), u.value("address", ""));
 }
 
 void print_installed(const Json &r) {

@@ -1,0 +1,449 @@
+// The DomainManager's nodes, devices, connections and channels: what nodes and components
+// announce, where a connection's end is served, the connections' live state, runtime connections
+// kept across restarts, and event channels.
+#include <algorithm>
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include "allocator/plan_json.hpp"
+#include "common/names.hpp"
+#include "domain/domain_manager_impl.hpp"
+
+namespace rsca::domain {
+namespace {
+
+using control::Json;
+using control::Status;
+
+// One end's live state from its owner's status (by address): {"matched", "samples",
+// "filtered"}, or null.
+Json end_state(const std::map<std::string, Json> &status_of, const std::string &address,
+               const std::string &port_name, const std::string &connection) {
+  auto it = status_of.find(address);
+  if (address.empty() || it == status_of.end())
+    return nullptr;
+  for (const auto &port : it->second.value("ports", Json::array())) {
+    if (port.value("name", "") != port_name)
+      continue;
+    for (const auto &c : port.value("connections", Json::array())) {
+      if (c.value("connection", "") != connection)
+        continue;
+      if (c.contains("calls"))
+        return Json{{"calls", c.value("calls", 0)}}; // a caller of a supported interface
+      return Json{{"matched", c.value("matched", 0)},
+                  {"samples", c.value("samples", 0)},
+                  {"filtered", c.value("filtered", 0)},
+                  {"deadline_missed", c.value("deadline_missed", 0)},
+                  {"in_host", c.value("in_host", false)}};
+    }
+  }
+  return nullptr;
+}
+
+Json connection_json(const Application &app, const ConnectionInstance &c,
+                     const std::map<std::string, Json> &status_of) {
+  auto state = [&](const ConnectionEnd &e) {
+    return end_state(status_of, e.address, e.port, end_key(c, e));
+  };
+  return {{"application", app.name},
+          {"id", c.id},
+          {"uses", c.uses.name()},
+          {"provides", c.provides.name()},
+          {"topic", c.topic},
+          {"repid", c.repid},
+          {"qos", c.qos},
+          {"filter", c.filter},
+          {"uses_state", state(c.uses)},
+          {"provides_state", state(c.provides)}};
+}
+
+Json device_ids(const Json &node_body) {
+  Json ids = Json::array();
+  for (const auto &d : node_body.value("devices", Json::array()))
+    ids.push_back(d.value("id", ""));
+  return ids;
+}
+
+std::vector<allocator::Device> devices_of(const std::string &node, const Json &body) {
+  std::vector<allocator::Device> devices;
+  for (const auto &d : body.value("devices", Json::array()))
+    devices.push_back(allocator::device_from_announcement(node, d));
+  return devices;
+}
+
+// {"application", "component", "port"}, {"application", "port"} (an external port) or
+// {"device", "port"}.
+CallResult<PortRef> port_ref(const Json &body, const char *key) {
+  if (!body.contains(key) || !body.at(key).is_object())
+    return control::call_error(Status::BadRequest,
+                               fmt::format("the request has no \"{}\" port", key));
+  const Json &end = body.at(key);
+  PortRef ref;
+  ref.port = end.value("port", "");
+  if (end.contains("device")) {
+    ref.kind = PortRef::Kind::Device;
+    ref.owner = end.value("device", "");
+  } else {
+    ref.owner = end.value("application", "");
+    ref.component = end.value("component", "");
+    ref.kind = ref.component.empty() ? PortRef::Kind::External : PortRef::Kind::Component;
+  }
+  if (ref.owner.empty() || ref.port.empty())
+    return control::call_error(
+        Status::BadRequest,
+        fmt::format("\"{}\" needs a port and an application (with a component) or a device", key));
+  return ref;
+}
+
+// The addresses whose status shows the state of `app`'s connections: its components that have
+// not exited (one that exited cannot answer) and the devices its connections reach.
+void status_addresses(const Application &app, std::set<std::string> &addresses) {
+  for (const auto &c : app.components)
+    if (c.state != "exited")
+      addresses.insert(c.address);
+  for (const auto &c : app.connections)
+    for (const auto *end : {&c.uses, &c.provides})
+      if (!end->device.empty() && !end->address.empty())
+        addresses.insert(end->address);
+}
+
+} // namespace
+
+void DomainManager::Impl::on_announcement(const control::AnnouncementEvent &event) {
+  using Kind = control::AnnouncementEvent::Kind;
+  if (event.kind == Kind::Alive && event.endpoint_kind == "node")
+    return node_alive(event);
+  if (event.kind == Kind::Alive && event.endpoint_kind == "component")
+    return component_announced(event);
+  if (event.kind != Kind::Gone)
+    return;
+  components.gone(event.address);
+  node_gone(event.address);
+}
+
+void DomainManager::Impl::node_alive(const control::AnnouncementEvent &event) {
+  const std::string node = event.body.value("node", event.address);
+  allocator.set_node_devices(node, devices_of(node, event.body));
+  std::lock_guard lock(nodes_mutex);
+  const bool known = nodes.count(node) != 0;
+  nodes[node] = {node, event.address, event.body};
+  runtime_connections->endpoints_changed(); // connections waiting for its devices
+  if (known)
+    return;
+  spdlog::info("node {} registered with {} device(s)", node,
+               event.body.value("devices", Json::array()).size());
+  events->publish("node.added", {{"node", node}, {"devices", device_ids(event.body)}});
+}
+
+void DomainManager::Impl::node_gone(const std::string &address) {
+  std::lock_guard lock(nodes_mutex);
+  unknown.erase(address); // an unknown component that went away
+  auto it = std::find_if(nodes.begin(), nodes.end(),
+                         [&](const auto &n) { return n.second.address == address; });
+  if (it == nodes.end())
+    return;
+  const std::string node = it->first;
+  spdlog::warn("node {} is gone; its devices leave the domain", node);
+  events->publish("node.removed", {{"node", node}, {"devices", device_ids(it->second.body)}});
+  allocator.remove_node(node);
+  // Its component processes died with it (they cannot outlive their node); their own leases
+  // are longer than a node's, so their announcements would linger.
+  const auto why = fmt::format("its node {} is gone", node);
+  for (const auto &component : components.node_gone(node, why))
+    endpoint->abandon(component, why);
+  mark_exited([&node](const ComponentInstance &c) { return c.node == node; }, why);
+  runtime_connections->owner_gone_later([prefix = node + ":"](const PortRef &ref) {
+    return ref.kind == PortRef::Kind::Device && ref.owner.starts_with(prefix);
+  });
+  nodes.erase(it);
+}
+
+// A component announced itself. One that an earlier run of this domain daemon launched (its
+// address carries another incarnation) is running without an application this run knows: it is
+// reported, once, and never taken for a component of a launch of this run.
+void DomainManager::Impl::component_announced(const control::AnnouncementEvent &event) {
+  const auto launched_by = incarnation_of(event.address);
+  if (!launched_by || *launched_by == incarnation) {
+    components.announced(event.address, event.body);
+    return;
+  }
+  std::lock_guard lock(nodes_mutex);
+  const bool first = unknown.count(event.address) == 0;
+  unknown[event.address] = {event.address, event.body};
+  if (!first)
+    return;
+  spdlog::warn("component {} (pid {}) runs but no application of this domain daemon launched "
+               "it: an earlier run (incarnation {}, this one is {}) did; stop it by hand or "
+               "restart its node",
+               event.address, event.body.value("pid", 0), *launched_by, incarnation);
+  events->publish("component.unknown", {{"address", event.address},
+                                        {"application", event.body.value("application", "")},
+                                        {"component", event.body.value("id", "")},
+                                        {"pid", event.body.value("pid", 0)}});
+}
+
+Json DomainManager::Impl::unknown_components() {
+  std::lock_guard lock(nodes_mutex);
+  Json list = Json::array();
+  for (const auto &[address, u] : unknown)
+    list.push_back({{"address", address},
+                    {"application", u.announcement.value("application", "")},
+                    {"component", u.announcement.value("id", "")},
+                    {"pid", u.announcement.value("pid", 0)}});
+  return list;
+}
+
+const Json *DomainManager::Impl::find_device(const std::string &id) const {
+  const auto colon = id.find(':');
+  auto node = nodes.find(id.substr(0, colon));
+  if (colon == std::string::npos || node == nodes.end())
+    return nullptr;
+  const Json &body = node->second.body;
+  auto devices = body.find("devices"); // a reference into the record: value() would copy
+  if (devices == body.end() || !devices->is_array())
+    return nullptr;
+  for (const auto &d : *devices)
+    if (d.value("id", "") == id)
+      return &d;
+  return nullptr;
+}
+
+// A device's control address, for "device" requests of app.configure and app.query.
+CallResult<std::string> DomainManager::Impl::device_address(const std::string &id) {
+  std::lock_guard lock(nodes_mutex);
+  const Json *device = find_device(id);
+  if (device == nullptr)
+    return control::call_error(Status::NotFound,
+                               fmt::format("no device {} has registered", excerpt(id)));
+  if (!device->contains("address"))
+    return control::call_error(Status::NotFound,
+                               fmt::format("device {} has no properties to reach", id));
+  return device->value("address", "");
+}
+
+CallResult<ResolvedEnd> DomainManager::Impl::resolve_end(const PortRef &ref,
+                                                         profile::PortDirection direction) {
+  return ref.kind == PortRef::Kind::Device ? resolve_device_end(ref, direction)
+                                           : resolve_component_end(ref, direction);
+}
+
+CallResult<ResolvedEnd>
+DomainManager::Impl::resolve_component_end(const PortRef &ref, profile::PortDirection direction) {
+  const bool uses = direction == profile::PortDirection::Uses;
+  auto found = applications.snapshot(ref.owner);
+  if (!found)
+    return control::call_error(Status::Unavailable,
+                               fmt::format("application {} is not running", ref.owner));
+  const Application &app = *found;
+  std::string component = ref.component, port = ref.port;
+  if (ref.kind == PortRef::Kind::External) {
+    const auto wanted =
+        uses ? profile::ExternalPort::Kind::Uses : profile::ExternalPort::Kind::Provides;
+    const profile::ExternalPort *external = nullptr;
+    for (const auto &e : app.profile->sad->external_ports)
+      if (e.external_name == ref.port && e.kind == wanted)
+        external = &e;
+    if (external == nullptr)
+      return control::call_error(Status::NotFound,
+                                 fmt::format("{} is not an external {} port", ref.to_string(),
+                                             profile::to_string(direction)));
+    component = external->component_ref;
+    port = external->port;
+  }
+  const auto *instance = app.find_component(component);
+  if (instance == nullptr)
+    return control::call_error(
+        Status::NotFound, fmt::format("application {} has no component {}", ref.owner, component));
+  const profile::ComponentPlacement *placement = nullptr;
+  app.profile->sad->find_instantiation(component, &placement);
+  const auto *pkg = placement != nullptr ? app.profile->softpkg_of(*placement) : nullptr;
+  const auto *definition =
+      pkg != nullptr && pkg->scd ? pkg->scd->find_port(port, direction) : nullptr;
+  if (definition == nullptr)
+    return control::call_error(Status::NotFound, fmt::format("{} is not a {} port", ref.to_string(),
+                                                             profile::to_string(direction)));
+  return ResolvedEnd{instance->address, port, definition->repid};
+}
+
+CallResult<ResolvedEnd> DomainManager::Impl::resolve_device_end(const PortRef &ref,
+                                                                profile::PortDirection direction) {
+  const auto wanted = profile::to_string(direction);
+  std::lock_guard lock(nodes_mutex);
+  const std::string node = ref.owner.substr(0, ref.owner.find(':'));
+  if (nodes.count(node) == 0)
+    return control::call_error(Status::Unavailable,
+                               fmt::format("device {} has not registered", ref.owner));
+  const Json *device = find_device(ref.owner);
+  if (device == nullptr)
+    return control::call_error(Status::NotFound,
+                               fmt::format("node {} has no device {}", node, ref.owner));
+  for (const auto &p : device->value("ports", Json::array()))
+    if (p.value("name", "") == ref.port && p.value("direction", "") == wanted)
+      return ResolvedEnd{device->value("address", ""), ref.port, p.value("repid", "")};
+  return control::call_error(Status::NotFound,
+                             fmt::format("{} is not a {} port", ref.to_string(), wanted));
+}
+
+CallResult<Json> DomainManager::Impl::list_nodes() {
+  std::lock_guard lock(nodes_mutex);
+  Json list = Json::array();
+  for (const auto &[name, node] : nodes)
+    list.push_back({{"name", name},
+                    {"address", node.address},
+                    {"pid", node.body.value("pid", 0)},
+                    {"devices", node.body.value("devices", Json::array()).size()}});
+  return Json{{"nodes", list}};
+}
+
+CallResult<Json> DomainManager::Impl::list_devices() {
+  return Json{{"devices", allocator::to_json(allocator.snapshot())}};
+}
+
+CallResult<Json> DomainManager::Impl::list_channels() {
+  Json list = Json::array();
+  for (const auto &c : channels->list())
+    list.push_back(to_json(c));
+  return Json{{"channels", list}};
+}
+
+CallResult<Json> DomainManager::Impl::create_channel(const Json &body) {
+  auto name = required<std::string>(body, "name");
+  if (!name)
+    return tl::unexpected(name.error());
+  auto channel = channels->create(*name);
+  if (!channel)
+    return tl::unexpected(channel.error());
+  return to_json(*channel);
+}
+
+CallResult<Json> DomainManager::Impl::destroy_channel(const Json &body) {
+  auto name = required<std::string>(body, "name");
+  if (!name)
+    return tl::unexpected(name.error());
+  if (auto ok = channels->destroy(*name); !ok)
+    return tl::unexpected(ok.error());
+  return Json{{"name", *name}};
+}
+
+// Every connection of the running applications (or of one), with its live state as its
+// components report it: matched or not, samples through it. The domain answers with what it
+// knows: one status call to every live owner at once, bounded below the CLI's own wait; an end
+// whose owner exited or does not answer shows no state.
+CallResult<Json> DomainManager::Impl::list_connections(const Json &body) {
+  const std::string only = body.value("app", "");
+  std::vector<Application> apps = applications.snapshots();
+  std::erase_if(apps, [&](const Application &a) { return !only.empty() && a.name != only; });
+  if (!only.empty() && apps.empty())
+    return control::call_error(Status::NotFound,
+                               fmt::format("no application {} runs", excerpt(only)));
+  auto runtime = runtime_connections->list();
+  std::erase_if(runtime, [&](const RuntimeConnection &c) {
+    return !only.empty() && c.uses.owner != only && c.provides.owner != only;
+  });
+  std::set<std::string> addresses;
+  for (const auto &app : apps)
+    status_addresses(app, addresses);
+  for (const auto &c : runtime)
+    if (c.connected())
+      addresses.insert({c.uses_end.address, c.provides_end.address});
+  std::vector<control::Call> calls;
+  for (const auto &address : addresses)
+    calls.push_back({address, "component.status", Json::object()});
+  const auto statuses = endpoint->call_all(calls, options.call_timeout / 2);
+  std::map<std::string, Json> status_of;
+  for (std::size_t i = 0; i < calls.size(); ++i)
+    if (statuses[i])
+      status_of[calls[i].target] = *statuses[i];
+  Json list = Json::array();
+  for (const auto &app : apps)
+    for (const auto &c : app.connections)
+      list.push_back(connection_json(app, c, status_of));
+  for (const auto &c : runtime) {
+    Json entry = to_json(c);
+    entry["application"] = "(runtime)";
+    entry["uses_state"] =
+        c.connected() ? end_state(status_of, c.uses_end.address, c.uses_end.port, c.id) : nullptr;
+    entry["provides_state"] =
+        c.connected() ? end_state(status_of, c.provides_end.address, c.provides_end.port, c.id)
+                      : nullptr;
+    list.push_back(std::move(entry));
+  }
+  return Json{{"connections", list}};
+}
+
+CallResult<RuntimeConnection> DomainManager::Impl::make_connection(const Json &body) {
+  auto uses = port_ref(body, "uses");
+  if (!uses)
+    return tl::unexpected(uses.error());
+  auto provides = port_ref(body, "provides");
+  if (!provides)
+    return tl::unexpected(provides.error());
+  return runtime_connections->connect(*uses, *provides, body.value("id", ""),
+                                      body.value("qos", Json::object()));
+}
+
+// A runtime connection lasts until `rsca disconnect`, also over a restart of the domain daemon:
+// it is kept in the domain's store as its request.
+CallResult<Json> DomainManager::Impl::create_connection(const Json &body) {
+  // Made and kept as one step, so that a disconnect of the same id cannot come in between.
+  std::lock_guard kept_lock(kept_connections);
+  auto made = make_connection(body);
+  if (!made)
+    return tl::unexpected(made.error());
+  // The request as given (the QoS asked for, not today's defaults), with the id it got.
+  const Json request{{"format", 1},
+                     {"id", made->id},
+                     {"uses", body.at("uses")},
+                     {"provides", body.at("provides")},
+                     {"qos", body.value("qos", Json::object())}};
+  Json reply = to_json(*made);
+  reply["persisted"] = true;
+  if (auto kept = store->put_connection({made->id, request.dump()}); !kept) {
+    spdlog::warn("runtime connection {} will not outlast a restart of the domain daemon: {}",
+                 made->id, kept.error().to_string());
+    reply["persisted"] = false;
+  }
+  return reply;
+}
+
+// The runtime connections of before a restart, made again: pending until their ends appear.
+void DomainManager::Impl::restore_connections() {
+  auto records = store->connections();
+  if (!records) {
+    spdlog::warn("runtime connections not restored: {}", records.error().to_string());
+    return;
+  }
+  for (const auto &r : *records) {
+    const Json request = Json::parse(r.request, nullptr, /*allow_exceptions=*/false);
+    auto made = !request.is_object() ? control::call_error(Status::BadRequest, "not JSON")
+                : request.value("format", 0) != 1
+                    ? control::call_error(Status::BadRequest, "kept in another format")
+                    : make_connection(request);
+    if (!made) {
+      spdlog::warn("runtime connection {} not restored ({}); `rsca disconnect {}` forgets it", r.id,
+                   made.error().message, r.id);
+      continue;
+    }
+    spdlog::info("runtime connection {} restored: {} -> {}{}", r.id, made->uses.to_string(),
+                 made->provides.to_string(), made->connected() ? "" : " (pending)");
+  }
+}
+
+CallResult<Json> DomainManager::Impl::destroy_connection(const Json &body) {
+  auto id = required<std::string>(body, "id");
+  if (!id)
+    return tl::unexpected(id.error());
+  std::lock_guard kept_lock(kept_connections);
+  // Forgotten also when not made now: a kept request that no longer restores is removed so.
+  auto forgotten = store->remove_connection(*id);
+  if (!forgotten)
+    spdlog::warn("runtime connection {}: it may come back after a restart of the domain daemon: "
+                 "{}",
+                 *id, forgotten.error().to_string());
+  if (auto ok = runtime_connections->disconnect(*id); !ok)
+    return tl::unexpected(ok.error());
+  return Json{{"id", *id}};
+}
+
+} // namespace rsca::domain

@@ -1,0 +1,262 @@
+#include "domain/installed_repository.hpp"
+
+#include <unistd.h>
+
+#include <atomic>
+#include <fstream>
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include "common/names.hpp"
+#include "profile/runtime_model.hpp"
+
+namespace rsca::domain {
+namespace {
+
+namespace fs = std::filesystem;
+using control::CallResult;
+using control::Status;
+
+// Whether `path` lies strictly inside `dir`. Lexical: the repository's own folders hold no links
+// (files arrive as contents and are written as regular files).
+bool inside(const fs::path &dir, const fs::path &path) {
+  const fs::path rel = path.lexically_normal().lexically_relative(dir.lexically_normal());
+  return !rel.empty() && rel != "." && *rel.begin() != "..";
+}
+
+// Removes a folder of the repository, and nothing outside it whatever it is asked.
+void remove_inside(const fs::path &root, const fs::path &dir) {
+  if (!inside(root, dir)) {
+    spdlog::error("not removing {}: it is not inside the repository {}", dir.string(),
+                  root.string());
+    return;
+  }
+  std::error_code ec;
+  fs::remove_all(dir, ec);
+  if (ec)
+    spdlog::warn("removing {}: {}", dir.string(), ec.message());
+}
+
+// A folder of the repository that is removed when it goes out of scope, unless kept.
+class ScopedFolder {
+public:
+  ScopedFolder(fs::path root, fs::path dir) : root_(std::move(root)), dir_(std::move(dir)) {}
+  ~ScopedFolder() {
+    if (!dir_.empty())
+      remove_inside(root_, dir_);
+  }
+  ScopedFolder(const ScopedFolder &) = delete;
+  ScopedFolder &operator=(const ScopedFolder &) = delete;
+  const fs::path &path() const { return dir_; }
+  void keep() { dir_.clear(); }
+  void reset(fs::path dir) { dir_ = std::move(dir); }
+
+private:
+  fs::path root_;
+  fs::path dir_;
+};
+
+// A file's path from a client, which must stay inside the install: relative, no "..".
+std::optional<fs::path> safe_relative(const std::string &path) {
+  fs::path p = fs::path(path).lexically_normal();
+  if (p.empty() || p.is_absolute() || *p.begin() == "..")
+    return std::nullopt;
+  return p;
+}
+
+// A folder name no other install (of this or a concurrent daemon) has.
+std::string unique_name(std::string_view what) {
+  static std::atomic<std::uint64_t> counter{0};
+  return fmt::format("{}-{}-{}", what, ::getpid(), ++counter);
+}
+
+CallResult<void> write_files(const fs::path &dir, const std::vector<InstallFile> &files) {
+  for (const auto &f : files) {
+    auto rel = safe_relative(f.path);
+    if (!rel)
+      return control::call_error(
+          Status::BadRequest,
+          fmt::format("file path \"{}\" is not inside an SDR root", excerpt(f.path)));
+    std::error_code ec;
+    fs::create_directories((dir / *rel).parent_path(), ec);
+    std::ofstream out(dir / *rel, std::ios::binary);
+    out << f.content;
+    out.close();
+    if (ec || !out)
+      return control::call_error(Status::Failed,
+                                 fmt::format("writing {} into the repository: {}", excerpt(f.path),
+                                             ec ? ec.message() : std::strerror(errno)));
+  }
+  return {};
+}
+
+// The application's components then start from their runtime models, without reading XML; a
+// component without one still starts, reading its profile (profile/runtime_model.hpp).
+void write_runtime_models(const profile::ResolvedApplication &app) {
+  for (const auto &[id, softpkg] : app.component_files)
+    if (auto ok = profile::write_runtime_model(*softpkg); !ok)
+      spdlog::warn("no runtime model for {}: {}", softpkg->spd_path.string(),
+                   ok.error().to_string());
+}
+
+} // namespace
+
+InstalledRepository::InstalledRepository(fs::path root, DomainStore &store)
+    : root_(std::move(root)), store_(store) {}
+
+std::optional<fs::path> InstalledRepository::folder_of(const InstalledRecord &record) const {
+  if (!check_name("installed application", record.name))
+    return std::nullopt;
+  const fs::path sad = fs::path(record.sad).lexically_normal();
+  auto part = sad.begin();
+  if (part == sad.end())
+    return std::nullopt;
+  if (*part == "applications" && ++part != sad.end() && *part == record.name)
+    return applications_dir() / record.name;
+  // An earlier version's layout: the application's folder at the repository's top.
+  if (*sad.begin() == record.name && record.name != "applications")
+    return root_ / record.name;
+  return std::nullopt;
+}
+
+void InstalledRepository::load() {
+  auto records = store_.installed();
+  if (!records) {
+    spdlog::error("installed applications not loaded: {}", records.error().to_string());
+    return;
+  }
+  std::lock_guard lock(mutex_);
+  for (const auto &r : *records) {
+    auto folder = folder_of(r);
+    if (!folder) {
+      spdlog::warn("installed application \"{}\" skipped: its record ({}) does not place it in "
+                   "a folder of its own inside the repository",
+                   excerpt(r.name), excerpt(r.sad));
+      continue;
+    }
+    profile::ProfileLoader loader(*folder);
+    auto app = loader.load_application(root_ / r.sad);
+    if (!app) {
+      spdlog::warn("installed application {} no longer loads, skipped:\n{}", r.name,
+                   app.error().to_string());
+      continue;
+    }
+    write_runtime_models(*app); // anew: the files may have changed while the domain was down
+    installed_[r.name] = {r.name, root_ / r.sad,
+                          std::make_shared<const profile::ResolvedApplication>(std::move(*app))};
+    folders_[r.name] = *folder;
+  }
+  spdlog::info("{} installed application(s) loaded", installed_.size());
+}
+
+CallResult<InstalledApplication> InstalledRepository::install(const InstallRequest &request) {
+  auto sad = safe_relative(request.sad);
+  if (!sad)
+    return control::call_error(
+        Status::BadRequest,
+        fmt::format("the SAD's path \"{}\" is not inside an SDR root", excerpt(request.sad)));
+  if (request.name)
+    if (auto named = check_name("application name", *request.name); !named)
+      return control::call_error(Status::BadRequest, named.error());
+  // Written and loaded aside first: only an install that loads replaces anything.
+  ScopedFolder staging(root_, staging_dir() / unique_name("install"));
+  if (auto written = write_files(staging.path(), request.files); !written)
+    return tl::unexpected(written.error());
+  profile::ProfileLoader loader(staging.path());
+  auto app = loader.load_application(staging.path() / *sad);
+  if (!app)
+    return control::call_error(Status::BadRequest, app.error().to_string());
+  const std::string name =
+      request.name.value_or(app->sad->name.empty() ? app->sad->id : app->sad->name);
+  if (auto named = check_name("application name", name); !named)
+    return control::call_error(Status::BadRequest, named.error());
+  std::lock_guard lock(mutex_);
+  auto installed = replace(name, staging.path(), *sad);
+  if (installed)
+    staging.keep(); // it became the install
+  return installed;
+}
+
+// Puts a staged install in the place of `name` (called with mutex_ held). What was installed
+// under that name steps aside first and comes back if anything fails.
+CallResult<InstalledApplication> InstalledRepository::replace(const std::string &name,
+                                                              const fs::path &staged,
+                                                              const fs::path &sad_in_install) {
+  const fs::path target = applications_dir() / name;
+  std::error_code ec;
+  fs::create_directories(applications_dir(), ec);
+  ScopedFolder previous(root_, {});
+  const auto old = folders_.find(name);
+  const fs::path old_folder = old != folders_.end() ? old->second : target;
+  if (fs::exists(old_folder, ec)) {
+    previous.reset(staging_dir() / unique_name("previous"));
+    fs::rename(old_folder, previous.path(), ec);
+    if (ec)
+      previous.keep();
+  }
+  auto fail = [&](std::string why) -> CallResult<InstalledApplication> {
+    remove_inside(root_, target);
+    if (!previous.path().empty()) {
+      std::error_code restore;
+      fs::rename(previous.path(), old_folder, restore);
+      if (!restore)
+        previous.keep();
+    }
+    return control::call_error(Status::Failed, fmt::format("storing {}: {}", name, why));
+  };
+  if (ec)
+    return fail(ec.message());
+  fs::rename(staged, target, ec);
+  if (ec)
+    return fail(ec.message());
+  profile::ProfileLoader loader(target);
+  auto app = loader.load_application(target / sad_in_install);
+  if (!app)
+    return fail(app.error().to_string());
+  const fs::path sad = target / sad_in_install;
+  if (auto stored = store_.put_installed({name, sad.lexically_relative(root_).string()}); !stored)
+    return fail(stored.error().to_string());
+  write_runtime_models(*app);
+  InstalledApplication installed{
+      name, sad, std::make_shared<const profile::ResolvedApplication>(std::move(*app))};
+  installed_[name] = installed;
+  folders_[name] = target;
+  return installed;
+}
+
+CallResult<void> InstalledRepository::uninstall(const std::string &name) {
+  if (auto named = check_name("application name", name); !named)
+    return control::call_error(Status::BadRequest, named.error());
+  std::lock_guard lock(mutex_);
+  auto it = installed_.find(name);
+  if (it == installed_.end())
+    return control::call_error(Status::NotFound,
+                               fmt::format("no application {} is installed", name));
+  // The record first: files removed under a record that stays would not load after a restart.
+  if (auto forgotten = store_.remove_installed(name); !forgotten)
+    return control::call_error(
+        Status::Failed, fmt::format("uninstalling {}: {}", name, forgotten.error().to_string()));
+  remove_inside(root_, folders_.at(name));
+  installed_.erase(it);
+  folders_.erase(name);
+  return {};
+}
+
+std::optional<InstalledApplication> InstalledRepository::find(const std::string &name) const {
+  std::lock_guard lock(mutex_);
+  auto it = installed_.find(name);
+  if (it == installed_.end())
+    return std::nullopt;
+  return it->second;
+}
+
+std::vector<InstalledApplication> InstalledRepository::list() const {
+  std::lock_guard lock(mutex_);
+  std::vector<InstalledApplication> out;
+  for (const auto &[name, app] : installed_)
+    out.push_back(app);
+  return out;
+}
+
+} // namespace rsca::domain

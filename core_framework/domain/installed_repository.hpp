@@ -1,0 +1,74 @@
+// InstalledRepository: the applications installed in the domain. Each one's profiles are copied
+// into a folder of its own inside the domain's repository (applications/NAME), loaded from there,
+// and recorded in the domain's store, so that a restarted domain daemon has them again.
+//
+// Nothing a client sends can make the repository act outside itself: a name is checked as a name
+// (common/names.hpp) before it touches the file system, a file's path must be relative and stay
+// inside the install, and every folder the repository removes or replaces is checked to lie inside
+// it. An install is staged in a folder of its own and takes the application's place only once it
+// loads; one that fails at any point leaves the repository as it was (no staging folder, the
+// previous install of the same name intact).
+#pragma once
+
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "control/endpoint.hpp"
+#include "domain/domain_store.hpp"
+#include "profile/profile_loader.hpp"
+
+namespace rsca::domain {
+
+struct InstalledApplication {
+  std::string name;
+  std::filesystem::path sad;
+  std::shared_ptr<const profile::ResolvedApplication> profile;
+};
+
+struct InstallFile {
+  std::string path; // relative to the SDR root the profiles came from
+  std::string content;
+};
+
+struct InstallRequest {
+  std::string sad; // the SAD's path among the files
+  std::vector<InstallFile> files;
+  std::optional<std::string> name; // the SAD's name (or id) when not given
+};
+
+class InstalledRepository {
+public:
+  InstalledRepository(std::filesystem::path root, DomainStore &store);
+
+  // Loads what the store says is installed; an application that no longer loads is skipped
+  // with a warning.
+  void load();
+  control::CallResult<InstalledApplication> install(const InstallRequest &request);
+  control::CallResult<void> uninstall(const std::string &name);
+  std::optional<InstalledApplication> find(const std::string &name) const;
+  std::vector<InstalledApplication> list() const;
+
+private:
+  std::filesystem::path applications_dir() const { return root_ / "applications"; }
+  std::filesystem::path staging_dir() const { return root_ / ".staging"; }
+  // The folder an installed application's record places it in: applications/NAME, or NAME for
+  // what an earlier version installed; nothing when the record points elsewhere.
+  std::optional<std::filesystem::path> folder_of(const InstalledRecord &record) const;
+  control::CallResult<std::filesystem::path> stage(const InstallRequest &request) const;
+  control::CallResult<InstalledApplication> replace(const std::string &name,
+                                                    const std::filesystem::path &staged,
+                                                    const std::filesystem::path &sad_in_install);
+
+  std::filesystem::path root_;
+  DomainStore &store_;
+  mutable std::mutex mutex_;
+  std::map<std::string, InstalledApplication> installed_;
+  std::map<std::string, std::filesystem::path> folders_; // where each one's files are
+};
+
+} // namespace rsca::domain
