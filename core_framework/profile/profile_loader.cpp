@@ -63,6 +63,32 @@ const PropertyDefinition *ResolvedSoftPkg::find_property(std::string_view id) co
   return nullptr;
 }
 
+namespace {
+
+void collect_files(const ResolvedSoftPkg &pkg, std::set<std::filesystem::path> &files) {
+  if (!files.insert(pkg.spd_path).second)
+    return;
+  if (pkg.properties)
+    files.insert(pkg.properties->file);
+  if (pkg.scd)
+    files.insert(pkg.scd->file);
+  for (const auto &impl : pkg.implementations) {
+    if (impl.properties)
+      files.insert(impl.properties->file);
+    for (const auto &dep : impl.dependencies)
+      collect_files(*dep.softpkg, files);
+  }
+}
+
+} // namespace
+
+std::set<std::filesystem::path> ResolvedApplication::files() const {
+  std::set<std::filesystem::path> files{sad_path};
+  for (const auto &[id, pkg] : component_files)
+    collect_files(*pkg, files);
+  return files;
+}
+
 const ResolvedSoftPkg *ResolvedApplication::softpkg_of(const ComponentPlacement &placement) const {
   auto it = component_files.find(placement.componentfile_ref);
   return it == component_files.end() ? nullptr : it->second.get();

@@ -52,6 +52,9 @@ struct ResolvedApplication {
   std::vector<Diagnostic> warnings; // wiring findings; a launch treats them as errors
 
   const ResolvedSoftPkg *softpkg_of(const ComponentPlacement &placement) const;
+  // Every profile file the application names: its SAD, and each package's SPD, SCD and PRFs,
+  // softpkg dependencies included (what an install carries to the domain).
+  std::set<std::filesystem::path> files() const;
 };
 
 struct ResolvedDevicePlacement {

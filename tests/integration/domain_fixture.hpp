@@ -186,6 +186,12 @@ public:
     start_domaind(registration_timeout_ms);
   }
 
+  // Kills the domain daemon as a crash would (SIGKILL): it stops nothing and tells nobody.
+  void kill_domaind() {
+    domaind_->signal(SIGKILL);
+    REQUIRE(domaind_->wait_exit(5s).has_value());
+  }
+
   // A domain daemon on this domain's repository.
   void start_domaind(int registration_timeout_ms) {
     domaind_ = std::make_unique<ChildProcess>(

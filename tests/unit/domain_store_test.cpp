@@ -59,3 +59,24 @@ TEST_CASE("a store that cannot be opened is an error naming the file", "[unit][d
   REQUIRE_FALSE(store.has_value());
   CHECK_THAT(store.error().to_string(), Catch::Contains("/proc/rsca-no-such-dir/domain.sqlite"));
 }
+
+TEST_CASE("each start of the domain daemon counts one more incarnation, also after reopening",
+          "[unit][domain-store]") {
+  TemporaryStore temporary;
+  std::uint64_t first = 0;
+  {
+    auto store = DomainStore::open(temporary.file);
+    REQUIRE(store.has_value());
+    auto a = store->next_incarnation();
+    auto b = store->next_incarnation();
+    REQUIRE(a.has_value());
+    REQUIRE(b.has_value());
+    CHECK(*b == *a + 1);
+    first = *a;
+  }
+  auto reopened = DomainStore::open(temporary.file);
+  REQUIRE(reopened.has_value());
+  auto c = reopened->next_incarnation();
+  REQUIRE(c.has_value());
+  CHECK(*c == first + 2);
+}

@@ -33,22 +33,6 @@ std::string read_text(const fs::path &file) {
   return out.str();
 }
 
-// Every file an application needs, as paths relative to its SDR root.
-void collect(const profile::ResolvedSoftPkg &pkg, std::set<fs::path> &files) {
-  if (!files.insert(pkg.spd_path).second)
-    return;
-  if (pkg.properties)
-    files.insert(pkg.properties->file);
-  if (pkg.scd)
-    files.insert(pkg.scd->file);
-  for (const auto &impl : pkg.implementations) {
-    if (impl.properties)
-      files.insert(impl.properties->file);
-    for (const auto &dep : impl.dependencies)
-      collect(*dep.softpkg, files);
-  }
-}
-
 std::optional<fs::path> sdrroot_of(const fs::path &file, const GlobalOptions &global) {
   if (!global.sdrroot.empty())
     return fs::absolute(global.sdrroot);
@@ -70,11 +54,8 @@ Expected<Json> install_request(const fs::path &sad, const GlobalOptions &global,
   auto app = loader.load_application(sad);
   if (!app)
     return tl::unexpected(app.error());
-  std::set<fs::path> files{app->sad_path};
-  for (const auto &[id, pkg] : app->component_files)
-    collect(*pkg, files);
   Json list = Json::array();
-  for (const auto &f : files)
+  for (const auto &f : app->files())
     list.push_back(
         {{"path", fs::path(f).lexically_relative(*root).string()}, {"content", read_text(f)}});
   Json request{{"sad", app->sad_path.lexically_relative(*root).string()}, {"files", list}};

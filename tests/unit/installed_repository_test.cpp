@@ -1,0 +1,183 @@
+// The InstalledRepository: whatever name or path a client sends, it acts only inside its own
+// folder, and an install that fails leaves the repository as it was.
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+#include <catch2/catch.hpp>
+
+#include "domain/installed_repository.hpp"
+
+namespace fs = std::filesystem;
+using rsca::control::Status;
+using rsca::domain::DomainStore;
+using rsca::domain::InstalledRepository;
+using rsca::domain::InstallRequest;
+
+namespace {
+
+const fs::path kTestSdr = fs::path(RSCA_TEST_DATA_DIR) / "integration";
+
+std::string read(const fs::path &file) {
+  std::ifstream in(file, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// The install request the CLI sends for an application of the test SDR root.
+InstallRequest request_for(const std::string &application) {
+  rsca::profile::ProfileLoader loader(kTestSdr);
+  auto app = loader.load_application(kTestSdr / "dom/waveforms" / application /
+                                     (application + ".sad.xml"));
+  REQUIRE(app.has_value());
+  InstallRequest request;
+  request.sad = app->sad_path.lexically_relative(kTestSdr).string();
+  for (const auto &f : app->files())
+    request.files.push_back({f.lexically_relative(kTestSdr).string(), read(f)});
+  return request;
+}
+
+// A folder with a repository (and its store) inside and a victim beside it, removed with it.
+struct Sandbox {
+  fs::path top = fs::temp_directory_path() / ("rsca-repository-test-" + std::to_string(::getpid()) +
+                                              "-" + std::to_string(std::random_device{}()));
+  fs::path root = top / "a/b/repository";
+  fs::path victim = top / "a/victim";
+  std::optional<DomainStore> store;
+  std::optional<InstalledRepository> repository;
+
+  Sandbox() {
+    fs::create_directories(root);
+    fs::create_directories(victim);
+    std::ofstream(victim / "precious") << "keep me";
+    open();
+  }
+  ~Sandbox() {
+    repository.reset();
+    store.reset();
+    std::error_code ignored;
+    fs::remove_all(top, ignored);
+  }
+  Sandbox(const Sandbox &) = delete;
+  Sandbox &operator=(const Sandbox &) = delete;
+
+  void open() {
+    repository.reset();
+    store.reset();
+    auto s = DomainStore::open(root / "domain.sqlite");
+    REQUIRE(s.has_value());
+    store.emplace(std::move(*s));
+    repository.emplace(root, *store);
+    repository->load();
+  }
+  bool victim_intact() const { return read(victim / "precious") == "keep me"; }
+  // Folders or files in the repository other than the store and the installs.
+  std::vector<std::string> leftovers() const {
+    std::vector<std::string> found;
+    if (!fs::exists(root / ".staging"))
+      return found;
+    for (const auto &e : fs::recursive_directory_iterator(root / ".staging")) {
+      found.push_back(e.path().string());
+    }
+    return found;
+  }
+};
+
+} // namespace
+
+TEST_CASE("an install name that is a path is refused and nothing outside the repository changes",
+          "[unit][installed-repository]") {
+  Sandbox box;
+  for (const std::string name : {"../../victim", "../victim", ".", "..", "a/b", ""}) {
+    INFO(name);
+    auto request = request_for("Healthy");
+    request.name = name;
+    auto installed = box.repository->install(request);
+    REQUIRE_FALSE(installed.has_value());
+    CHECK(installed.error().status == Status::BadRequest);
+    CHECK(box.victim_intact());
+    CHECK(fs::exists(box.root / "domain.sqlite"));
+  }
+  CHECK(box.repository->list().empty());
+  for (const std::string name : {"../../victim", "..", "."}) {
+    INFO(name);
+    auto removed = box.repository->uninstall(name);
+    REQUIRE_FALSE(removed.has_value());
+    CHECK(removed.error().status == Status::BadRequest);
+    CHECK(box.victim_intact());
+    CHECK(fs::exists(box.root / "domain.sqlite"));
+  }
+}
+
+TEST_CASE("an install goes into a folder of its own and its uninstall removes only that",
+          "[unit][installed-repository]") {
+  Sandbox box;
+  auto request = request_for("Healthy");
+  request.name = "domain.sqlite"; // a name like the store's file cannot reach it
+  auto installed = box.repository->install(request);
+  REQUIRE(installed.has_value());
+  CHECK(fs::exists(box.root / "applications/domain.sqlite" / request.sad));
+  REQUIRE(box.repository->uninstall("domain.sqlite").has_value());
+  CHECK_FALSE(fs::exists(box.root / "applications/domain.sqlite"));
+  CHECK(fs::is_regular_file(box.root / "domain.sqlite"));
+  box.open(); // the store still works and no longer lists it
+  CHECK(box.repository->list().empty());
+}
+
+TEST_CASE("a failed install leaves no staging copy and keeps what was installed under its name",
+          "[unit][installed-repository]") {
+  Sandbox box;
+  auto good = request_for("Healthy");
+  REQUIRE(box.repository->install(good).has_value());
+  const auto before = box.repository->find("Healthy");
+  REQUIRE(before.has_value());
+
+  SECTION("a profile that does not load") {
+    auto broken = good;
+    for (auto &f : broken.files)
+      if (f.path == broken.sad)
+        f.content = "<softwareassembly";
+    auto installed = box.repository->install(broken);
+    REQUIRE_FALSE(installed.has_value());
+    CHECK(installed.error().status == Status::BadRequest);
+  }
+  SECTION("a file outside the SDR root") {
+    auto outside = good;
+    outside.files.push_back({"../../escape.xml", "x"});
+    auto installed = box.repository->install(outside);
+    REQUIRE_FALSE(installed.has_value());
+    CHECK_FALSE(fs::exists(box.root.parent_path() / "escape.xml"));
+  }
+  SECTION("a SAD whose name is 7 MB long") {
+    auto huge = good;
+    const std::string name(7 * 1024 * 1024, 'n');
+    for (auto &f : huge.files)
+      if (f.path == huge.sad) {
+        const auto at = f.content.find("name=\"Healthy\"");
+        REQUIRE(at != std::string::npos);
+        f.content.replace(at, 14, "name=\"" + name + "\"");
+      }
+    auto installed = box.repository->install(huge);
+    REQUIRE_FALSE(installed.has_value());
+    CHECK(installed.error().message.size() < 4096); // a bounded excerpt, not the name
+  }
+  CHECK(box.leftovers().empty());
+  auto after = box.repository->find("Healthy");
+  REQUIRE(after.has_value());
+  CHECK(fs::exists(after->sad));
+  box.open(); // and after a restart
+  CHECK(box.repository->find("Healthy").has_value());
+}
+
+TEST_CASE("a store record that points outside the repository is skipped, never acted on",
+          "[unit][installed-repository]") {
+  Sandbox box;
+  // As a vulnerable version could have recorded it.
+  REQUIRE(box.store->put_installed({"../../victim", "../../victim/x.sad.xml"}).has_value());
+  REQUIRE(box.store->put_installed({"victim", "../victim/x.sad.xml"}).has_value());
+  box.open();
+  CHECK(box.repository->list().empty());
+  CHECK(box.repository->uninstall("victim").error().status == Status::NotFound);
+  CHECK(box.victim_intact());
+}
