@@ -301,6 +301,11 @@ TEST_CASE("a connection naming no componentinstantiation", "[malformed][dangling
   CHECK_THAT(d.message, Contains("which this file does not define"));
 }
 
+TEST_CASE("an application name that is a path", "[malformed][value]") {
+  single_file_error(fixture("value/application_name_path.sad.xml"), "application-name", 4, 39,
+                    {"application name \"../../victim\" is not a name", "'.'"});
+}
+
 TEST_CASE("an assemblycontroller naming no componentinstantiation", "[malformed][dangling]") {
   single_file_error(fixture("dangling/assemblycontroller.sad.xml"), "dangling-ref", 16, 49,
                     {"assemblycontroller names componentinstantiation \"ghost_1\"",
