@@ -10,6 +10,7 @@
 #pragma once
 
 #include <chrono>
+#include <cstdint>
 #include <map>
 #include <optional>
 #include <string>
@@ -97,10 +98,16 @@ struct Placement {
   std::vector<UsedDevice> used_devices;
 };
 
+// Names one reservation of the ResourceAllocator (one allocate); 0 names none.
+using AllocationId = std::uint64_t;
+
 struct Plan {
   std::vector<Placement> placements;
   std::vector<UsedDevice> application_devices; // the SAD's own usesdevice
   std::vector<std::string> notes;              // what was not checked, and why
+  // The reservation this plan was committed as by ResourceAllocator::allocate; 0 for a plan
+  // that reserved nothing (make_plan, ResourceAllocator::plan).
+  AllocationId allocation = 0;
 };
 
 // Why a request could not be placed: per component, each device and what failed there.

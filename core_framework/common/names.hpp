@@ -1,27 +1,31 @@
-// Names that become parts of paths, control addresses and DDS partitions: an application's
-// (installed or running), a component's, a port's, a device's, a node's. A name is one component
-// of such a path, never a path itself, so that no name that reaches the domain (from a profile or
-// from the network) can make it act outside what it owns.
+// The rule for names that travel in requests and become parts of addresses, topics and paths
+// (applications, components, ports, nodes, devices, connection ids), and bounded excerpts of
+// untrusted text for messages. A request from the network is untrusted: a name is checked before
+// it is used or kept, and an error quotes at most an excerpt of what it got.
 #pragma once
 
 #include <cstddef>
 #include <string>
 #include <string_view>
 
-#include <tl/expected.hpp>
+#include "common/diagnostic.hpp"
 
 namespace rsca {
 
-// Long enough for any real name, short enough to be a file name on every Linux file system.
+// The longest name, in bytes (a file name's limit on Linux).
 inline constexpr std::size_t kMaxNameLength = 255;
+// The longest excerpt of untrusted text a message quotes, in bytes.
+inline constexpr std::size_t kExcerptLength = 40;
 
-// Why `name` is not a name, or nothing: empty, longer than kMaxNameLength bytes, "." or "..",
-// starting with "." (the domain's own files), or holding a path separator ('/', '\') or a
-// control character. `what` says what it names ("application name").
-tl::expected<void, std::string> check_name(std::string_view what, std::string_view name);
+// Whether `name` can be a name: not empty, at most kMaxNameLength bytes, not "." or "..", not
+// starting with '.' (the domain's own files, e.g. its staging folder), no '/' or '\' (the
+// separators of APP/COMPONENT and of paths) and no control characters: a name is one component of
+// a path or an address, never a path. `what` names it in the message ("the application", "the
+// port"). The rule is "name"; the location is `what`.
+Expected<void> check_name(std::string_view what, std::string_view name);
 
-// At most `max` characters of `text` for a message, marked where it was cut: an error quotes
-// what it got without quoting megabytes of it.
-std::string excerpt(std::string_view text, std::size_t max = 64);
+// `text` for a message: at most `max` bytes, control characters as \xNN, and when cut, "..." and
+// how long it was. Never splits a UTF-8 sequence.
+std::string excerpt(std::string_view text, std::size_t max = kExcerptLength);
 
 } // namespace rsca

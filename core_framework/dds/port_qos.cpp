@@ -5,6 +5,9 @@
 
 #include <fmt/format.h>
 
+#include "common/names.hpp"
+#include "profile/connection_qos.hpp"
+
 namespace rsca::dds {
 namespace {
 
@@ -19,9 +22,16 @@ using profile::Reliability;
 constexpr const char *kInfinite = "infinite";
 constexpr dds_duration_t kMaxBlockingTime = DDS_MSECS(100);
 
-constexpr std::array kKeys{"reliability", "durability",       "history",           "depth",
-                           "deadline_ns", "latencybudget_ns", "transportpriority", "liveliness",
-                           "lease_ns",    "ownership",        "strength"};
+// The wire's names of the durations, in whole nanoseconds (qos_to_json), beside the SAD's.
+struct NanosecondKey {
+  const char *wire;
+  const char *sad;
+  std::optional<Duration> ConnectionQos::*field;
+};
+constexpr std::array<NanosecondKey, 3> kNanosecondKeys{
+    {{"deadline_ns", "deadline", &ConnectionQos::deadline},
+     {"latencybudget_ns", "latencybudget", &ConnectionQos::latency_budget},
+     {"lease_ns", "lease", &ConnectionQos::lease}}};
 
 tl::unexpected<Error> qos_error(std::string message) {
   return make_error({"qos", 0, 0}, "qos", std::move(message));
@@ -63,17 +73,6 @@ Json duration_json(const Duration &duration) {
   return duration.value->count();
 }
 
-template <typename E, std::size_t N>
-Expected<E> enum_from_json(const Json &json, const char *key, const std::array<E, N> &values) {
-  std::string names;
-  for (E v : values) {
-    if (json.is_string() && json.get_ref<const std::string &>() == profile::to_string(v))
-      return v;
-    names += (names.empty() ? "" : ", ") + std::string(profile::to_string(v));
-  }
-  return qos_error(fmt::format("\"{}\" is {}, not one of {}", key, json.dump(), names));
-}
-
 Expected<Duration> duration_from_json(const Json &json, const char *key) {
   if (json.is_string() && json.get_ref<const std::string &>() == kInfinite)
     return Duration{};
@@ -81,101 +80,52 @@ Expected<Duration> duration_from_json(const Json &json, const char *key) {
       !(json.is_number_unsigned() &&
         json.get<std::uint64_t>() > std::uint64_t(std::numeric_limits<std::int64_t>::max())))
     return Duration{std::chrono::nanoseconds(json.get<std::int64_t>())};
-  return qos_error(
-      fmt::format("\"{}\" is {}, not whole nanoseconds or \"infinite\"", key, json.dump()));
+  return qos_error(fmt::format("\"{}\" is {}, not whole nanoseconds or \"infinite\"", key,
+                               excerpt(json.dump())));
 }
 
-// Whether an integer JSON number (received numbers >= 0 are unsigned) lies in [min, max].
-bool within(const Json &json, std::int64_t min, std::int64_t max) {
-  if (json.is_number_unsigned()) {
-    const auto value = json.get<std::uint64_t>();
-    return value <= static_cast<std::uint64_t>(max) &&
-           (min <= 0 || value >= static_cast<std::uint64_t>(min));
-  }
-  const auto value = json.get<std::int64_t>();
-  return value >= min && value <= max;
+// A SAD attribute's value as text: a string as it is, anything else as JSON writes it (rsca
+// connect sends numbers as numbers).
+std::string text_of(const Json &value) {
+  return value.is_string() ? value.get<std::string>() : value.dump();
 }
 
-template <typename T>
-Expected<T> integer_from_json(const Json &json, const char *key, T min) {
-  constexpr T kMax = std::numeric_limits<T>::max();
-  if (json.is_number_integer() && within(json, min, kMax))
-    return json.get<T>();
-  return qos_error(
-      fmt::format("\"{}\" is {}, not an integer from {} to {}", key, json.dump(), min, kMax));
-}
-
-Expected<void> check_keys(const Json &json) {
-  if (!json.is_object())
-    return qos_error(fmt::format("the QoS is {}, not an object", json.dump()));
-  for (const auto &[key, value] : json.items()) {
-    bool known = false;
-    for (const char *k : kKeys)
-      known = known || key == k;
-    if (!known)
-      return qos_error(fmt::format("unknown QoS \"{}\"", key));
-  }
+// `key`, a SAD <qos> attribute, by the SAD's own parser (profile/connection_qos.hpp).
+Expected<void> read_attribute(ConnectionQos &qos, const std::string &key, const Json &value) {
+  if (auto set = profile::set_qos_attribute(qos, key, text_of(value)); !set)
+    return qos_error(fmt::format("\"{}\" is {}, {}", key, excerpt(value.dump()), set.error()));
   return {};
 }
 
-// Reads `key` into `field` when present: `parse` gives the value or the error.
-template <typename T, typename Parse>
-Expected<void> read(const Json &json, const char *key, std::optional<T> &field, Parse parse) {
-  auto it = json.find(key);
-  if (it == json.end())
+// `key`, a duration in whole nanoseconds (the wire's form), into the field its SAD name names.
+Expected<void> read_nanoseconds(ConnectionQos &qos, const std::string &key, const Json &value,
+                                const Json &json) {
+  for (const auto &k : kNanosecondKeys) {
+    if (key != k.wire)
+      continue;
+    if (json.contains(k.sad))
+      return qos_error(fmt::format("give \"{}\" or \"{}\", not both", k.sad, k.wire));
+    auto duration = duration_from_json(value, k.wire);
+    if (!duration)
+      return tl::unexpected(duration.error());
+    qos.*k.field = *duration;
     return {};
-  Expected<T> value = parse(*it, key);
-  if (!value)
-    return tl::unexpected(value.error());
-  field = *value;
-  return {};
+  }
+  return qos_error(fmt::format("unknown QoS \"{}\"", excerpt(key)));
 }
 
+// The SAD's names and values ("deadline": "100ms"), and the wire's durations in nanoseconds
+// ("deadline_ns": 100000000); unknown keys are refused.
 Expected<ConnectionQos> parse(const Json &json) {
+  if (!json.is_object())
+    return qos_error(fmt::format("the QoS is {}, not an object", excerpt(json.dump())));
   ConnectionQos qos;
-  auto reliability = [](const Json &j, const char *k) {
-    return enum_from_json(j, k, std::array{Reliability::BestEffort, Reliability::Reliable});
-  };
-  auto durability = [](const Json &j, const char *k) {
-    return enum_from_json(j, k,
-                          std::array{Durability::Volatile, Durability::TransientLocal,
-                                     Durability::Transient, Durability::Persistent});
-  };
-  auto history = [](const Json &j, const char *k) {
-    return enum_from_json(j, k, std::array{History::KeepLast, History::KeepAll});
-  };
-  auto liveliness = [](const Json &j, const char *k) {
-    return enum_from_json(j, k,
-                          std::array{Liveliness::Automatic, Liveliness::ManualByParticipant,
-                                     Liveliness::ManualByTopic});
-  };
-  auto ownership = [](const Json &j, const char *k) {
-    return enum_from_json(j, k, std::array{Ownership::Shared, Ownership::Exclusive});
-  };
-  auto depth = [](const Json &j, const char *k) {
-    return integer_from_json<std::int32_t>(j, k, 1).map(
-        [](std::int32_t v) { return static_cast<std::uint32_t>(v); });
-  };
-  auto int32 = [](const Json &j, const char *k) {
-    return integer_from_json<std::int32_t>(j, k, std::numeric_limits<std::int32_t>::min());
-  };
-  auto ok =
-      check_keys(json)
-          .and_then([&] { return read(json, "reliability", qos.reliability, reliability); })
-          .and_then([&] { return read(json, "durability", qos.durability, durability); })
-          .and_then([&] { return read(json, "history", qos.history, history); })
-          .and_then([&] { return read(json, "depth", qos.depth, depth); })
-          .and_then([&] { return read(json, "deadline_ns", qos.deadline, duration_from_json); })
-          .and_then([&] {
-            return read(json, "latencybudget_ns", qos.latency_budget, duration_from_json);
-          })
-          .and_then([&] { return read(json, "transportpriority", qos.transport_priority, int32); })
-          .and_then([&] { return read(json, "liveliness", qos.liveliness, liveliness); })
-          .and_then([&] { return read(json, "lease_ns", qos.lease, duration_from_json); })
-          .and_then([&] { return read(json, "ownership", qos.ownership, ownership); })
-          .and_then([&] { return read(json, "strength", qos.strength, int32); });
-  if (!ok)
-    return tl::unexpected(ok.error());
+  for (const auto &[key, value] : json.items()) {
+    auto ok = profile::is_qos_attribute(key) ? read_attribute(qos, key, value)
+                                             : read_nanoseconds(qos, key, value, json);
+    if (!ok)
+      return tl::unexpected(ok.error());
+  }
   return with_defaults(std::move(qos));
 }
 

@@ -26,7 +26,11 @@ inline constexpr std::uint32_t kDefaultDepth = 16;
 
 nlohmann::json qos_to_json(const profile::ConnectionQos &qos);
 
-// The connection QoS `json` describes, every field set (absent keys take the defaults).
+// The connection QoS `json` describes, every field set (absent keys take the defaults). Keys are
+// the SAD's <qos> attributes with their values as the SAD gives them ("deadline": "100ms",
+// "depth": 4 or "4"; one parser, profile/connection_qos.hpp), or the durations in whole
+// nanoseconds as above ("deadline_ns"). Unknown keys and bad values are errors naming the key and
+// quoting at most an excerpt of the value.
 Expected<profile::ConnectionQos> connection_qos_from_json(const nlohmann::json &json);
 
 // Why a writer with QoS `offered` and a reader with QoS `requested` would never match under

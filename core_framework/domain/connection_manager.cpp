@@ -4,6 +4,7 @@
 #include <spdlog/spdlog.h>
 
 #include "common/dds_names.hpp"
+#include "common/names.hpp"
 #include "dds/port_qos.hpp"
 
 namespace rsca::domain {
@@ -22,6 +23,50 @@ std::string PortRef::to_string() const {
   }
   return owner + "." + port;
 }
+
+namespace {
+
+// Every name of an end can be a name (common/names.hpp): an end that breaks the rule can never
+// exist, so it is refused at once instead of being kept pending. Checked here, the one path of
+// every runtime connection (made, retried and restored), because the request is untrusted.
+CallResult<void> check_end(const PortRef &end, const char *which) {
+  auto refused = [which](const Error &error) {
+    return control::call_error(Status::BadRequest,
+                               fmt::format("{} end: {}", which, error.diagnostics()[0].message));
+  };
+  Expected<void> ok;
+  if (end.kind == PortRef::Kind::Device) {
+    const auto colon = end.owner.find(':');
+    if (colon == std::string::npos)
+      return control::call_error(
+          Status::BadRequest,
+          fmt::format("{} end: the device \"{}\" is not NODE:DEVICE", which, excerpt(end.owner)));
+    ok = check_name("the node", std::string_view(end.owner).substr(0, colon)).and_then([&] {
+      return check_name("the device", std::string_view(end.owner).substr(colon + 1));
+    });
+  } else {
+    ok = check_name("the application", end.owner).and_then([&]() -> Expected<void> {
+      if (end.kind == PortRef::Kind::Component)
+        return check_name("the component", end.component);
+      return {};
+    });
+  }
+  ok = ok.and_then([&] { return check_name("the port", end.port); });
+  if (!ok)
+    return refused(ok.error());
+  return {};
+}
+
+// The ends and the id a connection request gives, before anything is made or kept.
+CallResult<void> check_request(const PortRef &uses, const PortRef &provides,
+                               const std::string &id) {
+  if (!id.empty())
+    if (auto ok = check_name("the connection id", id); !ok)
+      return control::call_error(Status::BadRequest, ok.error().diagnostics()[0].message);
+  return check_end(uses, "uses").and_then([&] { return check_end(provides, "provides"); });
+}
+
+} // namespace
 
 ConnectionManager::ConnectionManager(std::string domain,
                                      const std::unique_ptr<control::Endpoint> &endpoint,
@@ -90,6 +135,8 @@ void ConnectionManager::unwire_end(const RuntimeConnection &c, const ResolvedEnd
 CallResult<RuntimeConnection> ConnectionManager::connect(const PortRef &uses,
                                                          const PortRef &provides, std::string id,
                                                          const Json &qos_json) {
+  if (auto ok = check_request(uses, provides, id); !ok)
+    return tl::unexpected(ok.error());
   auto qos = dds::connection_qos_from_json(qos_json);
   if (!qos)
     return control::call_error(Status::BadRequest, qos.error().to_string());

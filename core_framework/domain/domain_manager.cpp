@@ -237,8 +237,8 @@ CallResult<Json> DomainManager::Impl::create_application(const Json &body) {
                                                                     : placement.error())
                                                        .message);
   if (*wanted)
-    if (auto named = check_name("application name", **wanted); !named)
-      return control::call_error(Status::BadRequest, named.error());
+    if (auto named = check_name("the application", **wanted); !named)
+      return control::call_error(Status::BadRequest, named.error().diagnostics().front().message);
   LaunchRequest request;
   {
     std::lock_guard lock(installs);

@@ -91,6 +91,13 @@ CallResult<void> write_files(const fs::path &dir, const std::vector<InstallFile>
   return {};
 }
 
+// A name a client sent, checked: BadRequest when it is not a name.
+CallResult<void> checked_name(const std::string &name) {
+  if (auto named = check_name("the application", name); !named)
+    return control::call_error(Status::BadRequest, named.error().diagnostics().front().message);
+  return {};
+}
+
 // The application's components then start from their runtime models, without reading XML; a
 // component without one still starts, reading its profile (profile/runtime_model.hpp).
 void write_runtime_models(const profile::ResolvedApplication &app) {
@@ -106,7 +113,7 @@ InstalledRepository::InstalledRepository(fs::path root, DomainStore &store)
     : root_(std::move(root)), store_(store) {}
 
 std::optional<fs::path> InstalledRepository::folder_of(const InstalledRecord &record) const {
-  if (!check_name("installed application", record.name))
+  if (!check_name("the installed application", record.name))
     return std::nullopt;
   const fs::path sad = fs::path(record.sad).lexically_normal();
   auto part = sad.begin();
@@ -157,8 +164,8 @@ CallResult<InstalledApplication> InstalledRepository::install(const InstallReque
         Status::BadRequest,
         fmt::format("the SAD's path \"{}\" is not inside an SDR root", excerpt(request.sad)));
   if (request.name)
-    if (auto named = check_name("application name", *request.name); !named)
-      return control::call_error(Status::BadRequest, named.error());
+    if (auto named = checked_name(*request.name); !named)
+      return tl::unexpected(named.error());
   // Written and loaded aside first: only an install that loads replaces anything.
   ScopedFolder staging(root_, staging_dir() / unique_name("install"));
   if (auto written = write_files(staging.path(), request.files); !written)
@@ -169,8 +176,8 @@ CallResult<InstalledApplication> InstalledRepository::install(const InstallReque
     return control::call_error(Status::BadRequest, app.error().to_string());
   const std::string name =
       request.name.value_or(app->sad->name.empty() ? app->sad->id : app->sad->name);
-  if (auto named = check_name("application name", name); !named)
-    return control::call_error(Status::BadRequest, named.error());
+  if (auto named = checked_name(name); !named)
+    return tl::unexpected(named.error());
   std::lock_guard lock(mutex_);
   auto installed = replace(name, staging.path(), *sad);
   if (installed)
@@ -226,8 +233,8 @@ CallResult<InstalledApplication> InstalledRepository::replace(const std::string 
 }
 
 CallResult<void> InstalledRepository::uninstall(const std::string &name) {
-  if (auto named = check_name("application name", name); !named)
-    return control::call_error(Status::BadRequest, named.error());
+  if (auto named = checked_name(name); !named)
+    return tl::unexpected(named.error());
   std::lock_guard lock(mutex_);
   auto it = installed_.find(name);
   if (it == installed_.end())

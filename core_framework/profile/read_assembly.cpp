@@ -5,6 +5,7 @@
 #include <fmt/ranges.h>
 
 #include "common/content_filter.hpp"
+#include "profile/connection_qos.hpp"
 #include "profile/read_context.hpp"
 
 namespace rsca::profile::detail {
@@ -33,21 +34,6 @@ tl::expected<Int, std::string> parse_int(std::string_view text) {
   return value;
 }
 
-constexpr std::pair<std::string_view, Reliability> kReliability[] = {
-    {"besteffort", Reliability::BestEffort}, {"reliable", Reliability::Reliable}};
-constexpr std::pair<std::string_view, Durability> kDurability[] = {
-    {"volatile", Durability::Volatile},
-    {"transientlocal", Durability::TransientLocal},
-    {"transient", Durability::Transient},
-    {"persistent", Durability::Persistent}};
-constexpr std::pair<std::string_view, History> kHistory[] = {{"keeplast", History::KeepLast},
-                                                             {"keepall", History::KeepAll}};
-constexpr std::pair<std::string_view, Liveliness> kLiveliness[] = {
-    {"automatic", Liveliness::Automatic},
-    {"manualbyparticipant", Liveliness::ManualByParticipant},
-    {"manualbytopic", Liveliness::ManualByTopic}};
-constexpr std::pair<std::string_view, Ownership> kOwnership[] = {
-    {"shared", Ownership::Shared}, {"exclusive", Ownership::Exclusive}};
 constexpr std::pair<std::string_view, Criticality> kCriticality[] = {
     {"low", Criticality::Low},
     {"medium", Criticality::Medium},
@@ -119,24 +105,17 @@ EndpointTarget read_target(ReadContext &ctx, const XmlElement &end) {
   return target;
 }
 
+// Every attribute by the one parser of QoS values (profile/connection_qos.hpp), which
+// `rsca connect --qos` shares.
 ConnectionQos read_qos(ReadContext &ctx, const XmlElement &e) {
   ConnectionQos qos;
   qos.where = ctx.at(e);
-  qos.reliability = enum_attr(ctx, e, "reliability", kReliability);
-  qos.durability = enum_attr(ctx, e, "durability", kDurability);
-  qos.history = enum_attr(ctx, e, "history", kHistory);
-  qos.depth = ctx.optional_attr(e, "depth", parse_int<std::uint32_t>);
-  qos.deadline = ctx.duration_attr(e, "deadline");
-  qos.latency_budget = ctx.duration_attr(e, "latencybudget");
-  qos.transport_priority = ctx.optional_attr(e, "transportpriority", parse_int<std::int32_t>);
-  qos.liveliness = enum_attr(ctx, e, "liveliness", kLiveliness);
-  qos.lease = ctx.duration_attr(e, "lease");
-  qos.ownership = enum_attr(ctx, e, "ownership", kOwnership);
-  qos.strength = ctx.optional_attr(e, "strength", parse_int<std::int32_t>);
-  if (qos.depth && qos.history == History::KeepAll)
-    ctx.fail(e, "qos", "depth applies only to history=\"keeplast\", not to keepall");
-  if (qos.strength && qos.ownership != Ownership::Exclusive)
-    ctx.fail(e, "qos", "strength applies only to ownership=\"exclusive\"");
+  for (std::string_view name : kQosAttributes)
+    if (const std::string *text = e.attribute(name))
+      if (auto set = set_qos_attribute(qos, name, *text); !set)
+        ctx.fail(e, "value", fmt::format("attribute {}: \"{}\" is {}", name, *text, set.error()));
+  if (auto why = qos_inconsistency(qos))
+    ctx.fail(e, "qos", *why);
   return qos;
 }
 

@@ -114,8 +114,8 @@ Expected<SoftwareAssembly> read_sad(const XmlDocument &document) {
   sad.version = root.attr("version");
   // The name the application is installed and runs under (the id when it has none) becomes a
   // folder of the domain's repository and part of control addresses: it must be a name.
-  if (auto named = check_name("application name", sad.name.empty() ? sad.id : sad.name); !named)
-    ctx.fail(root, "application-name", named.error());
+  if (auto named = check_name("the application", sad.name.empty() ? sad.id : sad.name); !named)
+    ctx.fail(root, "application-name", named.error().diagnostics().front().message);
   sad.description = root.child_text("description");
   sad.component_files = detail::read_component_files(ctx, root.child("componentfiles"));
   for (const auto &c : root.children) {

@@ -303,7 +303,7 @@ TEST_CASE("a connection naming no componentinstantiation", "[malformed][dangling
 
 TEST_CASE("an application name that is a path", "[malformed][value]") {
   single_file_error(fixture("value/application_name_path.sad.xml"), "application-name", 4, 39,
-                    {"application name \"../../victim\" is not a name", "'.'"});
+                    {"the application \"../../victim\" is not a name", "'.'"});
 }
 
 TEST_CASE("an assemblycontroller naming no componentinstantiation", "[malformed][dangling]") {

@@ -70,7 +70,7 @@ int install(const std::string &sad, const std::string &name, const GlobalOptions
             std::string *installed_name) {
   if (!name.empty())
     if (auto named = check_name("--name", name); !named) {
-      fmt::print(stderr, "rsca install: {}\n", named.error());
+      fmt::print(stderr, "rsca install: {}\n", named.error().diagnostics().front().message);
       return kUsage;
     }
   auto request = install_request(sad, global, name);

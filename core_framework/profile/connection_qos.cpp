@@ -1,0 +1,97 @@
+#include "profile/connection_qos.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <limits>
+
+#include <fmt/format.h>
+
+namespace rsca::profile {
+namespace {
+
+using Result = tl::expected<void, std::string>;
+
+// `text` as one of `values`, by their names in the model (profile::to_string).
+template <typename E, std::size_t N>
+Result set_enum(std::optional<E> &field, std::string_view text, const std::array<E, N> &values) {
+  for (E v : values)
+    if (text == to_string(v)) {
+      field = v;
+      return {};
+    }
+  std::string names;
+  for (E v : values)
+    names += (names.empty() ? "" : ", ") + std::string(to_string(v));
+  return tl::unexpected(fmt::format("not one of {}", names));
+}
+
+// `text` as an integer from `min` to the largest Int (xs:int for transportpriority and strength;
+// xs:positiveInteger for depth, bounded by what DDS takes: an int32).
+template <typename Int, typename Field>
+Result set_integer(std::optional<Field> &field, std::string_view text, Int min) {
+  constexpr Int kMax = std::numeric_limits<Int>::max();
+  Int value{};
+  auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (ec != std::errc() || end != text.data() + text.size() || value < min)
+    return tl::unexpected(fmt::format("not an integer from {} to {}", min, kMax));
+  field = static_cast<Field>(value);
+  return {};
+}
+
+Result set_duration(std::optional<Duration> &field, std::string_view text) {
+  auto duration = parse_duration(text);
+  if (!duration)
+    return tl::unexpected(std::string(
+        "not a duration such as 100ms, 1.5s or infinite (units ns, us, ms, s; at most about 292 "
+        "years)"));
+  field = *duration;
+  return {};
+}
+
+} // namespace
+
+bool is_qos_attribute(std::string_view name) {
+  return std::find(kQosAttributes.begin(), kQosAttributes.end(), name) != kQosAttributes.end();
+}
+
+Result set_qos_attribute(ConnectionQos &qos, std::string_view name, std::string_view text) {
+  constexpr auto kInt32Min = std::numeric_limits<std::int32_t>::min();
+  if (name == "reliability")
+    return set_enum(qos.reliability, text,
+                    std::array{Reliability::BestEffort, Reliability::Reliable});
+  if (name == "durability")
+    return set_enum(qos.durability, text,
+                    std::array{Durability::Volatile, Durability::TransientLocal,
+                               Durability::Transient, Durability::Persistent});
+  if (name == "history")
+    return set_enum(qos.history, text, std::array{History::KeepLast, History::KeepAll});
+  if (name == "depth")
+    return set_integer<std::int32_t>(qos.depth, text, 1);
+  if (name == "deadline")
+    return set_duration(qos.deadline, text);
+  if (name == "latencybudget")
+    return set_duration(qos.latency_budget, text);
+  if (name == "transportpriority")
+    return set_integer<std::int32_t>(qos.transport_priority, text, kInt32Min);
+  if (name == "liveliness")
+    return set_enum(qos.liveliness, text,
+                    std::array{Liveliness::Automatic, Liveliness::ManualByParticipant,
+                               Liveliness::ManualByTopic});
+  if (name == "lease")
+    return set_duration(qos.lease, text);
+  if (name == "ownership")
+    return set_enum(qos.ownership, text, std::array{Ownership::Shared, Ownership::Exclusive});
+  if (name == "strength")
+    return set_integer<std::int32_t>(qos.strength, text, kInt32Min);
+  return tl::unexpected(std::string("not a QoS attribute"));
+}
+
+std::optional<std::string> qos_inconsistency(const ConnectionQos &qos) {
+  if (qos.depth && qos.history == History::KeepAll)
+    return "depth applies only to history=\"keeplast\", not to keepall";
+  if (qos.strength && qos.ownership != Ownership::Exclusive)
+    return "strength applies only to ownership=\"exclusive\"";
+  return std::nullopt;
+}
+
+} // namespace rsca::profile

@@ -1,0 +1,35 @@
+// The one parser of a connection's QoS values: each attribute of a SAD connection's <qos> (rsca
+// extension, docs/profiles.md) from its text. The SAD reader reads <qos> with it, and the domain
+// reads the QoS of `rsca connect --qos` with it (dds::connection_qos_from_json), so that both
+// take the same names and values ("reliability=besteffort", "depth=4", "deadline=100ms").
+#pragma once
+
+#include <array>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include <tl/expected.hpp>
+
+#include "profile/assembly.hpp"
+
+namespace rsca::profile {
+
+// The attribute names, in the schema's order.
+inline constexpr std::array<std::string_view, 11> kQosAttributes{
+    "reliability",       "durability", "history", "depth",     "deadline", "latencybudget",
+    "transportpriority", "liveliness", "lease",   "ownership", "strength"};
+
+bool is_qos_attribute(std::string_view name);
+
+// Sets the field of `qos` that attribute `name` names from its `text`. An error says what is
+// wrong with the value, to follow `is "<text>", ` ("not one of besteffort, reliable"); it
+// never quotes the text.
+tl::expected<void, std::string> set_qos_attribute(ConnectionQos &qos, std::string_view name,
+                                                  std::string_view text);
+
+// Values that make no sense together whatever they are: a depth with keepall, a strength
+// without exclusive ownership.
+std::optional<std::string> qos_inconsistency(const ConnectionQos &qos);
+
+} // namespace rsca::profile
