@@ -5,6 +5,7 @@
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 
+#include "common/daemon_heap.hpp"
 #include "common/process_priority.hpp"
 #include "common/termination_signals.hpp"
 #include "dds/participant.hpp"
@@ -27,6 +28,8 @@ std::filesystem::path own_folder() {
 int main(int argc, char **argv) {
   const int nice = rsca::run_above_applications(); // before any thread exists
   rsca::TerminationSignals signals;                // before any thread exists
+  rsca::bound_daemon_heap();
+  const rsca::HeapTrimmer heap_trimmer; // a thread: after the signals are blocked
   CLI::App app{"rsca-noded — an rsca node daemon (DeviceManager)"};
   rsca::node::NodeOptions options;
   std::string dcd, sdrroot, level = "info";

@@ -8,6 +8,7 @@
 #include <map>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <thread>
 #include <vector>
 
@@ -15,6 +16,7 @@
 #include <spdlog/spdlog.h>
 
 #include "control.h" // generated from dds/control.idl
+#include "control/partition_writers.hpp"
 
 namespace rsca::control {
 
@@ -47,6 +49,8 @@ constexpr const char *kRequestTopic = "rsca_ctl_Request";
 constexpr const char *kReplyTopic = "rsca_ctl_Reply";
 constexpr const char *kAnnouncementTopic = "rsca_ctl_Announcement";
 constexpr std::uint32_t kTakeBatch = 64;
+// How often the receive thread looks, while calls are under way, for addressees that left DDS.
+constexpr auto kDepartureCheck = std::chrono::milliseconds(200);
 
 // A fixed set of threads running queued tasks in order of arrival.
 class WorkerPool {
@@ -148,12 +152,6 @@ CallResult<Json> run_handler(const Handler &handler, const Json &body,
   }
 }
 
-// A writer into one partition, with the publisher that carries the partition.
-struct PartitionWriter {
-  Entity publisher;
-  Entity writer;
-};
-
 Json parse_body(const char *text) {
   if (text == nullptr || *text == '\0')
     return Json::object();
@@ -184,10 +182,12 @@ struct Endpoint::Impl {
   Entity request_reader, reply_reader, announcement_reader;
   Entity waitset, guard;
   Entity announcement_writer;
+  std::mutex announcement_mutex; // guards announcement_writer
 
-  std::mutex writers_mutex;
-  std::map<std::string, PartitionWriter> request_writers, reply_writers;
+  std::unique_ptr<PartitionWriters> request_ways, reply_ways;
+  std::mutex routes_mutex;
   std::map<std::string, std::string> routes; // target → the endpoint that serves it
+  Clock::time_point departures_checked;      // receive thread only
 
   std::mutex state_mutex;
   std::map<std::pair<std::string, std::string>, Handler> handlers; // (address or "", operation)
@@ -209,6 +209,7 @@ struct Endpoint::Impl {
   void take_replies();
   void take_announcements();
   void expire_calls();
+  void fail_calls_to_departed();
   void serve(RequestContext context, Json body);
   CallResult<Json> dispatch(const RequestContext &context, const Json &body);
   CallResult<Json> run_batch(const RequestContext &context, const Json &body);
@@ -217,13 +218,6 @@ struct Endpoint::Impl {
   void withdraw(const std::string &as);
   void send_request(std::string id, std::string target, std::string operation, std::string body);
   void complete(const std::string &id, CallResult<Json> result);
-  // The writer into `partition`, created when there is none yet.
-  CallResult<dds_entity_t> writer_for(std::map<std::string, PartitionWriter> &cache,
-                                      dds_entity_t topic, const std::string &partition);
-  // The same, once a reader in that partition is matched (or an error at the deadline).
-  CallResult<dds_entity_t> writer_to(std::map<std::string, PartitionWriter> &cache,
-                                     dds_entity_t topic, const std::string &partition,
-                                     Clock::time_point deadline);
   void wake() { dds_set_guardcondition(guard.get(), true); }
 };
 
@@ -272,6 +266,8 @@ Expected<void> Endpoint::Impl::create_entities() {
           });
   if (!ok)
     return ok;
+  request_ways = std::make_unique<PartitionWriters>(pp, request_topic.get(), qos.get());
+  reply_ways = std::make_unique<PartitionWriters>(pp, reply_topic.get(), qos.get());
   dds_set_status_mask(request_reader.get(), DDS_DATA_AVAILABLE_STATUS);
   dds_set_status_mask(reply_reader.get(), DDS_DATA_AVAILABLE_STATUS);
   dds_waitset_attach(waitset.get(), request_reader.get(), request_reader.get());
@@ -295,6 +291,8 @@ void Endpoint::Impl::receive_loop() {
     {
       std::lock_guard lock(state_mutex);
       const auto now = Clock::now();
+      if (!pending.empty())
+        timeout = std::chrono::duration_cast<std::chrono::nanoseconds>(kDepartureCheck).count();
       for (const auto &[id, p] : pending)
         timeout = std::min<dds_duration_t>(
             timeout,
@@ -309,6 +307,7 @@ void Endpoint::Impl::receive_loop() {
     if (announcement_reader)
       take_announcements();
     expire_calls();
+    fail_calls_to_departed();
   }
 }
 
@@ -389,8 +388,8 @@ void Endpoint::Impl::serve(RequestContext context, Json body) {
   reply.status = static_cast<std::int32_t>(result ? Status::Ok : result.error().status);
   reply.error = const_cast<char *>(error.c_str());
   reply.body = const_cast<char *>(reply_body.c_str());
-  auto writer = writer_to(reply_writers, reply_topic.get(), context.sender,
-                          Clock::now() + std::chrono::seconds(5));
+  auto writer =
+      reply_ways->matched_writer(context.sender, Clock::now() + std::chrono::seconds(5), stopping);
   if (!writer) {
     spdlog::warn("{}: cannot reply to {} for {}: {}", address, context.sender, context.operation,
                  writer.error().message);
@@ -451,7 +450,7 @@ void Endpoint::Impl::take_announcements() {
       if (event.kind == AnnouncementEvent::Kind::Alive &&
           std::find(options.prepare_kinds.begin(), options.prepare_kinds.end(),
                     event.endpoint_kind) != options.prepare_kinds.end())
-        writer_for(request_writers, request_topic.get(), event.address); // not waited for
+        request_ways->writer_for(event.address); // not waited for
       handler(event);
     }
     dds_return_loan(announcement_reader.get(), samples, n);
@@ -501,49 +500,37 @@ void Endpoint::Impl::expire_calls() {
   });
 }
 
-CallResult<dds_entity_t> Endpoint::Impl::writer_for(std::map<std::string, PartitionWriter> &cache,
-                                                    dds_entity_t topic,
-                                                    const std::string &partition) {
-  std::lock_guard lock(writers_mutex);
-  if (auto it = cache.find(partition); it != cache.end())
-    return it->second.writer.get();
-  auto pqos = partition_qos({partition});
-  auto publisher = dds::checked(dds_create_publisher(participant->get(), pqos.get(), nullptr),
-                                "creating a publisher");
-  if (!publisher)
-    return call_error(Status::Failed, publisher.error().to_string());
-  auto qos = control_qos();
-  auto w = dds::checked(dds_create_writer(publisher->get(), topic, qos.get(), nullptr),
-                        "creating a writer");
-  if (!w)
-    return call_error(Status::Failed, w.error().to_string());
-  dds_set_status_mask(w->get(), DDS_PUBLICATION_MATCHED_STATUS);
-  const dds_entity_t writer = w->get();
-  cache.emplace(partition, PartitionWriter{std::move(*publisher), std::move(*w)});
-  return writer;
-}
-
-CallResult<dds_entity_t> Endpoint::Impl::writer_to(std::map<std::string, PartitionWriter> &cache,
-                                                   dds_entity_t topic, const std::string &partition,
-                                                   Clock::time_point deadline) {
-  auto writer = writer_for(cache, topic, partition);
-  if (!writer)
-    return writer;
-  // Volatile data written before the reader is matched is lost: wait for the match first.
-  Entity ws(dds_create_waitset(participant->get()));
-  dds_waitset_attach(ws.get(), *writer, *writer);
-  for (;;) {
-    dds_publication_matched_status_t status{};
-    if (dds_get_publication_matched_status(*writer, &status) == 0 && status.current_count > 0)
-      return writer;
-    const auto left = deadline - Clock::now();
-    if (left <= Clock::duration::zero() || stopping.load())
-      return call_error(Status::Unavailable, fmt::format("no endpoint at address {}", partition));
-    dds_waitset_wait(
-        ws.get(), nullptr, 0,
-        std::min<dds_duration_t>(
-            DDS_MSECS(100), std::chrono::duration_cast<std::chrono::nanoseconds>(left).count()));
+// A call whose addressee left DDS after it was sent (its process exited, or lost its lease)
+// fails now instead of at its deadline: a CLI whose domain daemon died during a launch says so
+// within a lease, not after six times its timeout (issue 18, defect 10).
+void Endpoint::Impl::fail_calls_to_departed() {
+  const auto now = Clock::now();
+  if (now - departures_checked < kDepartureCheck)
+    return;
+  departures_checked = now;
+  {
+    std::lock_guard lock(state_mutex);
+    if (std::none_of(pending.begin(), pending.end(), [](const auto &p) { return p.second.sent; }))
+      return;
   }
+  const std::set<std::string> gone = request_ways->departed();
+  if (gone.empty())
+    return;
+  std::map<std::string, std::string> via;
+  {
+    std::lock_guard lock(routes_mutex);
+    via = routes;
+  }
+  fail_calls([&](const Pending &p) -> std::optional<CallError> {
+    auto route = via.find(p.target);
+    if (!p.sent || gone.count(route != via.end() ? route->second : p.target) == 0)
+      return std::nullopt;
+    return CallError{Status::Unavailable,
+                     fmt::format("{} left before it replied to \"{}\": its endpoint is gone from "
+                                 "DDS (the process exited or lost its lease)",
+                                 p.target, p.operation),
+                     /*maybe_received=*/true};
+  });
 }
 
 void Endpoint::Impl::send_request(std::string id, std::string target, std::string operation,
@@ -556,7 +543,7 @@ void Endpoint::Impl::send_request(std::string id, std::string target, std::strin
       return; // expired before it could be sent
     deadline = it->second.deadline;
   }
-  auto writer = writer_to(request_writers, request_topic.get(), route_of(target), deadline);
+  auto writer = request_ways->matched_writer(route_of(target), deadline, stopping);
   if (!writer) {
     complete(id, tl::unexpected(writer.error()));
     return;
@@ -584,14 +571,14 @@ void Endpoint::Impl::send_request(std::string id, std::string target, std::strin
 }
 
 std::string Endpoint::Impl::route_of(const std::string &target) {
-  std::lock_guard lock(writers_mutex);
+  std::lock_guard lock(routes_mutex);
   auto it = routes.find(target);
   return it != routes.end() ? it->second : target;
 }
 
 Expected<void> Endpoint::Impl::announce(const std::string &as, const std::string &kind,
                                         const Json &body) {
-  std::lock_guard lock(writers_mutex);
+  std::lock_guard lock(announcement_mutex);
   if (!announcement_writer) {
     auto qos = announcement_qos();
     auto w = dds::checked(
@@ -612,7 +599,7 @@ Expected<void> Endpoint::Impl::announce(const std::string &as, const std::string
 }
 
 void Endpoint::Impl::withdraw(const std::string &as) {
-  std::lock_guard lock(writers_mutex);
+  std::lock_guard lock(announcement_mutex);
   if (!announcement_writer)
     return;
   rsca_ctl_Announcement a{};
@@ -724,7 +711,7 @@ std::vector<CallResult<Json>> Endpoint::call_all(const std::vector<Call> &calls,
 }
 
 void Endpoint::route(const std::string &target, const std::string &via) {
-  std::lock_guard lock(impl_->writers_mutex);
+  std::lock_guard lock(impl_->routes_mutex);
   impl_->routes[target] = via;
 }
 
@@ -748,15 +735,12 @@ std::future<CallResult<Json>> Endpoint::call(const std::string &target,
 }
 
 void Endpoint::prepare(const std::string &target) {
-  if (auto writer = impl_->writer_for(impl_->request_writers, impl_->request_topic.get(),
-                                      impl_->route_of(target));
-      !writer)
+  if (auto writer = impl_->request_ways->writer_for(impl_->route_of(target)); !writer)
     spdlog::debug("preparing the way to {}: {}", target, writer.error().message);
 }
 
 void Endpoint::prepare_replies(const std::string &caller) {
-  if (auto writer = impl_->writer_for(impl_->reply_writers, impl_->reply_topic.get(), caller);
-      !writer)
+  if (auto writer = impl_->reply_ways->writer_for(caller); !writer)
     spdlog::debug("preparing replies to {}: {}", caller, writer.error().message);
 }
 
@@ -770,9 +754,9 @@ void Endpoint::abandon(const std::string &target, const std::string &why) {
 }
 
 void Endpoint::forget(const std::string &target) {
-  std::lock_guard lock(impl_->writers_mutex);
-  impl_->request_writers.erase(target);
-  impl_->reply_writers.erase(target);
+  impl_->request_ways->erase(target);
+  impl_->reply_ways->erase(target);
+  std::lock_guard lock(impl_->routes_mutex);
   impl_->routes.erase(target);
 }
 

@@ -43,6 +43,9 @@ std::string_view to_string(Status status);
 struct CallError {
   Status status = Status::Failed;
   std::string message;
+  // The addressee was there when the request was sent and may have acted on it: an Unavailable
+  // call whose addressee left DDS before it replied, as opposed to one nobody ever served.
+  bool maybe_received = false;
 };
 
 template <typename T>
@@ -117,6 +120,9 @@ public:
   // Drops the handlers of `address` and returns once none of them is running any more.
   void stop_serving(const std::string &address);
 
+  // A call fails at its deadline (Timeout), at once when nobody serves `target` by then
+  // (Unavailable), or as soon as its addressee leaves DDS after it was sent (Unavailable,
+  // maybe_received): it exited or lost its lease, and will not reply.
   std::future<CallResult<Json>> call(const std::string &target, const std::string &operation,
                                      Json body, std::chrono::milliseconds timeout);
   CallResult<Json> call_sync(const std::string &target, const std::string &operation, Json body,

@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 
+#include "common/daemon_heap.hpp"
 #include "common/process_priority.hpp"
 #include "common/termination_signals.hpp"
 #include "dds/participant.hpp"
@@ -12,6 +13,8 @@
 int main(int argc, char **argv) {
   const int nice = rsca::run_above_applications(); // before any thread exists
   rsca::TerminationSignals signals;                // before any thread exists
+  rsca::bound_daemon_heap();
+  const rsca::HeapTrimmer heap_trimmer; // a thread: after the signals are blocked
   CLI::App app{"rsca-domaind — the rsca domain daemon (DomainManager, ApplicationFactory, "
                "ResourceAllocator)"};
   std::string dmd;

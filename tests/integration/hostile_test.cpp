@@ -243,3 +243,35 @@ TEST_CASE("concurrent stops and starts of one application leave its record as it
   REQUIRE(domain.call("app.release", Json{{"app", "Healthy"}}).has_value());
   domain.require_clean(pids_of(app));
 }
+
+TEST_CASE("a launch whose domain daemon dies says so within a lease, not after its whole wait",
+          "[integration][hostile][recovery]") {
+  TestDomain domain(2, /*registration_timeout_ms=*/60000); // the launch waits for Victim_1
+  domain.install("NeverRegisters");
+  // The CLI waits up to six times --timeout-ms (here 10 minutes) for a launch.
+  auto launch = std::async(std::launch::async, [&] {
+    return domain.cli({"--timeout-ms", "100000", "launch", "NeverRegisters"});
+  });
+  std::vector<long> orphans;
+  REQUIRE(TestDomain::wait_for([&] {
+    orphans = domain.running_pids();
+    return orphans.size() == 2; // executed: the launch waits for Victim_1 to register
+  }));
+  domain.kill_domaind();
+  REQUIRE(launch.wait_for(60s) == std::future_status::ready);
+  auto [rc, out] = launch.get();
+  INFO(out);
+  CHECK(rc == 4); // unreachable
+  CHECK_THAT(out, Catch::Contains("rsca/domain left before it replied to \"app.create\""));
+  CHECK_THAT(out, Catch::Contains("may still run"));
+
+  // What the dead daemon started is the operator's to stop (a restarted one reports it).
+  for (long pid : orphans)
+    ::kill(static_cast<pid_t>(pid), SIGKILL);
+  domain.start_domaind(TestDomain::kRegistrationTimeoutMs);
+  REQUIRE(TestDomain::wait_for([&] {
+    auto nodes = domain.call("domain.nodes", Json::object(), 2s);
+    return nodes && nodes->at("nodes").size() == 2;
+  }));
+  domain.require_clean(orphans);
+}

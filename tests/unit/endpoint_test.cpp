@@ -391,3 +391,64 @@ TEST_CASE("stop_serving waits for the address's running handler, then the addres
   REQUIRE_FALSE(after.has_value());
   CHECK(after.error().status == Status::BadRequest);
 }
+
+TEST_CASE("an endpoint keeps reply writers for the callers alive, not one for every caller it had",
+          "[control]") {
+  // A daemon answering CLI commands: each caller a participant (a process) of its own, gone after
+  // its call (issue 18, defect 5: the domain kept a reply writer for every CLI it ever answered).
+  auto pp = test::participant();
+  auto server = open(pp, "test/server");
+  server->on("fast", fast);
+  auto call_and_leave = [&](const std::string &address) {
+    auto client = open(test::participant(), address);
+    REQUIRE(client->call_sync("test/server", "fast", Json::object(), 5s).has_value());
+  };
+  const int callers = 8;
+  for (int i = 0; i < callers; ++i)
+    call_and_leave("test/cli-" + std::to_string(i));
+  auto replies_to_departed = [&] {
+    int n = 0;
+    for (int i = 0; i < callers; ++i)
+      n += writers_into(pp, "rsca_ctl_Reply", "test/cli-" + std::to_string(i));
+    return n;
+  };
+  CHECK(replies_to_departed() > 0); // dropped when the next way is made, not before
+  // The next caller's way is made once the others are known to be gone.
+  REQUIRE(eventually([&] {
+    call_and_leave("test/cli-next");
+    return replies_to_departed() == 0;
+  }));
+  // A caller that is alive keeps its writer, and is answered again.
+  auto alive = open(test::participant(), "test/cli-alive");
+  REQUIRE(alive->call_sync("test/server", "fast", Json::object(), 5s).has_value());
+  call_and_leave("test/cli-after");
+  CHECK(writers_into(pp, "rsca_ctl_Reply", "test/cli-alive") == 1);
+  CHECK(alive->call_sync("test/server", "fast", Json::object(), 5s).has_value());
+}
+
+TEST_CASE("a call whose addressee leaves DDS before it replies fails then, not at its deadline",
+          "[control]") {
+  // What a CLI sees when the domain daemon dies during a launch (issue 18, defect 10).
+  Gate gate; // outlives the server, whose handler waits on it
+  std::atomic<bool> entered{false};
+  auto server_pp = test::participant();
+  auto server = open(server_pp, "test/server");
+  server->on("hang", [&](const Json &, const control::RequestContext &) {
+    entered = true;
+    return gate.wait();
+  });
+  server->on("fast", fast);
+  auto client = open(test::participant(), "test/client");
+  REQUIRE(client->call_sync("test/server", "fast", Json::object(), 5s).has_value());
+  auto hanging = client->call("test/server", "hang", Json::object(), 1h);
+  REQUIRE(eventually([&] { return entered.load(); }));
+  // The server's process vanishes from DDS with the handler still running: its participant and
+  // every entity of it are deleted under it.
+  dds_delete(server_pp->get());
+  REQUIRE(hanging.wait_for(30s) == std::future_status::ready);
+  auto result = hanging.get();
+  REQUIRE_FALSE(result.has_value());
+  CHECK(result.error().status == Status::Unavailable);
+  CHECK_THAT(result.error().message, Catch::Contains("test/server left before it replied"));
+  gate.open();
+}

@@ -241,6 +241,12 @@ int launch(const std::string &what, const std::string &name, bool no_start,
                                        application, launch_timeout.count(),
                                        cancel_launch(*client, launch_id, global))});
   }
+  if (!reply && reply.error().maybe_received) {
+    auto error = reply.error();
+    error.message += "; what it had started for this launch may still run (a domain daemon "
+                     "started again reports it: `rsca ls apps`)";
+    return report_failure(global, "launch", error);
+  }
   if (!reply)
     return report_failure(global, "launch", reply.error());
   if (global.json) {

@@ -1,0 +1,38 @@
+// A daemon's heap over months of launches, releases and commands. Its live heap stays flat
+// (heaptrack, 30 against 230 launch/release cycles: +4 KB), yet with glibc's defaults its resident
+// memory grew by ~13 KB a cycle (issue 18, defect 5): each time a large block (a Cyclone receive
+// buffer, a long JSON reply) is freed, glibc raises its mmap threshold, so later large blocks come
+// from the heap, which fragments and is given back only from its top. So the daemons fix the
+// thresholds (large blocks keep mappings of their own, returned when freed) and give free pages
+// back now and then (malloc_trim: also those inside the heap). Figures: docs/measurements.md,
+// `tools/bench soak`.
+#pragma once
+
+#include <chrono>
+#include <condition_variable>
+#include <mutex>
+#include <thread>
+
+namespace rsca {
+
+// Fixes malloc's mmap and trim thresholds at 128 KiB (its initial values, no longer raised). First
+// in a daemon's main.
+void bound_daemon_heap();
+
+// For its lifetime, gives the heap's free pages back to the system every `period` (malloc_trim on
+// a thread of its own: a pass over the arenas, well under a millisecond for a daemon's heap).
+class HeapTrimmer {
+public:
+  explicit HeapTrimmer(std::chrono::milliseconds period = std::chrono::seconds(5));
+  ~HeapTrimmer();
+  HeapTrimmer(const HeapTrimmer &) = delete;
+  HeapTrimmer &operator=(const HeapTrimmer &) = delete;
+
+private:
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  bool stopping_ = false;
+  std::thread thread_;
+};
+
+} // namespace rsca

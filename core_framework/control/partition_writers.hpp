@@ -1,0 +1,62 @@
+// The ways from one endpoint to others over one control topic (requests, or replies): a DDS
+// writer per partition, that is per address, made on first use and kept while an endpoint reads
+// there. A daemon answers a stream of short-lived callers (every CLI command is a process with an
+// address of its own), so a way whose readers have all left is dropped when the next one is made:
+// the daemon holds writers for the endpoints alive and not one per caller it ever had (issue 18,
+// defect 5: 10-13 KB per CLI command, never given back).
+//
+// "Left" is DDS's own word for it: the writer was matched and is matched no longer, because the
+// endpoint there exited, withdrew its reader, or lost its participant's lease. The endpoint asks
+// the same question of the calls it has sent (departed()), so that a caller whose addressee died
+// learns it then, not at its deadline.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <map>
+#include <mutex>
+#include <set>
+#include <string>
+
+#include "control/endpoint.hpp"
+#include "dds/entity.hpp"
+
+namespace rsca::control {
+
+class PartitionWriters {
+public:
+  using Clock = std::chrono::steady_clock;
+
+  // Writers of `topic` with QoS `qos` (copied), under publishers of `participant`.
+  PartitionWriters(dds_entity_t participant, dds_entity_t topic, const dds_qos_t *qos);
+
+  // The writer into `partition`, made when there is none yet (and then the ways whose readers
+  // left are dropped).
+  CallResult<dds_entity_t> writer_for(const std::string &partition);
+  // The same, once a reader in that partition is matched: volatile data written before the
+  // match would be lost. Unavailable at `deadline`, or as soon as `stopping` is set.
+  CallResult<dds_entity_t> matched_writer(const std::string &partition, Clock::time_point deadline,
+                                          const std::atomic<bool> &stopping);
+  void erase(const std::string &partition);
+
+  // The partitions whose writer was matched and is matched no longer.
+  std::set<std::string> departed() const;
+  std::size_t size() const;
+
+private:
+  struct Way {
+    dds::Entity publisher; // carries the partition
+    dds::Entity writer;
+  };
+
+  // Drops the ways whose readers left. Called with mutex_ held.
+  void drop_departed_locked();
+
+  dds_entity_t participant_;
+  dds_entity_t topic_;
+  dds::Qos qos_;
+  mutable std::mutex mutex_;
+  std::map<std::string, Way> ways_;
+};
+
+} // namespace rsca::control
