@@ -11,7 +11,6 @@ Starts `rsca domain up --nodes 2` on a DDS domain id and run folder of its own, 
 - footprint: RSS and PSS of the idle daemons, and their CPU use over an idle interval.
 The domain is always taken down, also on failure.
 """
-import argparse
 import json
 import os
 import statistics
@@ -19,7 +18,7 @@ import subprocess
 import sys
 import time
 
-from local_domain import Domain, cpu_ticks, memory_kb, summary
+from local_domain import Domain, bench_arguments, cpu_ticks, memory_kb, summary
 
 
 def bench_launch(domain, sad, runs):
@@ -64,11 +63,7 @@ def bench_footprint(domain, idle_s):
 
 
 def main():
-    parser = argparse.ArgumentParser()
-    parser.add_argument("--bin", required=True)
-    parser.add_argument("--sdrroot", required=True)
-    parser.add_argument("--out", required=True)
-    parser.add_argument("--quick", action="store_true")
+    parser = bench_arguments(__doc__)
     args = parser.parse_args()
     runs = 5 if args.quick else 30
     rsca = os.path.join(args.bin, "rsca")

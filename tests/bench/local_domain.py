@@ -7,6 +7,7 @@ other programs, each in a process group of its own. Both kill everything they st
 go, also on failure: the daemons are taken down gracefully first, then whatever is left of them,
 of the component processes they ran and of the other programs is killed by process group.
 """
+import argparse
 import json
 import os
 import select
@@ -17,6 +18,19 @@ import subprocess
 import sys
 import tempfile
 import time
+
+
+def bench_arguments(doc, sdrroot=True):
+    """The arguments every benchmark script takes from tools/bench: the build's bin folder, the
+    SDR root (when it launches profiles), the JSON results file and --quick. `doc` is the script's
+    docstring, whose first line describes it."""
+    parser = argparse.ArgumentParser(description=doc.splitlines()[0])
+    parser.add_argument("--bin", required=True, help="the build's bin folder")
+    if sdrroot:
+        parser.add_argument("--sdrroot", required=True, help="the SDR root of the profiles")
+    parser.add_argument("--out", required=True, help="the JSON results file")
+    parser.add_argument("--quick", action="store_true", help="fewer runs")
+    return parser
 
 
 def percentile(values, p):
