@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <atomic>
 #include <condition_variable>
-#include <deque>
 #include <functional>
 #include <map>
 #include <mutex>
@@ -17,6 +16,7 @@
 
 #include "control.h" // generated from dds/control.idl
 #include "control/partition_writers.hpp"
+#include "control/worker_pool.hpp"
 
 namespace rsca::control {
 
@@ -51,53 +51,6 @@ constexpr const char *kAnnouncementTopic = "rsca_ctl_Announcement";
 constexpr std::uint32_t kTakeBatch = 64;
 // How often the receive thread looks, while calls are under way, for addressees that left DDS.
 constexpr auto kDepartureCheck = std::chrono::milliseconds(200);
-
-// A fixed set of threads running queued tasks in order of arrival.
-class WorkerPool {
-public:
-  explicit WorkerPool(std::size_t threads) {
-    for (std::size_t i = 0; i < threads; ++i)
-      threads_.emplace_back([this] { run(); });
-  }
-  ~WorkerPool() {
-    {
-      std::lock_guard lock(mutex_);
-      stopping_ = true;
-    }
-    wake_.notify_all();
-    for (auto &t : threads_)
-      t.join();
-  }
-  void post(std::function<void()> task) {
-    {
-      std::lock_guard lock(mutex_);
-      tasks_.push_back(std::move(task));
-    }
-    wake_.notify_one();
-  }
-
-private:
-  void run() {
-    for (;;) {
-      std::function<void()> task;
-      {
-        std::unique_lock lock(mutex_);
-        wake_.wait(lock, [this] { return stopping_ || !tasks_.empty(); });
-        if (tasks_.empty())
-          return;
-        task = std::move(tasks_.front());
-        tasks_.pop_front();
-      }
-      task();
-    }
-  }
-
-  std::mutex mutex_;
-  std::condition_variable wake_;
-  std::deque<std::function<void()>> tasks_;
-  bool stopping_ = false;
-  std::vector<std::thread> threads_;
-};
 
 dds::Qos control_qos() {
   auto qos = dds::make_qos();
