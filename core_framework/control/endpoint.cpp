@@ -150,6 +150,7 @@ struct Endpoint::Impl {
   std::uint64_t next_id = 0;
 
   std::atomic<bool> stopping{false};
+  std::atomic<bool> serving{false}; // requests are taken (see EndpointOptions::hold_requests)
   std::unique_ptr<WorkerPool> handler_pool; // runs request handlers
   std::unique_ptr<WorkerPool> send_pool;    // writes requests, so callers never wait on discovery
   std::thread receiver;
@@ -221,7 +222,9 @@ Expected<void> Endpoint::Impl::create_entities() {
     return ok;
   request_ways = std::make_unique<PartitionWriters>(pp, request_topic.get(), qos.get());
   reply_ways = std::make_unique<PartitionWriters>(pp, reply_topic.get(), qos.get());
-  dds_set_status_mask(request_reader.get(), DDS_DATA_AVAILABLE_STATUS);
+  // Held requests stay in the reader, which wakes nobody until start_serving.
+  serving = !options.hold_requests;
+  dds_set_status_mask(request_reader.get(), serving ? DDS_DATA_AVAILABLE_STATUS : 0);
   dds_set_status_mask(reply_reader.get(), DDS_DATA_AVAILABLE_STATUS);
   dds_waitset_attach(waitset.get(), request_reader.get(), request_reader.get());
   dds_waitset_attach(waitset.get(), reply_reader.get(), reply_reader.get());
@@ -255,7 +258,8 @@ void Endpoint::Impl::receive_loop() {
     dds_waitset_wait(waitset.get(), nullptr, 0, timeout);
     bool triggered = false;
     dds_take_guardcondition(guard.get(), &triggered);
-    take_requests();
+    if (serving)
+      take_requests();
     take_replies();
     if (announcement_reader)
       take_announcements();
@@ -616,6 +620,12 @@ void Endpoint::on(const std::string &operation, Handler handler) {
 void Endpoint::on(const std::string &address, const std::string &operation, Handler handler) {
   std::lock_guard lock(impl_->state_mutex);
   impl_->handlers[{address, operation}] = std::move(handler);
+}
+
+void Endpoint::start_serving() {
+  dds_set_status_mask(impl_->request_reader.get(), DDS_DATA_AVAILABLE_STATUS);
+  impl_->serving = true;
+  impl_->wake(); // takes what was held
 }
 
 void Endpoint::stop_serving(const std::string &address) {

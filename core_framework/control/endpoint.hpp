@@ -88,6 +88,10 @@ struct EndpointOptions {
   // Announced endpoints of these kinds get their way prepared (see prepare) as soon as they are
   // announced: the first call to a node then does not wait for DDS to match a new writer.
   std::vector<std::string> prepare_kinds;
+  // Requests wait, unread, until start_serving(): a daemon that registers its handlers (and
+  // restores its state) after open never answers a request that came in between with "does not
+  // serve" (a CLI calling a domain daemon that is restarting).
+  bool hold_requests = false;
 };
 
 // One call of many made at once (Endpoint::call_all).
@@ -117,6 +121,8 @@ public:
   // Serves `operation` at `address` (its own or an alias) only, before any handler of
   // on(operation).
   void on(const std::string &address, const std::string &operation, Handler handler);
+  // Serves the requests held since open (EndpointOptions::hold_requests) and those that follow.
+  void start_serving();
   // Drops the handlers of `address` and returns once none of them is running any more.
   void stop_serving(const std::string &address);
 

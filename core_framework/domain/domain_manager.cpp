@@ -629,13 +629,15 @@ DomainManager::create(std::shared_ptr<dds::Participant> participant, DomainOptio
        .senders = 4,
        .on_announcement = [raw](const control::AnnouncementEvent &e) { raw->on_announcement(e); },
        .aliases = {},
-       .prepare_kinds = {"node"}});
+       .prepare_kinds = {"node"},
+       .hold_requests = true});
   if (!endpoint)
     return tl::unexpected(endpoint.error());
   impl->endpoint = std::move(*endpoint);
   // Before serving: a connection requested meanwhile could take a restored one's id.
   impl->restore_connections();
   impl->serve();
+  impl->endpoint->start_serving();
   spdlog::info("domain {} serving at {} (incarnation {})", impl->options.name,
                impl->endpoint->address(), impl->incarnation);
   return std::unique_ptr<DomainManager>(new DomainManager(std::move(impl)));

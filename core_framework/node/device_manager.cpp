@@ -210,14 +210,18 @@ DeviceManager::create(std::shared_ptr<dds::Participant> participant, NodeOptions
     return tl::unexpected(node.error());
   impl->node = std::move(*node);
   impl->dcd = impl->node.dcd;
+  control::EndpointOptions endpoint_options;
+  endpoint_options.hold_requests = true; // until its devices run and their handlers are there
   auto endpoint = control::Endpoint::open(
-      participant, fmt::format("{}/node/{}", impl->options.domain_name, impl->dcd->name));
+      participant, fmt::format("{}/node/{}", impl->options.domain_name, impl->dcd->name),
+      std::move(endpoint_options));
   if (!endpoint)
     return tl::unexpected(endpoint.error());
   impl->endpoint = std::move(*endpoint);
   if (auto ok = impl->start_devices(registry); !ok)
     return tl::unexpected(ok.error());
   impl->serve();
+  impl->endpoint->start_serving();
   // The domain is the node's caller, and the node calls it: both ways are made now, so the
   // first launch does not wait for DDS to match them.
   impl->endpoint->prepare(impl->options.domain_name + "/domain");

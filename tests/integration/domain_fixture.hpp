@@ -179,11 +179,13 @@ public:
     return pids;
   }
 
-  // Stops the domain daemon and starts a new one on the same repository.
+  // Stops the domain daemon and starts a new one on the same repository; returns once the new
+  // one answers (a call sent before then may reach the one that was stopping, and be lost).
   void restart_domaind(int registration_timeout_ms = kRegistrationTimeoutMs) {
     domaind_->signal(SIGTERM);
     REQUIRE(domaind_->wait_exit(5s).has_value());
     start_domaind(registration_timeout_ms);
+    REQUIRE(wait_for([&] { return call("domain.nodes", Json::object(), 2s).has_value(); }));
   }
 
   // Kills the domain daemon as a crash would (SIGKILL): it stops nothing and tells nobody.

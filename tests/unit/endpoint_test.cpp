@@ -452,3 +452,25 @@ TEST_CASE("a call whose addressee leaves DDS before it replies fails then, not a
   CHECK_THAT(result.error().message, Catch::Contains("test/server left before it replied"));
   gate.open();
 }
+
+TEST_CASE("an endpoint that holds requests answers none before it starts serving, then all",
+          "[control]") {
+  // A daemon registers its handlers after open: a request that came in between must wait for
+  // them, not be told the operation is not served (a CLI calling a restarting domain daemon).
+  auto pp = test::participant();
+  control::EndpointOptions options;
+  options.hold_requests = true;
+  auto server = open(pp, "test/server", options);
+  auto client = open(pp, "test/client");
+  auto early = client->call("test/server", "fast", Json::object(), 10s);
+  // Received and held: the way is matched, yet no answer comes while nothing serves.
+  REQUIRE(eventually([&] { return writers_into(pp, "rsca_ctl_Request", "test/server") == 1; }));
+  CHECK(early.wait_for(300ms) == std::future_status::timeout);
+  server->on("fast", fast);
+  server->start_serving();
+  REQUIRE(early.wait_for(5s) == std::future_status::ready);
+  auto reply = early.get();
+  REQUIRE(reply.has_value());
+  CHECK(reply->at("ok") == true);
+  CHECK(client->call_sync("test/server", "fast", Json::object(), 5s).has_value());
+}
