@@ -1,11 +1,10 @@
-// A daemon's heap over months of launches, releases and commands. Its live heap stays flat
-// (heaptrack, 30 against 230 launch/release cycles: +4 KB), yet with glibc's defaults its resident
-// memory grew by ~13 KB a cycle (issue 18, defect 5): each time a large block (a Cyclone receive
-// buffer, a long JSON reply) is freed, glibc raises its mmap threshold, so later large blocks come
-// from the heap, which fragments and is given back only from its top. So the daemons fix the
-// thresholds (large blocks keep mappings of their own, returned when freed) and give free pages
-// back now and then (malloc_trim: also those inside the heap). Figures: docs/measurements.md,
-// `tools/bench soak`.
+// A daemon's heap over months of launches, releases and commands. With glibc's defaults its
+// resident memory grew by ~15 KB a launch/release cycle, most of it memory the daemon had freed
+// (issue 18, defect 5): each time a large block (a Cyclone receive buffer, a long JSON reply) is
+// freed, glibc raises its mmap threshold, so later large blocks come from the heap, which fragments
+// and is given back only from its top. So the daemons fix the thresholds (large blocks keep
+// mappings of their own, returned when freed) and give free pages back now and then (malloc_trim:
+// also those inside the heap): ~3 KB a cycle. Figures: docs/measurements.md, `tools/bench soak`.
 #pragma once
 
 #include <chrono>
