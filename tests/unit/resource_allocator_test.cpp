@@ -75,11 +75,15 @@ std::size_t tasks_on(const ResourceAllocator &allocator, const std::string &devi
   return n;
 }
 
-// Two nodes of one GPP each.
-void add_two_nodes(ResourceAllocator &allocator) {
-  allocator.set_node_devices("n1", {gpp("n1")});
-  allocator.set_node_devices("n2", {gpp("n2")});
-}
+// An allocator of two nodes of one GPP each, and a package of a 30 % component.
+struct TwoNodes {
+  TwoNodes() {
+    allocator.set_node_devices("n1", {gpp("n1")});
+    allocator.set_node_devices("n2", {gpp("n2")});
+  }
+  PkgPtr pkg = softpkg("worker", 0.3);
+  ResourceAllocator allocator;
+};
 
 // An application of a 30 % component on n1 and a periodic one (20 %) on n2, by the same
 // instance names each time: equal tasks, as two launches of one SAD give.
@@ -91,12 +95,10 @@ PlanRequest spread_app(const PkgPtr &pkg) {
 
 } // namespace
 
-TEST_CASE("allocator: a release after a node came back gives back only what the application "
-          "still holds",
-          "[allocator]") {
-  auto pkg = softpkg("worker", 0.3);
-  ResourceAllocator allocator;
-  add_two_nodes(allocator);
+TEST_CASE_METHOD(TwoNodes,
+                 "allocator: a release after a node came back gives back only what the application "
+                 "still holds",
+                 "[allocator]") {
   const auto a = allocator.allocate(spread_app(pkg), {});
   REQUIRE(a.has_value());
   CHECK(cpu_allocated(allocator, "n2:GPP") == Approx(20));
@@ -125,12 +127,11 @@ TEST_CASE("allocator: a release after a node came back gives back only what the 
   CHECK(allocator.reservations() == 0);
 }
 
-TEST_CASE("allocator: a device the node stops announcing takes its part of every reservation "
-          "along",
-          "[allocator]") {
-  auto pkg = softpkg("worker", 0.3);
-  ResourceAllocator allocator;
-  add_two_nodes(allocator);
+TEST_CASE_METHOD(
+    TwoNodes,
+    "allocator: a device the node stops announcing takes its part of every reservation "
+    "along",
+    "[allocator]") {
   const auto a = allocator.allocate(spread_app(pkg), {});
   REQUIRE(a.has_value());
   // n2 announces itself without its GPP, then with it again (no remove_node in between).
@@ -146,11 +147,9 @@ TEST_CASE("allocator: a device the node stops announcing takes its part of every
   CHECK(cpu_allocated(allocator, "n2:GPP") == Approx(30));
 }
 
-TEST_CASE("allocator: a node that re-announces itself keeps the reservations on it",
-          "[allocator]") {
-  auto pkg = softpkg("worker", 0.3);
-  ResourceAllocator allocator;
-  add_two_nodes(allocator);
+TEST_CASE_METHOD(TwoNodes,
+                 "allocator: a node that re-announces itself keeps the reservations on it",
+                 "[allocator]") {
   const auto a = allocator.allocate(spread_app(pkg), {});
   REQUIRE(a.has_value());
   allocator.set_node_devices("n2", {gpp("n2")}); // the same devices again
@@ -160,11 +159,10 @@ TEST_CASE("allocator: a node that re-announces itself keeps the reservations on 
   CHECK(tasks_on(allocator, "n2:GPP") == 0);
 }
 
-TEST_CASE("allocator: a plan is given back once, and one that reserved nothing gives back nothing",
-          "[allocator]") {
-  auto pkg = softpkg("worker", 0.3);
-  ResourceAllocator allocator;
-  add_two_nodes(allocator);
+TEST_CASE_METHOD(
+    TwoNodes,
+    "allocator: a plan is given back once, and one that reserved nothing gives back nothing",
+    "[allocator]") {
   PlanRequest request;
   request.components = {pinned("a", pkg, "n1:GPP")};
   const auto first = allocator.allocate(request, {});
