@@ -1,0 +1,98 @@
+// Announcements: what an endpoint says about itself, and what it hears of others.
+#include "control/endpoint_impl.hpp"
+
+#include <algorithm>
+#include <set>
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include "control.h" // generated from dds/control.idl
+
+namespace rsca::control {
+
+using namespace detail;
+
+void Endpoint::Impl::take_announcements() {
+  void *samples[kTakeBatch] = {nullptr};
+  dds_sample_info_t infos[kTakeBatch];
+  for (;;) {
+    const dds_return_t n =
+        dds_take(announcement_reader.get(), samples, infos, kTakeBatch, kTakeBatch);
+    if (n <= 0)
+      return;
+    const AnnouncementHandler &handler = options.on_announcement;
+    for (dds_return_t i = 0; i < n; ++i) {
+      const auto *a = static_cast<const rsca_ctl_Announcement *>(samples[i]);
+      AnnouncementEvent event;
+      event.address = str(a->address);
+      if (infos[i].valid_data && infos[i].instance_state == DDS_IST_ALIVE) {
+        event.kind = AnnouncementEvent::Kind::Alive;
+        event.endpoint_kind = str(a->kind);
+        event.body = parse_body(a->body);
+      } else if (infos[i].instance_state != DDS_IST_ALIVE) {
+        event.kind = AnnouncementEvent::Kind::Gone;
+      } else {
+        continue;
+      }
+      if (event.kind == AnnouncementEvent::Kind::Alive &&
+          std::find(options.prepare_kinds.begin(), options.prepare_kinds.end(),
+                    event.endpoint_kind) != options.prepare_kinds.end())
+        request_ways->writer_for(event.address); // not waited for
+      handler(event);
+    }
+    dds_return_loan(announcement_reader.get(), samples, n);
+  }
+}
+
+Expected<void> Endpoint::Impl::announce(const std::string &as, const std::string &kind,
+                                        const Json &body) {
+  std::lock_guard lock(announcement_mutex);
+  if (!announcement_writer) {
+    auto qos = announcement_qos();
+    auto w = dds::checked(
+        dds_create_writer(participant->get(), announcement_topic.get(), qos.get(), nullptr),
+        "creating the announcement writer");
+    if (!w)
+      return tl::unexpected(w.error());
+    announcement_writer = std::move(*w);
+  }
+  const std::string text = body.dump();
+  rsca_ctl_Announcement a{};
+  a.address = const_cast<char *>(as.c_str());
+  a.kind = const_cast<char *>(kind.c_str());
+  a.body = const_cast<char *>(text.c_str());
+  if (dds_return_t rc = dds_write(announcement_writer.get(), &a); rc < 0)
+    return tl::unexpected(dds::dds_error(rc, "announcing"));
+  return {};
+}
+
+void Endpoint::Impl::withdraw(const std::string &as) {
+  std::lock_guard lock(announcement_mutex);
+  if (!announcement_writer)
+    return;
+  rsca_ctl_Announcement a{};
+  a.address = const_cast<char *>(as.c_str());
+  a.kind = const_cast<char *>("");
+  a.body = const_cast<char *>("");
+  dds_dispose(announcement_writer.get(), &a);
+}
+
+Expected<void> Endpoint::announce(const std::string &kind, const Json &body) {
+  return impl_->announce(impl_->address, kind, body);
+}
+
+void Endpoint::withdraw() {
+  impl_->withdraw(impl_->address);
+}
+
+Expected<void> Endpoint::announce(const std::string &alias, const std::string &kind,
+                                  const Json &body) {
+  return impl_->announce(alias, kind, body);
+}
+
+void Endpoint::withdraw(const std::string &alias) {
+  impl_->withdraw(alias);
+}
+
+} // namespace rsca::control

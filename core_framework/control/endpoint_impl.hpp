@@ -1,0 +1,161 @@
+// The endpoint's private parts, shared by its files: endpoint.cpp (entities, the receive thread,
+// serving requests), endpoint_calls.cpp (calls made and their ends) and
+// endpoint_announcements.cpp. Nothing outside control/ includes it.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <functional>
+#include <future>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "control/endpoint.hpp"
+#include "control/partition_writers.hpp"
+#include "control/worker_pool.hpp"
+#include "dds/entity.hpp"
+
+namespace rsca::control {
+using Clock = std::chrono::steady_clock;
+
+namespace detail {
+
+inline constexpr const char *kRequestTopic = "rsca_ctl_Request";
+inline constexpr const char *kReplyTopic = "rsca_ctl_Reply";
+inline constexpr const char *kAnnouncementTopic = "rsca_ctl_Announcement";
+inline constexpr std::uint32_t kTakeBatch = 64;
+// How often the receive thread looks, while calls are under way, for addressees that left DDS.
+inline constexpr auto kDepartureCheck = std::chrono::milliseconds(200);
+
+inline dds::Qos control_qos() {
+  auto qos = dds::make_qos();
+  dds_qset_reliability(qos.get(), DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
+  dds_qset_history(qos.get(), DDS_HISTORY_KEEP_ALL, 0);
+  dds_qset_durability(qos.get(), DDS_DURABILITY_VOLATILE);
+  return qos;
+}
+
+inline dds::Qos announcement_qos() {
+  auto qos = dds::make_qos();
+  dds_qset_reliability(qos.get(), DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
+  dds_qset_history(qos.get(), DDS_HISTORY_KEEP_LAST, 1);
+  dds_qset_durability(qos.get(), DDS_DURABILITY_TRANSIENT_LOCAL);
+  return qos;
+}
+
+inline dds::Qos partition_qos(const std::vector<std::string> &partitions) {
+  auto qos = dds::make_qos();
+  std::vector<const char *> names;
+  for (const auto &p : partitions)
+    names.push_back(p.c_str());
+  dds_qset_partition(qos.get(), static_cast<std::uint32_t>(names.size()), names.data());
+  return qos;
+}
+
+inline constexpr const char *kBatch = "endpoint.batch";
+
+inline Json reply_json(const CallResult<Json> &result) {
+  if (result)
+    return Json{{"status", 0}, {"body", *result}};
+  return Json{{"status", static_cast<std::int32_t>(result.error().status)},
+              {"error", result.error().message}};
+}
+
+inline CallResult<Json> result_of(const Json &reply) {
+  const auto status = static_cast<Status>(reply.value("status", 3));
+  if (status != Status::Ok)
+    return call_error(status, reply.value("error", std::string("no reason given")));
+  return reply.value("body", Json::object());
+}
+
+// Runs a handler. A request is untrusted: a handler that reads a field of the wrong type (JSON's
+// type errors) answers BadRequest instead of ending the process.
+inline CallResult<Json> run_handler(const Handler &handler, const Json &body,
+                                    const RequestContext &context) {
+  try {
+    return handler(body, context);
+  } catch (const Json::exception &e) {
+    return call_error(Status::BadRequest,
+                      fmt::format("malformed \"{}\" request: {}", context.operation, e.what()));
+  }
+}
+
+inline Json parse_body(const char *text) {
+  if (text == nullptr || *text == '\0')
+    return Json::object();
+  return Json::parse(text, nullptr, /*allow_exceptions=*/false);
+}
+
+inline std::string str(const char *text) {
+  return text != nullptr ? std::string(text) : std::string();
+}
+
+} // namespace detail
+
+struct Endpoint::Impl {
+  struct Pending {
+    std::promise<CallResult<Json>> promise;
+    Clock::time_point deadline;
+    std::string target;
+    std::string operation;
+    bool sent = false; // the addressee was found: silence is a timeout
+  };
+
+  std::shared_ptr<dds::Participant> participant;
+  std::string address;
+  EndpointOptions options;
+
+  dds::Entity request_topic, reply_topic, announcement_topic;
+  dds::Entity subscriber; // in this endpoint's partition
+  dds::Entity request_reader, reply_reader, announcement_reader;
+  dds::Entity waitset, guard;
+  dds::Entity announcement_writer;
+  std::mutex announcement_mutex; // guards announcement_writer
+
+  std::unique_ptr<PartitionWriters> request_ways, reply_ways;
+  std::mutex routes_mutex;
+  std::map<std::string, std::string> routes; // target → the endpoint that serves it
+  Clock::time_point departures_checked;      // receive thread only
+
+  std::mutex state_mutex;
+  std::map<std::pair<std::string, std::string>, Handler> handlers; // (address or "", operation)
+  std::map<std::string, int> running;                              // handlers running, by address
+  std::condition_variable handler_done;
+  std::map<std::string, Pending> pending;
+  std::uint64_t next_id = 0;
+
+  std::atomic<bool> stopping{false};
+  std::atomic<bool> serving{false}; // requests are taken (see EndpointOptions::hold_requests)
+  std::unique_ptr<WorkerPool> handler_pool; // runs request handlers
+  std::unique_ptr<WorkerPool> send_pool;    // writes requests, so callers never wait on discovery
+  std::thread receiver;
+
+  Expected<void> create_entities();
+  void receive_loop();
+  // Fails, at once, every pending call for which `failure` gives an error.
+  void fail_calls(const std::function<std::optional<CallError>(const Pending &)> &failure);
+  void take_requests();
+  void take_replies();
+  void take_announcements();
+  void expire_calls();
+  void fail_calls_to_departed();
+  void serve(RequestContext context, Json body);
+  CallResult<Json> dispatch(const RequestContext &context, const Json &body);
+  CallResult<Json> run_batch(const RequestContext &context, const Json &body);
+  std::string route_of(const std::string &target);
+  Expected<void> announce(const std::string &as, const std::string &kind, const Json &body);
+  void withdraw(const std::string &as);
+  void send_request(std::string id, std::string target, std::string operation, std::string body);
+  void complete(const std::string &id, CallResult<Json> result);
+  void wake() { dds_set_guardcondition(guard.get(), true); }
+};
+
+} // namespace rsca::control
