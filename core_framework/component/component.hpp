@@ -39,6 +39,7 @@
 #include "component/properties.hpp"
 #include "component/resource_port.hpp"
 #include "control/endpoint.hpp"
+#include "protocol/exec_params.hpp"
 
 namespace rsca::component {
 
@@ -56,13 +57,7 @@ std::string_view to_string(State state);
 // What timing admission decided for a periodic component (RSCA): the CPU it runs on (the
 // runtime pins the process there), its priority, its period, its execution budget per period
 // and its deadline. The component paces itself by it.
-struct Schedule {
-  unsigned cpu = 0;
-  std::uint32_t priority = 0;
-  std::chrono::nanoseconds period{0};
-  std::chrono::nanoseconds budget{0};
-  std::chrono::nanoseconds deadline{0};
-};
+using Schedule = protocol::Schedule;
 
 struct Context {
   std::string identifier;                 // COMPONENT_IDENTIFIER

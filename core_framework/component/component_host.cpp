@@ -23,18 +23,6 @@ namespace fs = std::filesystem;
 using detail::ExitEvents;
 
 // Takes LIBRARY out of the group's other parameters.
-tl::expected<fs::path, std::string> take_library(ExecParams &params) {
-  auto &others = params.others;
-  auto it = std::find_if(others.begin(), others.end(),
-                         [](const auto &pair) { return pair.first == "LIBRARY"; });
-  if (it == others.end())
-    return tl::unexpected(
-        fmt::format("{}: the exec parameter LIBRARY is missing", params.identifier));
-  fs::path library = it->second;
-  others.erase(it);
-  return library;
-}
-
 // The library as the SPD names it: absolute, or relative to the SPD's folder; one that is not
 // there is looked up by name in the host's own lib folder (where the build puts the example
 // components' libraries) and next to the host.
@@ -85,7 +73,7 @@ open_endpoint(const HostParams &host, std::shared_ptr<dds::Participant> particip
   control::EndpointOptions options{
       .workers = 4, .senders = 2, .on_announcement = {}, .aliases = {}, .prepare_kinds = {}};
   for (const auto &h : host.components)
-    options.aliases.push_back(h.params.control_address);
+    options.aliases.push_back(h.control_address);
   auto endpoint = control::Endpoint::open(std::move(participant), host.control_address, options);
   if (!endpoint)
     return tl::unexpected(endpoint.error());
@@ -96,7 +84,7 @@ int serve_hosted(const HostParams &host, const ExitEvents &events, spdlog::logge
   const auto &hosted = host.components;
   std::vector<std::string> spds;
   for (const auto &h : hosted)
-    spds.push_back(h.params.profile);
+    spds.push_back(h.profile);
   auto softpkgs = detail::load_component_profiles(spds, log);
   if (!softpkgs) {
     log.error("{}", softpkgs.error());
@@ -120,16 +108,15 @@ int serve_hosted(const HostParams &host, const ExitEvents &events, spdlog::logge
   std::vector<std::unique_ptr<InProcessComponent>> components;
   for (std::size_t i = 0; i < hosted.size(); ++i) {
     const auto &h = hosted[i];
-    auto factory = load_factory(resolve_library(h.library, h.params.profile));
+    auto factory = load_factory(resolve_library(h.library, h.profile));
     if (!factory) {
-      log.error("{}: {}", h.params.identifier, factory.error());
+      log.error("{}: {}", h.identifier, factory.error());
       return kExitFailure;
     }
-    auto component =
-        InProcessComponent::open(*factory, context_of(h.params), (*softpkgs)[i], *participant,
-                                 h.params.others, on_released, *endpoint);
+    auto component = InProcessComponent::open(*factory, context_of(h), (*softpkgs)[i], *participant,
+                                              h.others, on_released, *endpoint);
     if (!component) {
-      log.error("{}: {}", h.params.identifier, component.error().to_string());
+      log.error("{}: {}", h.identifier, component.error().to_string());
       return kExitProfile;
     }
     components.push_back(std::move(*component));
@@ -146,36 +133,6 @@ int serve_hosted(const HostParams &host, const ExitEvents &events, spdlog::logge
 
 } // namespace
 
-tl::expected<HostParams, std::string> parse_host_params(int argc, const char *const *argv) {
-  constexpr std::string_view kAddress = "CONTROL_ADDRESS";
-  constexpr std::string_view kStart = "COMPONENT_IDENTIFIER";
-  if (argc < 3 || argv[1] != kAddress)
-    return tl::unexpected(
-        fmt::format("the exec parameters start with {} <the host's address>", kAddress));
-  if (argc < 4 || argv[3] != kStart)
-    return tl::unexpected(
-        fmt::format("the host's address is followed by components, each starting with {}", kStart));
-  HostParams host{argv[2], {}};
-  auto &hosted = host.components;
-  for (int begin = 3; begin < argc;) {
-    int end = begin + 2; // keys stand at every other argument
-    while (end < argc && argv[end] != kStart)
-      end += 2;
-    end = std::min(end, argc);
-    std::vector<const char *> group{argv[0]};
-    group.insert(group.end(), argv + begin, argv + end);
-    auto params = parse_exec_params(static_cast<int>(group.size()), group.data());
-    if (!params)
-      return tl::unexpected(fmt::format("component {}: {}", hosted.size() + 1, params.error()));
-    auto library = take_library(*params);
-    if (!library)
-      return tl::unexpected(library.error());
-    hosted.push_back({std::move(*params), std::move(*library)});
-    begin = end;
-  }
-  return host;
-}
-
 int run_component_host(int argc, char **argv) {
   return detail::run_process<HostParams>(
       argc, argv,
@@ -184,7 +141,7 @@ int run_component_host(int argc, char **argv) {
       "[<property id> <value>]...)...",
       parse_host_params,
       [](const HostParams &host) {
-        return fmt::format("host:{}", host.components.front().params.application);
+        return fmt::format("host:{}", host.components.front().application);
       },
       [](const HostParams &host, const ExitEvents &events, auto logger) {
         return serve_hosted(host, events, *logger);

@@ -21,6 +21,8 @@
 #include "control/endpoint.hpp"
 #include "dds/participant.hpp"
 #include "profile/profile_loader.hpp"
+#include "protocol/component_ops.hpp"
+#include "protocol/node_ops.hpp"
 
 namespace rsca::component::detail {
 
@@ -51,22 +53,27 @@ public:
   // Initializes, configures with `properties` and starts the component: what the domain would
   // ask, for a component its own process brings up (a device in its node).
   Expected<void> bring_up(const Json &properties);
-  // The component's ports: [{"name", "direction", "repid"}].
-  Json ports_json() const;
+  // The component's ports, as a device announces them.
+  std::vector<protocol::node::DevicePort> ports() const;
   // Withdraws the announcement, closes the endpoint (waiting for running operations), stops the
   // threads and destroys the component. Idempotent.
   void close();
 
 private:
-  using Operation = CallResult<Json> (Host::*)(const Json &, const control::RequestContext &);
+  template <typename Op>
+  using Operation = CallResult<typename Op::Reply> (Host::*)(const typename Op::Request &,
+                                                             const control::RequestContext &);
 
   Expected<void> check_ports() const;
-  void serve(const std::string &operation, Operation op);
+  void serve_operations();
+  template <typename Op>
+  void serve(Operation<Op> op);
   Json announcement() const;
   void set_state(State state);
   PortBase *find_port(const std::string &name) const;
   ResourceUsesPort *find_resource_port(const std::string &name) const;
-  CallResult<Json> connect_resource_port(ResourceUsesPort &port, const Json &body);
+  CallResult<protocol::Empty> connect_resource_port(ResourceUsesPort &port,
+                                                    const protocol::component::ConnectRequest &r);
   void poll_ports();
   void watch_connections();
   std::string domain_address() const;
@@ -78,16 +85,21 @@ private:
   void service_loop();
   void stop_component();
 
-  CallResult<Json> op_initialize(const Json &body, const control::RequestContext &context);
-  CallResult<Json> op_configure(const Json &body, const control::RequestContext &context);
-  CallResult<Json> op_query(const Json &body, const control::RequestContext &context);
-  CallResult<Json> op_connect(const Json &body, const control::RequestContext &context);
-  CallResult<Json> op_disconnect(const Json &body, const control::RequestContext &context);
-  CallResult<Json> op_start(const Json &body, const control::RequestContext &context);
-  CallResult<Json> op_stop(const Json &body, const control::RequestContext &context);
-  CallResult<Json> op_status(const Json &body, const control::RequestContext &context);
-  CallResult<Json> op_await_matched(const Json &body, const control::RequestContext &context);
-  CallResult<Json> op_release(const Json &body, const control::RequestContext &context);
+  // The component.* operations (component_operations.cpp).
+  using Empty = protocol::Empty;
+  using Context = control::RequestContext;
+  CallResult<Empty> op_initialize(const Empty &, const Context &);
+  CallResult<Empty> op_configure(const protocol::component::ConfigureRequest &r, const Context &);
+  CallResult<protocol::component::QueryReply> op_query(const protocol::component::QueryRequest &r,
+                                                       const Context &);
+  CallResult<Empty> op_connect(const protocol::component::ConnectRequest &r, const Context &);
+  CallResult<Empty> op_disconnect(const protocol::component::DisconnectRequest &r, const Context &);
+  CallResult<Empty> op_start(const Empty &, const Context &);
+  CallResult<Empty> op_stop(const Empty &, const Context &);
+  CallResult<protocol::component::StatusReply> op_status(const Empty &, const Context &);
+  CallResult<protocol::component::AwaitMatchedReply>
+  op_await_matched(const protocol::component::AwaitMatchedRequest &r, const Context &context);
+  CallResult<Empty> op_release(const Empty &, const Context &);
 
   Component &c() const { return *component_; }
   spdlog::logger &log() const { return component_->log(); }

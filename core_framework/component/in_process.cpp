@@ -47,8 +47,8 @@ Expected<void> InProcessComponent::bring_up(const control::Json &properties) {
   return host_->bring_up(properties);
 }
 
-control::Json InProcessComponent::ports() const {
-  return host_->ports_json();
+std::vector<protocol::node::DevicePort> InProcessComponent::ports() const {
+  return host_->ports();
 }
 
 std::shared_ptr<spdlog::logger> in_process_logger(const std::string &name) {

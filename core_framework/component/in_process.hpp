@@ -15,6 +15,7 @@
 #include "control/endpoint.hpp"
 #include "dds/participant.hpp"
 #include "profile/profile_loader.hpp"
+#include "protocol/node_ops.hpp"
 
 namespace rsca::component {
 
@@ -44,7 +45,7 @@ public:
   Expected<void> bring_up(const control::Json &properties);
   const std::string &address() const { return address_; }
   // Its ports as announced: [{"name", "direction", "repid"}].
-  control::Json ports() const;
+  std::vector<protocol::node::DevicePort> ports() const;
 
 private:
   explicit InProcessComponent(std::unique_ptr<detail::Host> host, std::string address);

@@ -2,7 +2,12 @@
 
 #include <fmt/format.h>
 
+#include "control/operation.hpp"
+#include "protocol/component_ops.hpp"
+
 namespace rsca::component {
+
+namespace op = protocol::component;
 
 std::map<std::string, ResourceUsesPort::Target> ResourceUsesPort::targets() const {
   std::lock_guard lock(mutex_);
@@ -26,8 +31,9 @@ void ResourceUsesPort::disconnect_all() {
   targets_.clear();
 }
 
-control::CallResult<std::map<std::string, nlohmann::json>>
-ResourceUsesPort::call_each(const std::string &operation, const nlohmann::json &body,
+template <typename Op>
+control::CallResult<std::map<std::string, typename Op::Reply>>
+ResourceUsesPort::call_each(const typename Op::Request &request,
                             std::chrono::milliseconds timeout) {
   std::map<std::string, Target> targets;
   std::shared_ptr<control::Endpoint> endpoint;
@@ -37,7 +43,7 @@ ResourceUsesPort::call_each(const std::string &operation, const nlohmann::json &
     targets = targets_;
     endpoint = endpoint_.lock();
   }
-  std::map<std::string, nlohmann::json> replies;
+  std::map<std::string, typename Op::Reply> replies;
   if (targets.empty())
     return replies;
   if (!endpoint)
@@ -52,11 +58,11 @@ ResourceUsesPort::call_each(const std::string &operation, const nlohmann::json &
         continue;
       ++it->second.calls;
     }
-    auto reply = endpoint->call_sync(target.address, operation, body, timeout);
+    auto reply = control::call<Op>(*endpoint, target.address, request, timeout);
     if (!reply)
       return control::call_error(reply.error().status,
                                  fmt::format("port {}, connection {}: {} to {}: {}", name_,
-                                             connection, operation, target.address,
+                                             connection, Op::name, target.address,
                                              reply.error().message));
     replies.emplace(connection, std::move(*reply));
   }
@@ -65,26 +71,26 @@ ResourceUsesPort::call_each(const std::string &operation, const nlohmann::json &
 
 control::CallResult<void> ResourceUsesPort::configure(const nlohmann::json &properties,
                                                       std::chrono::milliseconds timeout) {
-  return call_each("component.configure", {{"properties", properties}}, timeout).map([](auto &&) {
-  });
+  return call_each<op::Configure>({properties}, timeout).map([](auto &&) {});
 }
 
 control::CallResult<std::map<std::string, nlohmann::json>>
 ResourceUsesPort::query(const std::vector<std::string> &ids, std::chrono::milliseconds timeout) {
-  auto replies = call_each("component.query", {{"ids", ids}}, timeout);
+  auto replies = call_each<op::Query>({ids}, timeout);
   if (!replies)
-    return replies;
+    return tl::unexpected(replies.error());
+  std::map<std::string, nlohmann::json> properties;
   for (auto &[connection, reply] : *replies)
-    reply = reply.value("properties", nlohmann::json::object());
-  return replies;
+    properties.emplace(connection, std::move(reply.properties));
+  return properties;
 }
 
 control::CallResult<void> ResourceUsesPort::start(std::chrono::milliseconds timeout) {
-  return call_each("component.start", nlohmann::json::object(), timeout).map([](auto &&) {});
+  return call_each<op::Start>({}, timeout).map([](auto &&) {});
 }
 
 control::CallResult<void> ResourceUsesPort::stop(std::chrono::milliseconds timeout) {
-  return call_each("component.stop", nlohmann::json::object(), timeout).map([](auto &&) {});
+  return call_each<op::Stop>({}, timeout).map([](auto &&) {});
 }
 
 } // namespace rsca::component

@@ -61,10 +61,10 @@ public:
   void disconnect_all();
 
 private:
-  // `operation` with `body` to every target; the replies by connection id.
-  control::CallResult<std::map<std::string, nlohmann::json>>
-  call_each(const std::string &operation, const nlohmann::json &body,
-            std::chrono::milliseconds timeout);
+  // Operation `Op` (protocol/component_ops.hpp) to every target; the replies by connection id.
+  template <typename Op>
+  control::CallResult<std::map<std::string, typename Op::Reply>>
+  call_each(const typename Op::Request &request, std::chrono::milliseconds timeout);
 
   std::string name_;
   mutable std::mutex mutex_;

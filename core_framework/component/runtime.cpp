@@ -30,35 +30,6 @@ namespace rsca::component {
 
 namespace {
 
-// The schedule's exec parameters (the ApplicationFactory passes them for periodic components).
-// Returns whether `key` was one of them, or an error for a malformed value.
-tl::expected<bool, std::string> take_schedule_param(const std::string &key,
-                                                    const std::string &value,
-                                                    std::optional<Schedule> &schedule) {
-  static const std::map<std::string, std::function<void(Schedule &, std::uint64_t)>> kFields{
-      {"RSCA_CPU", [](Schedule &s, std::uint64_t v) { s.cpu = static_cast<unsigned>(v); }},
-      {"RSCA_PRIORITY",
-       [](Schedule &s, std::uint64_t v) { s.priority = static_cast<std::uint32_t>(v); }},
-      {"RSCA_PERIOD_NS",
-       [](Schedule &s, std::uint64_t v) { s.period = std::chrono::nanoseconds(v); }},
-      {"RSCA_BUDGET_NS",
-       [](Schedule &s, std::uint64_t v) { s.budget = std::chrono::nanoseconds(v); }},
-      {"RSCA_DEADLINE_NS",
-       [](Schedule &s, std::uint64_t v) { s.deadline = std::chrono::nanoseconds(v); }},
-  };
-  auto field = kFields.find(key);
-  if (field == kFields.end())
-    return false;
-  std::uint64_t number = 0;
-  auto [end, ec] = std::from_chars(value.data(), value.data() + value.size(), number);
-  if (ec != std::errc() || end != value.data() + value.size())
-    return tl::unexpected(fmt::format("the exec parameter {} is not a number: \"{}\"", key, value));
-  if (!schedule)
-    schedule = Schedule{};
-  field->second(*schedule, number);
-  return true;
-}
-
 // Runs the process on the CPU admission chose, so that the analysis holds for what runs.
 void pin_to_cpu(unsigned cpu, spdlog::logger &log) {
   cpu_set_t set;
@@ -69,41 +40,6 @@ void pin_to_cpu(unsigned cpu, spdlog::logger &log) {
 }
 
 } // namespace
-
-tl::expected<ExecParams, std::string> parse_exec_params(int argc, const char *const *argv) {
-  ExecParams params;
-  if ((argc - 1) % 2 != 0)
-    return tl::unexpected(
-        fmt::format("exec parameters come in pairs: \"{}\" has no value", argv[argc - 1]));
-  for (int i = 1; i + 1 < argc; i += 2) {
-    const std::string key = argv[i];
-    std::string value = argv[i + 1];
-    if (key == "COMPONENT_IDENTIFIER")
-      params.identifier = std::move(value);
-    else if (key == "NAME_BINDING")
-      params.name_binding = std::move(value);
-    else if (key == "PROFILE_NAME")
-      params.profile = std::move(value);
-    else if (key == "DOMAIN_NAME")
-      params.domain = std::move(value);
-    else if (key == "APPLICATION")
-      params.application = std::move(value);
-    else if (key == "CONTROL_ADDRESS")
-      params.control_address = std::move(value);
-    else if (auto taken = take_schedule_param(key, value, params.schedule); !taken)
-      return tl::unexpected(taken.error());
-    else if (!*taken)
-      params.others.emplace_back(key, std::move(value));
-  }
-  for (const auto &[key, value] : {std::pair{"COMPONENT_IDENTIFIER", &params.identifier},
-                                   std::pair{"PROFILE_NAME", &params.profile},
-                                   std::pair{"CONTROL_ADDRESS", &params.control_address}})
-    if (value->empty())
-      return tl::unexpected(fmt::format("the exec parameter {} is missing", key));
-  if (params.name_binding.empty())
-    params.name_binding = params.identifier;
-  return params;
-}
 
 namespace {
 

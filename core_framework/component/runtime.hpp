@@ -21,6 +21,7 @@
 #include <tl/expected.hpp>
 
 #include "component/component.hpp"
+#include "protocol/exec_params.hpp"
 
 namespace rsca::component {
 
@@ -32,34 +33,11 @@ enum ExitStatus : int {
   kExitProfile = 3, // the profile cannot be loaded or does not fit the component
 };
 
-struct ExecParams {
-  std::string identifier;      // COMPONENT_IDENTIFIER (required)
-  std::string name_binding;    // NAME_BINDING (the identifier when absent)
-  std::string profile;         // PROFILE_NAME (required)
-  std::string domain;          // DOMAIN_NAME
-  std::string application;     // APPLICATION
-  std::string control_address; // CONTROL_ADDRESS (required)
-  std::vector<std::pair<std::string, std::string>> others; // execparam properties and the rest
-  std::optional<Schedule> schedule; // RSCA_CPU, RSCA_PRIORITY, RSCA_PERIOD_NS, ... (admission)
-};
-
-// The exec parameters of argv[1..], in pairs.
-tl::expected<ExecParams, std::string> parse_exec_params(int argc, const char *const *argv);
-
-// One component of a component host (run_component_host): its exec parameters and its library.
-struct HostedComponent {
-  ExecParams params;
-  std::filesystem::path library; // LIBRARY, as the SPD names it
-};
-
-struct HostParams {
-  std::string control_address; // the host's own: it serves its components' addresses too
-  std::vector<HostedComponent> components;
-};
-
-// A component host's exec parameters: CONTROL_ADDRESS <the host's>, then one group per
-// component, each starting with COMPONENT_IDENTIFIER and naming its LIBRARY.
-tl::expected<HostParams, std::string> parse_host_params(int argc, const char *const *argv);
+// The exec parameters (protocol/exec_params.hpp: made by the ApplicationFactory, read here).
+using protocol::ExecParams;
+using protocol::HostParams;
+using protocol::parse_exec_params;
+using protocol::parse_host_params;
 
 using Factory = std::function<std::unique_ptr<Component>(const Context &)>;
 int run_component(int argc, char **argv, const Factory &factory);

@@ -5,8 +5,8 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
-#include "common/dds_names.hpp"
 #include "ports.h" // generated from dds/ports.idl
+#include "protocol/topics.hpp"
 
 namespace rsca::control {
 namespace {
@@ -18,10 +18,6 @@ std::uint64_t now_ns() {
 }
 
 } // namespace
-
-std::string domain_events_topic(const std::string &domain) {
-  return fmt::format("rsca_{}_domain_events", dds_name(domain));
-}
 
 dds::Qos domain_events_qos() {
   auto qos = dds::make_qos();
@@ -38,7 +34,7 @@ dds::Qos domain_events_qos() {
 namespace {
 
 Expected<dds::Entity> events_topic(dds_entity_t participant, const std::string &domain) {
-  const std::string name = domain_events_topic(domain);
+  const std::string name = protocol::domain_events_topic(domain);
   auto qos = domain_events_qos();
   return dds::checked(dds_create_topic(participant, &rsca_port_PropertyEvent_desc, name.c_str(),
                                        qos.get(), nullptr),

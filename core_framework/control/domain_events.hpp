@@ -18,8 +18,7 @@
 
 namespace rsca::control {
 
-// The DDS topic of the domain's events.
-std::string domain_events_topic(const std::string &domain);
+// The DDS topic of the domain's events: protocol::domain_events_topic.
 
 // How many past events a late follower still receives.
 inline constexpr int kKeptDomainEvents = 64;

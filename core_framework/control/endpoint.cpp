@@ -24,26 +24,6 @@ namespace rsca::control {
 using namespace detail;
 using dds::Entity;
 
-std::string_view to_string(Status status) {
-  switch (status) {
-  case Status::Ok:
-    return "ok";
-  case Status::BadRequest:
-    return "bad request";
-  case Status::NotFound:
-    return "not found";
-  case Status::Failed:
-    return "failed";
-  case Status::Timeout:
-    return "timeout";
-  case Status::Unavailable:
-    return "unavailable";
-  case Status::Rejected:
-    return "rejected";
-  }
-  return "unknown";
-}
-
 Expected<void> Endpoint::Impl::create_entities() {
   const dds_entity_t pp = participant->get();
   auto make = [](dds_entity_t handle, std::string_view what, Entity &into) -> Expected<void> {
@@ -236,9 +216,13 @@ void Endpoint::Impl::take_replies() {
       if (!infos[i].valid_data)
         continue;
       const auto *r = static_cast<const rsca_ctl_Reply *>(samples[i]);
-      const auto status = static_cast<Status>(r->status);
-      if (status != Status::Ok) {
-        complete(str(r->id), call_error(status, str(r->error)));
+      if (r->status != static_cast<std::int32_t>(Status::Ok)) {
+        // A status this version does not know is a failure all the same, said as it came.
+        complete(str(r->id),
+                 protocol::is_known(r->status)
+                     ? call_error(static_cast<Status>(r->status), str(r->error))
+                     : call_error(Status::Failed,
+                                  fmt::format("status {}: {}", r->status, str(r->error))));
         continue;
       }
       Json body = parse_body(r->body);

@@ -23,37 +23,18 @@
 
 #include "common/diagnostic.hpp"
 #include "dds/participant.hpp"
+#include "protocol/status.hpp"
 
 namespace rsca::control {
 
 using Json = nlohmann::json;
 
-// Why a call failed. Travels in replies, so the values are part of the wire protocol.
-enum class Status : std::int32_t {
-  Ok = 0,
-  BadRequest = 1,  // the request makes no sense (unknown operation, malformed body)
-  NotFound = 2,    // the thing named does not exist
-  Failed = 3,      // the operation was tried and failed; the message says where and why
-  Timeout = 4,     // no reply before the deadline
-  Unavailable = 5, // nobody at the address, or the endpoint is shutting down
-  Rejected = 6,    // refused by policy (admission control, conflicting state)
-};
-std::string_view to_string(Status status);
-
-struct CallError {
-  Status status = Status::Failed;
-  std::string message;
-  // The addressee was there when the request was sent and may have acted on it: an Unavailable
-  // call whose addressee left DDS before it replied, as opposed to one nobody ever served.
-  bool maybe_received = false;
-};
-
-template <typename T>
-using CallResult = tl::expected<T, CallError>;
-
-inline tl::unexpected<CallError> call_error(Status status, std::string message) {
-  return tl::unexpected(CallError{status, std::move(message)});
-}
+// Why a call failed: the runtime error type (protocol/status.hpp), used under these names here.
+using protocol::call_error;
+using protocol::CallError;
+using protocol::CallResult;
+using protocol::Status;
+using protocol::to_string;
 
 struct RequestContext {
   std::string id;

@@ -22,15 +22,16 @@
 #include "control/partition_writers.hpp"
 #include "control/worker_pool.hpp"
 #include "dds/entity.hpp"
+#include "protocol/topics.hpp"
 
 namespace rsca::control {
 using Clock = std::chrono::steady_clock;
 
 namespace detail {
 
-inline constexpr const char *kRequestTopic = "rsca_ctl_Request";
-inline constexpr const char *kReplyTopic = "rsca_ctl_Reply";
-inline constexpr const char *kAnnouncementTopic = "rsca_ctl_Announcement";
+using protocol::kAnnouncementTopic;
+using protocol::kReplyTopic;
+using protocol::kRequestTopic;
 inline constexpr std::uint32_t kTakeBatch = 64;
 // How often the receive thread looks, while calls are under way, for addressees that left DDS.
 inline constexpr auto kDepartureCheck = std::chrono::milliseconds(200);
@@ -70,10 +71,13 @@ inline Json reply_json(const CallResult<Json> &result) {
 }
 
 inline CallResult<Json> result_of(const Json &reply) {
-  const auto status = static_cast<Status>(reply.value("status", 3));
-  if (status != Status::Ok)
-    return call_error(status, reply.value("error", std::string("no reason given")));
-  return reply.value("body", Json::object());
+  const auto status = reply.value("status", static_cast<std::int32_t>(Status::Failed));
+  if (status == static_cast<std::int32_t>(Status::Ok))
+    return reply.value("body", Json::object());
+  const auto error = reply.value("error", std::string("no reason given"));
+  if (!protocol::is_known(status))
+    return call_error(Status::Failed, fmt::format("status {}: {}", status, error));
+  return call_error(static_cast<Status>(status), error);
 }
 
 // Runs a handler. A request is untrusted: a handler that reads a field of the wrong type (JSON's

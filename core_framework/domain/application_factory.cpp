@@ -14,9 +14,13 @@
 
 #include "common/dds_names.hpp"
 #include "common/elapsed.hpp"
+#include "control/operation.hpp"
 #include "dds/port_qos.hpp"
 #include "profile/property_binding.hpp"
 #include "profile/property_json.hpp"
+#include "protocol/component_ops.hpp"
+#include "protocol/exec_params.hpp"
+#include "protocol/topics.hpp"
 
 namespace rsca::domain {
 namespace {
@@ -34,6 +38,12 @@ struct Call {
   std::string what; // for messages: "Producer_1"
 };
 
+// A call of operation `Op` (protocol/): its request typed, its `what` for messages.
+template <control::Operation Op>
+Call call_of(std::string target, const typename Op::Request &request, std::string what) {
+  return {std::move(target), std::string(Op::name), protocol::encode(request), std::move(what)};
+}
+
 // Makes every call at once and waits for all of them; each result in the order of the calls.
 // The components of one host get theirs in one request (control::Endpoint::call_all).
 std::vector<CallResult<Json>> call_each_of(control::Endpoint &endpoint,
@@ -47,8 +57,9 @@ std::vector<CallResult<Json>> call_each_of(control::Endpoint &endpoint,
 }
 
 // The first failure among `results`, prefixed with its call's `what`.
+template <typename T>
 CallResult<void> first_failure(const std::vector<Call> &calls,
-                               const std::vector<CallResult<Json>> &results) {
+                               const std::vector<CallResult<T>> &results) {
   for (std::size_t i = 0; i < results.size(); ++i)
     if (!results[i])
       return control::call_error(results[i].error().status,
@@ -79,48 +90,12 @@ bool is_execparam_only(const profile::PropertyDefinition &d) {
 
 } // namespace
 
-std::string ApplicationFactory::topic_name(const std::string &domain, const std::string &app,
-                                           const std::string &connection) {
-  return fmt::format("rsca_{}_{}_{}", dds_name(domain), dds_name(app), dds_name(connection));
-}
-
-std::string to_string(const LaunchIdentity &launch) {
-  return fmt::format("{}.{}", launch.incarnation, launch.number);
-}
-
-// Addresses are DOMAIN/component/APP.INCARNATION.NUMBER/INSTANCE and
-// DOMAIN/host/APP.INCARNATION.NUMBER/DEVICE (see build_components); the application's name may
-// itself hold dots, the launch's two numbers never do.
-std::optional<std::uint64_t> incarnation_of(std::string_view address) {
-  for (std::string_view kind : {"/component/", "/host/"}) {
-    const auto at = address.find(kind);
-    if (at == std::string_view::npos)
-      continue;
-    std::string_view launch = address.substr(at + kind.size());
-    launch = launch.substr(0, launch.find('/'));
-    const auto last = launch.rfind('.');
-    if (last == std::string_view::npos || last == 0)
-      return std::nullopt;
-    const auto before = launch.rfind('.', last - 1);
-    if (before == std::string_view::npos)
-      return std::nullopt;
-    const std::string_view number = launch.substr(before + 1, last - before - 1);
-    std::uint64_t incarnation = 0;
-    const auto [end, ec] =
-        std::from_chars(number.data(), number.data() + number.size(), incarnation);
-    if (ec != std::errc() || end != number.data() + number.size())
-      return std::nullopt;
-    return incarnation;
-  }
-  return std::nullopt;
-}
-
 // The state of one launch, step by step, and how to undo it.
 class ApplicationFactory::Launch {
 public:
   Launch(const DomainServices &services, const LaunchRequest &request, const ProgressSink &progress)
       : s_(services), request_(request), progress_(progress), app_(std::make_shared<Application>()),
-        launch_(to_string(s_.next_launch ? s_.next_launch() : LaunchIdentity{})) {
+        launch_(s_.next_launch ? s_.next_launch() : LaunchIdentity{}) {
     app_->name = request.name;
     app_->installed = request.installed;
     app_->profile = request.profile;
@@ -274,41 +249,50 @@ private:
         s_.endpoint->route(c.address, c.host);
       s_.endpoint->prepare(c.address);
     }
-    std::vector<Call> calls;
-    std::vector<std::vector<std::size_t>> started_by; // per call, the components it starts
-    std::map<std::string, std::size_t> host_calls;    // by device
+    std::vector<protocol::node::ExecuteRequest> requests;
+    std::vector<std::pair<std::string, std::string>> to; // per request: its node and its `what`
+    std::vector<std::vector<std::size_t>> started_by;    // per request, the components it starts
+    std::map<std::string, std::size_t> host_of;          // by device: its host's request
+    std::map<std::size_t, protocol::HostParams> hosts;   // by request
     for (std::size_t i = 0; i < app_->components.size(); ++i) {
       const auto &c = app_->components[i];
       auto node = s_.node_address(c.node);
       if (!node)
         return control::call_error(Status::Unavailable, fmt::format("node {} is gone", c.node));
       if (!is_hosted(c)) {
-        calls.push_back({*node, "node.execute", execute_body(c), c.id});
+        requests.push_back(execute_request(c));
+        to.emplace_back(*node, c.id);
         started_by.push_back({i});
         continue;
       }
-      auto [host, fresh] = host_calls.try_emplace(c.device, calls.size());
+      auto [host, fresh] = host_of.try_emplace(c.device, requests.size());
       if (fresh) {
-        calls.push_back({*node, "node.execute", host_body(c),
-                         fmt::format("the component host on {}", c.device)});
+        requests.push_back(host_request(c));
+        to.emplace_back(*node, fmt::format("the component host on {}", c.device));
         started_by.emplace_back();
+        hosts[host->second].control_address = c.host;
       }
-      auto &args = calls[host->second].body["args"];
-      for (auto &arg : hosted_args(c))
-        args.push_back(std::move(arg));
+      hosts[host->second].components.push_back(exec_params(c));
       started_by[host->second].push_back(i);
     }
+    for (const auto &[k, params] : hosts)
+      requests[k].args = protocol::to_args(params);
+    std::vector<Call> calls;
+    for (std::size_t k = 0; k < requests.size(); ++k)
+      calls.push_back(call_of<protocol::node::Execute>(to[k].first, requests[k], to[k].second));
     auto replies = call_each_of(*s_.endpoint, calls, s_.call_timeout);
     // Record every process that did start, even when another failed, so rollback finds it.
+    std::vector<CallResult<protocol::node::ExecuteReply>> started;
     for (std::size_t k = 0; k < calls.size(); ++k) {
-      if (!replies[k] || !replies[k]->contains("pid"))
+      started.push_back(control::reply_of<protocol::node::Execute>(std::move(replies[k])));
+      if (!started.back())
         continue;
       for (auto i : started_by[k]) {
-        app_->components[i].pid = (*replies[k])["pid"].get<long>();
+        app_->components[i].pid = started.back()->pid;
         app_->components[i].state = "executed";
       }
     }
-    if (auto ok = first_failure(calls, replies); !ok)
+    if (auto ok = first_failure(calls, started); !ok)
       return ok;
     detail_ = fmt::format("{} processes for {} components", calls.size(), app_->components.size());
     return {};
@@ -328,7 +312,7 @@ private:
   }
 
   CallResult<void> initialize() {
-    return call_each("component.initialize", [](auto &) { return Json::object(); });
+    return call_each<protocol::component::Initialize>([](auto &) { return protocol::Empty{}; });
   }
 
   CallResult<void> configure() {
@@ -349,8 +333,8 @@ private:
         }
         if (properties.empty())
           continue;
-        calls.push_back({component_of(ci.id)->address, "component.configure",
-                         Json{{"properties", properties}}, ci.id});
+        calls.push_back(call_of<protocol::component::Configure>(component_of(ci.id)->address,
+                                                                {std::move(properties)}, ci.id));
       }
     }
     detail_ = fmt::format("{} components configured", calls.size());
@@ -367,7 +351,7 @@ private:
       ci.qos = dds::qos_to_json(c.qos.value_or(profile::ConnectionQos{}));
       ci.topic = c.publishes_to_channel() || c.subscribes_to_channel()
                      ? s_.channels->topic_of(channel_name(c))
-                     : topic_name(s_.domain_name, fmt::format("{}_{}", app_->name, launch_), ci.id);
+                     : protocol::connection_topic(s_.domain_name, app_->name, launch_, ci.id);
       ci.filter = c.filter.value_or("");
       ci.repid = repid_of(c);
       auto uses = resolve_end(ci, c.uses.target, c.uses.port, profile::PortDirection::Uses);
@@ -449,16 +433,16 @@ private:
                                        const std::string &port, profile::PortDirection direction) {
     const auto wanted = profile::to_string(direction);
     auto ports = s_.device_ports ? s_.device_ports(device) : std::nullopt;
-    const Json *found = nullptr;
+    const protocol::node::DevicePort *found = nullptr;
     if (ports)
       for (const auto &p : ports->ports)
-        if (p.value("name", "") == port && p.value("direction", "") == wanted)
+        if (p.name == port && p.direction == wanted)
           found = &p;
     if (found == nullptr)
       return control::call_error(
           Status::BadRequest,
           fmt::format("connection {}: device {} has no {} port {}", ci.id, device, wanted, port));
-    const std::string repid = found->value("repid", "");
+    const std::string repid = found->repid;
     if (ci.repid.empty())
       ci.repid = repid;
     if (repid != ci.repid)
@@ -473,12 +457,13 @@ private:
   // member: this application's members on the other side), so that nothing a component writes
   // once started is lost to discovery still under way.
   CallResult<void> await_matched() {
-    std::map<std::string, Json> awaited; // by address
+    std::map<std::string, protocol::component::AwaitMatchedRequest> awaited; // by address
     auto await = [&](const ConnectionInstance &ci, const ConnectionEnd &end, int peers) {
       if (end.empty() || peers == 0)
         return;
-      awaited[end.address].push_back(
-          {{"port", end.port}, {"connection", end_key(ci, end)}, {"peers", peers}});
+      auto &request = awaited[end.address];
+      request.timeout_ms = s_.call_timeout.count();
+      request.connections.push_back({end.port, end_key(ci, end), peers, 0});
     };
     for (const auto &ci : app_->connections) {
       if (ci.is_interface())
@@ -488,20 +473,21 @@ private:
       await(ci, ci.provides, channel ? members_on(ci.topic, /*subscribers=*/false) : 1);
     }
     std::vector<Call> calls;
-    for (auto &[address, connections] : awaited)
-      calls.push_back({address, "component.await_matched",
-                       Json{{"connections", connections}, {"timeout_ms", s_.call_timeout.count()}},
-                       address});
+    for (auto &[address, request] : awaited)
+      calls.push_back(call_of<protocol::component::AwaitMatched>(address, request, address));
     auto replies = call_each_of(*s_.endpoint, calls, 2 * s_.call_timeout);
     if (auto ok = first_failure(calls, replies); !ok)
       return ok;
     std::vector<std::string> unmatched;
-    for (const auto &reply : replies)
-      for (const auto &c : reply->value("connections", Json::array()))
-        if (c.value("matched", 0) < c.value("peers", 1))
-          unmatched.push_back(fmt::format("{} on port {}: {} of {} peers matched",
-                                          c.value("connection", ""), c.value("port", ""),
-                                          c.value("matched", 0), c.value("peers", 1)));
+    for (auto &raw : replies) {
+      auto reply = control::reply_of<protocol::component::AwaitMatched>(std::move(raw));
+      if (!reply)
+        return tl::unexpected(reply.error());
+      for (const auto &c : reply->connections)
+        if (c.matched < c.peers)
+          unmatched.push_back(fmt::format("{} on port {}: {} of {} peers matched", c.connection,
+                                          c.port, c.matched, c.peers));
+    }
     if (!unmatched.empty())
       return control::call_error(Status::Unavailable,
                                  fmt::format("connections not matched after {} ms: {}",
@@ -529,37 +515,40 @@ private:
 
   // --- helpers ---
 
-  template <typename Body>
-  CallResult<void> call_each(const std::string &operation, Body body) {
+  template <control::Operation Op, typename Request>
+  CallResult<void> call_each(Request request) {
     std::vector<Call> calls;
     for (auto &c : app_->components)
-      calls.push_back({c.address, operation, body(c), c.id});
+      calls.push_back(call_of<Op>(c.address, request(c), c.id));
     return call_all(*s_.endpoint, calls, s_.call_timeout);
   }
 
   Call connect_call(const ConnectionInstance &ci, const ConnectionEnd &end, const char *direction) {
-    return {end.address, "component.connect",
-            Json{{"connection", end_key(ci, end)},
-                 {"port", end.port},
-                 {"direction", direction},
-                 {"topic", ci.topic},
-                 {"repid", ci.repid},
-                 {"qos", ci.qos},
-                 {"filter", std::string_view(direction) == "provides" ? ci.filter : ""},
-                 {"local", in_one_host(ci)}},
-            fmt::format("{} ({})", ci.id, end.name())};
+    protocol::component::ConnectRequest request;
+    request.connection = end_key(ci, end);
+    request.port = end.port;
+    request.direction = direction;
+    request.topic = ci.topic;
+    request.repid = ci.repid;
+    request.qos = ci.qos;
+    request.filter = std::string_view(direction) == "provides" ? ci.filter : "";
+    request.local = in_one_host(ci);
+    return call_of<protocol::component::Connect>(end.address, request,
+                                                 fmt::format("{} ({})", ci.id, end.name()));
   }
 
   // A uses port's connection to a component's supported interface: it calls the component's
   // control address.
   Call interface_call(const ConnectionInstance &ci) {
-    return {ci.uses.address, "component.connect",
-            Json{{"connection", end_key(ci, ci.uses)},
-                 {"port", ci.uses.port},
-                 {"direction", "uses"},
-                 {"repid", ci.repid},
-                 {"target", ci.provides.address}},
-            fmt::format("{} ({} -> {})", ci.id, ci.uses.name(), ci.provides.name())};
+    protocol::component::ConnectRequest request;
+    request.connection = end_key(ci, ci.uses);
+    request.port = ci.uses.port;
+    request.direction = "uses";
+    request.repid = ci.repid;
+    request.target = ci.provides.address;
+    return call_of<protocol::component::Connect>(
+        ci.uses.address, request,
+        fmt::format("{} ({} -> {})", ci.id, ci.uses.name(), ci.provides.name()));
   }
 
   // Both ends are components of one component host: the connection bypasses DDS.
@@ -594,66 +583,49 @@ private:
     return {};
   }
 
-  // The exec parameters of a component (component/runtime.hpp).
-  std::vector<std::string> component_args(const ComponentInstance &c) const {
-    std::vector<std::string> args = {
-        "COMPONENT_IDENTIFIER", c.id,       "NAME_BINDING",    c.usage_name,
-        "PROFILE_NAME",         c.spd,      "DOMAIN_NAME",     s_.domain_name,
-        "APPLICATION",          app_->name, "CONTROL_ADDRESS", c.address};
-    append_execparams(c, args);
-    if (const auto *placement = placement_of(c.id); placement->schedule)
-      append_schedule(*placement->schedule, args);
-    return args;
+  // The exec parameters of a component (protocol/exec_params.hpp); a hosted one's name the
+  // library its host loads, as the SPD names it (the host resolves it, as a GPP resolves an
+  // entry point).
+  protocol::ExecParams exec_params(const ComponentInstance &c) const {
+    protocol::ExecParams p;
+    p.identifier = c.id;
+    p.name_binding = c.usage_name;
+    p.profile = c.spd;
+    p.domain = s_.domain_name;
+    p.application = app_->name;
+    p.control_address = c.address;
+    const auto *placement = placement_of(c.id);
+    if (is_hosted(c))
+      p.library = placement->implementation->code.file.name;
+    if (const auto &s = placement->schedule)
+      p.schedule = protocol::Schedule{s->cpu, s->priority, s->period, s->budget, s->deadline};
+    p.others = execparams(c);
+    return p;
   }
 
   static bool is_hosted(const ComponentInstance &c) { return !c.host.empty(); }
 
-  Json execute_body(const ComponentInstance &c) const {
+  protocol::node::ExecuteRequest execute_request(const ComponentInstance &c) const {
     const auto *impl = placement_of(c.id)->implementation;
     const auto spd_dir = std::filesystem::path(c.spd).parent_path();
-    return Json{{"application", app_->name},
-                {"component", c.id},
-                {"device", c.device},
-                {"entrypoint",
-                 impl->code.entrypoint.empty() ? impl->code.file.name : impl->code.entrypoint},
-                {"spd_dir", spd_dir.string()},
-                {"args", component_args(c)}};
+    return {app_->name,
+            c.id,
+            c.device,
+            impl->code.entrypoint.empty() ? impl->code.file.name : impl->code.entrypoint,
+            spd_dir.string(),
+            protocol::to_args(exec_params(c))};
   }
 
-  // A component host's process at its own address; the components it hosts add their exec
-  // parameters.
-  Json host_body(const ComponentInstance &first) const {
-    return Json{{"application", app_->name},
-                {"component", fmt::format("ComponentHost_{}", first.device)},
-                {"device", first.device},
-                {"entrypoint", "rsca-component-host"},
-                {"spd_dir", ""},
-                {"args", Json::array({"CONTROL_ADDRESS", first.host})}};
+  // A component host's process at its own address; its components' exec parameters follow.
+  protocol::node::ExecuteRequest host_request(const ComponentInstance &first) const {
+    return {app_->name,   fmt::format("ComponentHost_{}", first.device),
+            first.device, "rsca-component-host",
+            "",           {}};
   }
 
-  // A hosted component's exec parameters: its own and the library the host loads, as the SPD
-  // names it (the host resolves it, as a GPP resolves an entry point).
-  std::vector<std::string> hosted_args(const ComponentInstance &c) const {
-    auto args = component_args(c);
-    args.emplace_back("LIBRARY");
-    args.push_back(placement_of(c.id)->implementation->code.file.name);
-    return args;
-  }
-
-  // What timing admission decided, for the component to run by (component/runtime.hpp).
-  static void append_schedule(const allocator::Schedule &s, std::vector<std::string> &args) {
-    for (const auto &[key, value] :
-         {std::pair{"RSCA_CPU", static_cast<std::int64_t>(s.cpu)},
-          std::pair{"RSCA_PRIORITY", static_cast<std::int64_t>(s.priority)},
-          std::pair{"RSCA_PERIOD_NS", static_cast<std::int64_t>(s.period.count())},
-          std::pair{"RSCA_BUDGET_NS", static_cast<std::int64_t>(s.budget.count())},
-          std::pair{"RSCA_DEADLINE_NS", static_cast<std::int64_t>(s.deadline.count())}}) {
-      args.emplace_back(key);
-      args.push_back(std::to_string(value));
-    }
-  }
-
-  void append_execparams(const ComponentInstance &c, std::vector<std::string> &args) const {
+  // The component's execparam-only properties, as its SAD instantiation sets them.
+  std::vector<std::pair<std::string, std::string>> execparams(const ComponentInstance &c) const {
+    std::vector<std::pair<std::string, std::string>> out;
     const profile::ComponentPlacement *placement = nullptr;
     const auto *ci = instantiation_of(c.id, &placement);
     const auto *pkg = request_.profile->softpkg_of(*placement);
@@ -661,11 +633,10 @@ private:
       const auto *definition = pkg->find_property(profile::refid_of(ref));
       if (definition == nullptr || !is_execparam_only(*definition))
         continue;
-      if (auto value = profile::bind_property(*definition, ref)) {
-        args.push_back(profile::refid_of(ref));
-        args.push_back(profile::format_value(*value));
-      }
+      if (auto value = profile::bind_property(*definition, ref))
+        out.emplace_back(profile::refid_of(ref), profile::format_value(*value));
     }
+    return out;
   }
 
   const allocator::Placement *placement_of(const std::string &instance) const {
@@ -707,10 +678,9 @@ private:
       c.node = p.node;
       c.device = p.device;
       c.implementation = p.implementation->id;
-      c.address =
-          fmt::format("{}/component/{}.{}/{}", s_.domain_name, app_->name, launch_, p.instance);
+      c.address = protocol::component_address(s_.domain_name, app_->name, launch_, p.instance);
       if (p.implementation->code.type == profile::CodeType::SharedLibrary)
-        c.host = fmt::format("{}/host/{}.{}/{}", s_.domain_name, app_->name, launch_, p.device);
+        c.host = protocol::host_address(s_.domain_name, app_->name, launch_, p.device);
       c.spd = request_.profile->softpkg_of(*placement)->spd_path.string();
       c.start_order = ci->start_order.value_or(UINT32_MAX);
       c.assembly_controller = sad.assembly_controller == ci->id;
@@ -790,7 +760,7 @@ private:
   std::shared_ptr<Application> app_;
   bool allocated_ = false;
   bool joined_channels_ = false;
-  std::string launch_; // LaunchIdentity as addresses and topics carry it
+  LaunchIdentity launch_; // addresses and topics carry it
   std::string detail_;
 };
 
@@ -834,7 +804,7 @@ CallResult<void> ApplicationFactory::start(const Application &app, const ApplyCh
     std::vector<Call> calls;
     std::vector<std::string> ids;
     for (; group != end; ++group) {
-      calls.push_back({(*group)->address, "component.start", Json::object(), (*group)->id});
+      calls.push_back(call_of<protocol::component::Start>((*group)->address, {}, (*group)->id));
       ids.push_back((*group)->id);
     }
     if (auto ok = call_all(*services_.endpoint, calls, services_.call_timeout); !ok)
@@ -850,7 +820,7 @@ CallResult<void> ApplicationFactory::stop(const Application &app, const ApplyCha
   std::vector<std::string> ids;
   for (const auto &c : app.components)
     if (!exited(c)) {
-      calls.push_back({c.address, "component.stop", Json::object(), c.id});
+      calls.push_back(call_of<protocol::component::Stop>(c.address, {}, c.id));
       ids.push_back(c.id);
     }
   const auto replies = call_each_of(*services_.endpoint, calls, services_.call_timeout);
@@ -872,9 +842,9 @@ void ApplicationFactory::disconnect_devices(const Application &app) {
   for (const auto &ci : app.connections)
     for (const auto *end : {&ci.uses, &ci.provides})
       if (!end->device.empty())
-        calls.push_back({end->address, "component.disconnect",
-                         Json{{"connection", end_key(ci, *end)}, {"port", end->port}},
-                         fmt::format("{} ({})", ci.id, end->name())});
+        calls.push_back(
+            call_of<protocol::component::Disconnect>(end->address, {end_key(ci, *end), end->port},
+                                                     fmt::format("{} ({})", ci.id, end->name())));
   const auto replies = call_each_of(*services_.endpoint, calls, services_.call_timeout);
   for (std::size_t i = 0; i < replies.size(); ++i)
     if (!replies[i])
@@ -887,7 +857,7 @@ CallResult<std::vector<std::string>> ApplicationFactory::release(Application &ap
   std::vector<Call> releases;
   for (auto &c : app.components)
     if (c.pid != 0 && services_.components->registered(c.address))
-      releases.push_back({c.address, "component.release", Json::object(), c.id});
+      releases.push_back(call_of<protocol::component::Release>(c.address, {}, c.id));
   const auto released = call_each_of(*services_.endpoint, releases, services_.call_timeout);
   std::vector<std::string> unconfirmed;
   for (std::size_t i = 0; i < released.size(); ++i) {
@@ -905,7 +875,7 @@ CallResult<std::vector<std::string>> ApplicationFactory::release(Application &ap
       continue;
     auto node = services_.node_address(c.node);
     if (node)
-      terminations.push_back({*node, "node.terminate", Json{{"pid", c.pid}}, c.id});
+      terminations.push_back(call_of<protocol::node::Terminate>(*node, {c.pid}, c.id));
   }
   auto terminated = call_each_of(*services_.endpoint, terminations, services_.call_timeout);
   for (auto &c : app.components) {

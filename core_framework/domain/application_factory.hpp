@@ -18,6 +18,8 @@
 #include "domain/application.hpp"
 #include "domain/component_registry.hpp"
 #include "domain/event_channel_manager.hpp"
+#include "protocol/addresses.hpp"
+#include "protocol/node_ops.hpp"
 
 namespace rsca::domain {
 
@@ -43,20 +45,12 @@ struct LaunchRequest {
 // A device's data ports as its node announced them.
 struct DevicePorts {
   std::string address;
-  nlohmann::json ports; // [{"name", "direction", "repid"}]
+  std::vector<protocol::node::DevicePort> ports;
 };
 
 // A launch's identity: the domain daemon's incarnation (counted in its store, one more at each
-// start) and the launch's number within it.
-struct LaunchIdentity {
-  std::uint64_t incarnation = 0;
-  std::uint64_t number = 0;
-};
-// "INCARNATION.NUMBER", as component addresses and topics carry it.
-std::string to_string(const LaunchIdentity &launch);
-// The incarnation of the domain daemon that launched the component or component host at
-// `address`; nothing when the address is not one a launch makes.
-std::optional<std::uint64_t> incarnation_of(std::string_view address);
+// start) and the launch's number within it (protocol/addresses.hpp).
+using protocol::LaunchIdentity;
 
 // What the factory uses of the domain.
 struct DomainServices {
@@ -92,10 +86,6 @@ public:
   // component that does not confirm its release is terminated by its node all the same, and
   // named in the result.
   control::CallResult<std::vector<std::string>> release(Application &app);
-
-  // The DDS topic of one connection: unique per domain, application instance and connection.
-  static std::string topic_name(const std::string &domain, const std::string &app,
-                                const std::string &connection);
 
 private:
   class Launch;

@@ -3,9 +3,11 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
-#include "common/dds_names.hpp"
 #include "common/names.hpp"
+#include "control/operation.hpp"
 #include "dds/port_qos.hpp"
+#include "protocol/component_ops.hpp"
+#include "protocol/topics.hpp"
 
 namespace rsca::domain {
 
@@ -100,16 +102,23 @@ CallResult<void> ConnectionManager::wire(RuntimeConnection &c) {
     return {};
   }
   c.repid = uses->repid;
-  auto body = [&](const ResolvedEnd &end, const char *direction) {
-    return Json{{"connection", c.id}, {"port", end.port}, {"direction", direction},
-                {"topic", c.topic},   {"repid", c.repid}, {"qos", c.qos}};
+  auto request = [&](const ResolvedEnd &end, const char *direction) {
+    protocol::component::ConnectRequest r;
+    r.connection = c.id;
+    r.port = end.port;
+    r.direction = direction;
+    r.topic = c.topic;
+    r.repid = c.repid;
+    r.qos = c.qos;
+    return r;
   };
+  using Connect = protocol::component::Connect;
   // The reader first, so that the first samples written find it.
-  auto provided = endpoint_->call_sync(provides->address, "component.connect",
-                                       body(*provides, "provides"), timeout_);
-  auto used = provided ? endpoint_->call_sync(uses->address, "component.connect",
-                                              body(*uses, "uses"), timeout_)
-                       : provided;
+  auto provided = control::call<Connect>(*endpoint_, provides->address,
+                                         request(*provides, "provides"), timeout_);
+  auto used =
+      provided ? control::call<Connect>(*endpoint_, uses->address, request(*uses, "uses"), timeout_)
+               : provided;
   if (!provided || !used) {
     if (provided)
       unwire_end(c, *provides);
@@ -125,8 +134,8 @@ CallResult<void> ConnectionManager::wire(RuntimeConnection &c) {
 }
 
 void ConnectionManager::unwire_end(const RuntimeConnection &c, const ResolvedEnd &end) {
-  if (auto ok = endpoint_->call_sync(end.address, "component.disconnect",
-                                     Json{{"connection", c.id}, {"port", end.port}}, timeout_);
+  if (auto ok = control::call<protocol::component::Disconnect>(*endpoint_, end.address,
+                                                               {c.id, end.port}, timeout_);
       !ok)
     spdlog::warn("runtime connection {}: disconnecting {} failed: {}", c.id, end.address,
                  ok.error().message);
@@ -151,7 +160,7 @@ CallResult<RuntimeConnection> ConnectionManager::connect(const PortRef &uses,
     if (connections_.count(c.id) != 0)
       return control::call_error(Status::Rejected, fmt::format("a connection {} exists", c.id));
   }
-  c.topic = fmt::format("rsca_{}_runtime_{}", dds_name(domain_), dds_name(c.id));
+  c.topic = protocol::runtime_connection_topic(domain_, c.id);
   if (auto ok = wire(c); !ok)
     return tl::unexpected(ok.error());
   if (!c.connected())

@@ -8,7 +8,9 @@
 
 #include "allocator/plan_json.hpp"
 #include "common/names.hpp"
+#include "control/operation.hpp"
 #include "domain/domain_manager_impl.hpp"
+#include "protocol/component_ops.hpp"
 
 namespace rsca::domain {
 namespace {
@@ -16,33 +18,35 @@ namespace {
 using control::Json;
 using control::Status;
 
-// One end's live state from its owner's status (by address): {"matched", "samples",
-// "filtered"}, or null.
-Json end_state(const std::map<std::string, Json> &status_of, const std::string &address,
-               const std::string &port_name, const std::string &connection) {
+using StatusOf = std::map<std::string, protocol::component::StatusReply>; // by address
+
+// One end's live state from its owner's status: {"matched", "samples", "filtered", ...}, or
+// null.
+Json end_state(const StatusOf &status_of, const std::string &address, const std::string &port_name,
+               const std::string &connection) {
   auto it = status_of.find(address);
   if (address.empty() || it == status_of.end())
     return nullptr;
-  for (const auto &port : it->second.value("ports", Json::array())) {
-    if (port.value("name", "") != port_name)
+  for (const auto &port : it->second.ports) {
+    if (port.name != port_name)
       continue;
-    for (const auto &c : port.value("connections", Json::array())) {
-      if (c.value("connection", "") != connection)
+    for (const auto &c : port.connections) {
+      if (c.connection != connection)
         continue;
-      if (c.contains("calls"))
-        return Json{{"calls", c.value("calls", 0)}}; // a caller of a supported interface
-      return Json{{"matched", c.value("matched", 0)},
-                  {"samples", c.value("samples", 0)},
-                  {"filtered", c.value("filtered", 0)},
-                  {"deadline_missed", c.value("deadline_missed", 0)},
-                  {"in_host", c.value("in_host", false)}};
+      if (c.calls)
+        return Json{{"calls", *c.calls}}; // a caller of a supported interface
+      return Json{{"matched", c.matched.value_or(0)},
+                  {"samples", c.samples.value_or(0)},
+                  {"filtered", c.filtered.value_or(0)},
+                  {"deadline_missed", c.deadline_missed.value_or(0)},
+                  {"in_host", c.in_host.value_or(false)}};
     }
   }
   return nullptr;
 }
 
 Json connection_json(const Application &app, const ConnectionInstance &c,
-                     const std::map<std::string, Json> &status_of) {
+                     const StatusOf &status_of) {
   auto state = [&](const ConnectionEnd &e) {
     return end_state(status_of, e.address, e.port, end_key(c, e));
   };
@@ -58,17 +62,17 @@ Json connection_json(const Application &app, const ConnectionInstance &c,
           {"provides_state", state(c.provides)}};
 }
 
-Json device_ids(const Json &node_body) {
+Json device_ids(const protocol::node::NodeAnnouncement &node) {
   Json ids = Json::array();
-  for (const auto &d : node_body.value("devices", Json::array()))
-    ids.push_back(d.value("id", ""));
+  for (const auto &d : node.devices)
+    ids.push_back(d.id);
   return ids;
 }
 
-std::vector<allocator::Device> devices_of(const std::string &node, const Json &body) {
+std::vector<allocator::Device> devices_of(const protocol::node::NodeAnnouncement &node) {
   std::vector<allocator::Device> devices;
-  for (const auto &d : body.value("devices", Json::array()))
-    devices.push_back(allocator::device_from_announcement(node, d));
+  for (const auto &d : node.devices)
+    devices.push_back(allocator::device_from_announcement(node.node, protocol::encode(d)));
   return devices;
 }
 
@@ -122,30 +126,38 @@ void DomainManager::Impl::on_announcement(const control::AnnouncementEvent &even
   node_gone(event.address);
 }
 
+// A node's announcement is untrusted like any message: one that does not fit the contract is
+// not taken (its devices would be guesses), and said so.
 void DomainManager::Impl::node_alive(const control::AnnouncementEvent &event) {
-  const std::string node = event.body.value("node", event.address);
-  allocator.set_node_devices(node, devices_of(node, event.body));
-  std::lock_guard lock(nodes_mutex);
-  const bool known = nodes.count(node) != 0;
-  nodes[node] = {node, event.address, event.body};
-  runtime_connections->endpoints_changed(); // connections waiting for its devices
-  if (known)
+  auto announced = protocol::decode<protocol::node::NodeAnnouncement>(event.body);
+  if (!announced) {
+    spdlog::warn("node at {}: its announcement is not taken: {}", excerpt(event.address),
+                 announced.error());
     return;
-  spdlog::info("node {} registered with {} device(s)", node,
-               event.body.value("devices", Json::array()).size());
-  events->publish("node.added", {{"node", node}, {"devices", device_ids(event.body)}});
+  }
+  const std::string node = announced->node;
+  const auto devices = announced->devices.size();
+  allocator.set_node_devices(node, devices_of(*announced));
+  const Json ids = device_ids(*announced);
+  const bool fresh = nodes.alive(event.address, std::move(*announced));
+  runtime_connections->endpoints_changed(); // connections waiting for its devices
+  if (!fresh)
+    return;
+  spdlog::info("node {} registered with {} device(s)", node, devices);
+  events->publish("node.added", {{"node", node}, {"devices", ids}});
 }
 
 void DomainManager::Impl::node_gone(const std::string &address) {
-  std::lock_guard lock(nodes_mutex);
-  unknown.erase(address); // an unknown component that went away
-  auto it = std::find_if(nodes.begin(), nodes.end(),
-                         [&](const auto &n) { return n.second.address == address; });
-  if (it == nodes.end())
+  {
+    std::lock_guard lock(unknown_mutex);
+    unknown.erase(address); // an unknown component that went away
+  }
+  auto gone = nodes.gone(address);
+  if (!gone)
     return;
-  const std::string node = it->first;
+  const std::string node = gone->announcement.node;
   spdlog::warn("node {} is gone; its devices leave the domain", node);
-  events->publish("node.removed", {{"node", node}, {"devices", device_ids(it->second.body)}});
+  events->publish("node.removed", {{"node", node}, {"devices", device_ids(gone->announcement)}});
   allocator.remove_node(node);
   // Its component processes died with it (they cannot outlive their node); their own leases
   // are longer than a node's, so their announcements would linger.
@@ -156,19 +168,18 @@ void DomainManager::Impl::node_gone(const std::string &address) {
   runtime_connections->owner_gone_later([prefix = node + ":"](const PortRef &ref) {
     return ref.kind == PortRef::Kind::Device && ref.owner.starts_with(prefix);
   });
-  nodes.erase(it);
 }
 
 // A component announced itself. One that an earlier run of this domain daemon launched (its
 // address carries another incarnation) is running without an application this run knows: it is
 // reported, once, and never taken for a component of a launch of this run.
 void DomainManager::Impl::component_announced(const control::AnnouncementEvent &event) {
-  const auto launched_by = incarnation_of(event.address);
+  const auto launched_by = protocol::incarnation_of(event.address);
   if (!launched_by || *launched_by == incarnation) {
     components.announced(event.address, event.body);
     return;
   }
-  std::lock_guard lock(nodes_mutex);
+  std::lock_guard lock(unknown_mutex);
   const bool first = unknown.count(event.address) == 0;
   unknown[event.address] = {event.address, event.body};
   if (!first)
@@ -184,7 +195,7 @@ void DomainManager::Impl::component_announced(const control::AnnouncementEvent &
 }
 
 Json DomainManager::Impl::unknown_components() {
-  std::lock_guard lock(nodes_mutex);
+  std::lock_guard lock(unknown_mutex);
   Json list = Json::array();
   for (const auto &[address, u] : unknown)
     list.push_back({{"address", address},
@@ -194,32 +205,16 @@ Json DomainManager::Impl::unknown_components() {
   return list;
 }
 
-const Json *DomainManager::Impl::find_device(const std::string &id) const {
-  const auto colon = id.find(':');
-  auto node = nodes.find(id.substr(0, colon));
-  if (colon == std::string::npos || node == nodes.end())
-    return nullptr;
-  const Json &body = node->second.body;
-  auto devices = body.find("devices"); // a reference into the record: value() would copy
-  if (devices == body.end() || !devices->is_array())
-    return nullptr;
-  for (const auto &d : *devices)
-    if (d.value("id", "") == id)
-      return &d;
-  return nullptr;
-}
-
 // A device's control address, for "device" requests of app.configure and app.query.
 CallResult<std::string> DomainManager::Impl::device_address(const std::string &id) {
-  std::lock_guard lock(nodes_mutex);
-  const Json *device = find_device(id);
-  if (device == nullptr)
+  const auto device = nodes.device(id);
+  if (!device)
     return control::call_error(Status::NotFound,
                                fmt::format("no device {} has registered", excerpt(id)));
-  if (!device->contains("address"))
+  if (device->address.empty())
     return control::call_error(Status::NotFound,
                                fmt::format("device {} has no properties to reach", id));
-  return device->value("address", "");
+  return device->address;
 }
 
 CallResult<ResolvedEnd> DomainManager::Impl::resolve_end(const PortRef &ref,
@@ -269,30 +264,28 @@ DomainManager::Impl::resolve_component_end(const PortRef &ref, profile::PortDire
 CallResult<ResolvedEnd> DomainManager::Impl::resolve_device_end(const PortRef &ref,
                                                                 profile::PortDirection direction) {
   const auto wanted = profile::to_string(direction);
-  std::lock_guard lock(nodes_mutex);
   const std::string node = ref.owner.substr(0, ref.owner.find(':'));
-  if (nodes.count(node) == 0)
+  if (!nodes.contains(node))
     return control::call_error(Status::Unavailable,
                                fmt::format("device {} has not registered", ref.owner));
-  const Json *device = find_device(ref.owner);
-  if (device == nullptr)
+  const auto device = nodes.device(ref.owner);
+  if (!device)
     return control::call_error(Status::NotFound,
                                fmt::format("node {} has no device {}", node, ref.owner));
-  for (const auto &p : device->value("ports", Json::array()))
-    if (p.value("name", "") == ref.port && p.value("direction", "") == wanted)
-      return ResolvedEnd{device->value("address", ""), ref.port, p.value("repid", "")};
+  for (const auto &p : device->ports)
+    if (p.name == ref.port && p.direction == wanted)
+      return ResolvedEnd{device->address, ref.port, p.repid};
   return control::call_error(Status::NotFound,
                              fmt::format("{} is not a {} port", ref.to_string(), wanted));
 }
 
 CallResult<Json> DomainManager::Impl::list_nodes() {
-  std::lock_guard lock(nodes_mutex);
   Json list = Json::array();
-  for (const auto &[name, node] : nodes)
-    list.push_back({{"name", name},
+  for (const auto &node : nodes.snapshot())
+    list.push_back({{"name", node.announcement.node},
                     {"address", node.address},
-                    {"pid", node.body.value("pid", 0)},
-                    {"devices", node.body.value("devices", Json::array()).size()}});
+                    {"pid", node.announcement.pid},
+                    {"devices", node.announcement.devices.size()}});
   return Json{{"nodes", list}};
 }
 
@@ -349,12 +342,12 @@ CallResult<Json> DomainManager::Impl::list_connections(const Json &body) {
       addresses.insert({c.uses_end.address, c.provides_end.address});
   std::vector<control::Call> calls;
   for (const auto &address : addresses)
-    calls.push_back({address, "component.status", Json::object()});
+    calls.push_back(control::make_call<protocol::component::Status>(address, {}));
   const auto statuses = endpoint->call_all(calls, options.call_timeout / 2);
-  std::map<std::string, Json> status_of;
+  StatusOf status_of;
   for (std::size_t i = 0; i < calls.size(); ++i)
-    if (statuses[i])
-      status_of[calls[i].target] = *statuses[i];
+    if (auto status = control::reply_of<protocol::component::Status>(statuses[i]))
+      status_of[calls[i].target] = std::move(*status);
   Json list = Json::array();
   for (const auto &app : apps)
     for (const auto &c : app.connections)

@@ -12,9 +12,12 @@
 #include "allocator/plan_json.hpp"
 #include "common/elapsed.hpp"
 #include "common/names.hpp"
+#include "control/operation.hpp"
 #include "domain/domain_manager_impl.hpp"
 #include "profile/property_binding.hpp"
 #include "profile/property_json.hpp"
+#include "protocol/addresses.hpp"
+#include "protocol/component_ops.hpp"
 
 namespace rsca::domain {
 namespace {
@@ -153,19 +156,12 @@ ApplicationFactory DomainManager::Impl::factory() {
   s.allocator = &allocator;
   s.components = &components;
   s.channels = &*channels;
-  s.node_address = [this](const std::string &node) -> std::optional<std::string> {
-    std::lock_guard lock(nodes_mutex);
-    auto it = nodes.find(node);
-    if (it == nodes.end())
-      return std::nullopt;
-    return it->second.address;
-  };
+  s.node_address = [this](const std::string &node) { return nodes.address_of(node); };
   s.device_ports = [this](const std::string &id) -> std::optional<DevicePorts> {
-    std::lock_guard lock(nodes_mutex);
-    const Json *device = find_device(id);
-    if (device == nullptr || !device->contains("address"))
+    auto device = nodes.device(id);
+    if (!device || device->address.empty())
       return std::nullopt;
-    return DevicePorts{device->value("address", ""), device->value("ports", Json::array())};
+    return DevicePorts{std::move(device->address), std::move(device->ports)};
   };
   s.next_launch = [this] { return LaunchIdentity{incarnation, ++launch_counter}; };
   s.call_timeout = options.call_timeout;
@@ -395,10 +391,7 @@ CallResult<Json> DomainManager::Impl::configure(const Json &body) {
     auto address = device_address(required<std::string>(body, "device").value_or(""));
     if (!address)
       return tl::unexpected(address.error());
-    return endpoint->call_sync(
-        *address, "component.configure",
-        Json{{"properties", json_values(body.value("values", Json::object()))}},
-        options.call_timeout);
+    return configure_at(*address, json_values(body.value("values", Json::object())));
   }
   auto name = required<std::string>(body, "app");
   auto component = optional_field<std::string>(body, "component");
@@ -418,17 +411,31 @@ CallResult<Json> DomainManager::Impl::configure(const Json &body) {
       return tl::unexpected(typed.error());
     properties.update(*typed);
   }
-  return endpoint->call_sync((*target)->address, "component.configure",
-                             Json{{"properties", properties}}, options.call_timeout);
+  return configure_at((*target)->address, std::move(properties));
+}
+
+CallResult<Json> DomainManager::Impl::configure_at(const std::string &address, Json properties) {
+  return control::call<protocol::component::Configure>(*endpoint, address, {std::move(properties)},
+                                                       options.call_timeout)
+      .map([](const auto &reply) { return protocol::encode(reply); });
+}
+
+CallResult<Json> DomainManager::Impl::query_at(const std::string &address,
+                                               std::vector<std::string> ids) {
+  return control::call<protocol::component::Query>(*endpoint, address, {std::move(ids)},
+                                                   options.call_timeout)
+      .map([](const auto &reply) { return protocol::encode(reply); });
 }
 
 CallResult<Json> DomainManager::Impl::query(const Json &body) {
-  const Json ids{{"ids", body.value("ids", Json::array())}};
+  auto ids = optional_field<std::vector<std::string>>(body, "ids");
+  if (!ids)
+    return tl::unexpected(ids.error());
   if (body.contains("device")) {
     auto address = device_address(required<std::string>(body, "device").value_or(""));
     if (!address)
       return tl::unexpected(address.error());
-    return endpoint->call_sync(*address, "component.query", ids, options.call_timeout);
+    return query_at(*address, ids->value_or(std::vector<std::string>{}));
   }
   auto name = required<std::string>(body, "app");
   auto component = optional_field<std::string>(body, "component");
@@ -441,7 +448,7 @@ CallResult<Json> DomainManager::Impl::query(const Json &body) {
   auto target = target_of(*app, component->value_or(""));
   if (!target)
     return tl::unexpected(target.error());
-  return endpoint->call_sync((*target)->address, "component.query", ids, options.call_timeout);
+  return query_at((*target)->address, ids->value_or(std::vector<std::string>{}));
 }
 
 CallResult<Json> DomainManager::Impl::list_applications() {
@@ -489,22 +496,20 @@ CallResult<Json> DomainManager::Impl::plan_application(const Json &body) {
   return Json{{"admitted", true}, {"plan", allocator::to_json(*plan)}, {"strategy", strategy}};
 }
 
-CallResult<Json> DomainManager::Impl::component_exited(const Json &body) {
+CallResult<protocol::Empty>
+DomainManager::Impl::component_exited(const protocol::domain::ComponentExitedReport &r) {
   // Every component the process served: one, or those of a component host.
-  auto addresses = required<std::vector<std::string>>(body, "addresses");
-  if (!addresses)
-    return tl::unexpected(addresses.error());
-  const std::string why = body.value("status", "exited");
-  for (const auto &address : *addresses) {
+  const std::string why = r.status.empty() ? std::string("exited") : r.status;
+  for (const auto &address : r.addresses) {
     components.exited(address, why); // a launch waiting for it fails at once
     endpoint->abandon(address, why);
   }
   mark_exited(
-      [&addresses](const ComponentInstance &c) {
-        return std::find(addresses->begin(), addresses->end(), c.address) != addresses->end();
+      [&r](const ComponentInstance &c) {
+        return std::find(r.addresses.begin(), r.addresses.end(), c.address) != r.addresses.end();
       },
       why);
-  return Json::object();
+  return protocol::Empty{};
 }
 
 void DomainManager::Impl::mark_exited(const std::function<bool(const ComponentInstance &)> &which,
@@ -526,19 +531,12 @@ void DomainManager::Impl::mark_exited(const std::function<bool(const ComponentIn
 }
 
 // A component saw its writer miss a connection's deadline or lose liveliness.
-CallResult<Json> DomainManager::Impl::connection_problem(const Json &body) {
-  const Json details{{"application", body.value("application", "")},
-                     {"component", body.value("component", "")},
-                     {"connection", body.value("connection", "")},
-                     {"problem", body.value("problem", "")},
-                     {"count", body.value("count", 0)}};
-  spdlog::warn("connection {} of application {} ({}): {} ({} times)",
-               excerpt(details.at("connection").get<std::string>()),
-               excerpt(details.at("application").get<std::string>()),
-               excerpt(details.at("component").get<std::string>()),
-               excerpt(details.at("problem").get<std::string>()), details.at("count").get<int>());
-  events->publish("connection.problem", details);
-  return Json::object();
+CallResult<protocol::Empty>
+DomainManager::Impl::connection_problem(const protocol::domain::ConnectionProblemReport &r) {
+  spdlog::warn("connection {} of application {} ({}): {} ({} times)", excerpt(r.connection),
+               excerpt(r.application), excerpt(r.component), excerpt(r.problem), r.count);
+  events->publish("connection.problem", protocol::encode(r));
+  return protocol::Empty{};
 }
 
 void DomainManager::Impl::serve() {
@@ -559,8 +557,10 @@ void DomainManager::Impl::serve() {
   bind0("domain.installed", &Impl::list_installed);
   bind0("domain.nodes", &Impl::list_nodes);
   bind0("domain.devices", &Impl::list_devices);
-  bind("domain.component_exited", &Impl::component_exited);
-  bind("domain.connection_problem", &Impl::connection_problem);
+  control::serve<protocol::domain::ComponentExited>(
+      *endpoint, [this](const auto &report, const auto &) { return component_exited(report); });
+  control::serve<protocol::domain::ConnectionProblem>(
+      *endpoint, [this](const auto &report, const auto &) { return connection_problem(report); });
   bind("app.create", &Impl::create_application);
   bind("app.plan", &Impl::plan_application);
   bind0("channel.list", &Impl::list_channels);
@@ -624,7 +624,7 @@ DomainManager::create(std::shared_ptr<dds::Participant> participant, DomainOptio
       },
       impl->options.call_timeout);
   auto endpoint = control::Endpoint::open(
-      participant, address_of(impl->options.name),
+      participant, protocol::domain_address(impl->options.name),
       {.workers = 16,
        .senders = 4,
        .on_announcement = [raw](const control::AnnouncementEvent &e) { raw->on_announcement(e); },

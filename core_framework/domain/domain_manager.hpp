@@ -33,11 +33,6 @@ public:
   create(std::shared_ptr<dds::Participant> participant, DomainOptions options);
   ~DomainManager();
 
-  static std::string address_of(const std::string &domain) { return domain + "/domain"; }
-  static std::string node_address(const std::string &domain, const std::string &node) {
-    return domain + "/node/" + node;
-  }
-
   struct Impl;
 
 private:

@@ -22,16 +22,12 @@
 #include "domain/domain_manager.hpp"
 #include "domain/installed_repository.hpp"
 #include "domain/launch_tracker.hpp"
+#include "domain/node_directory.hpp"
+#include "protocol/domain_ops.hpp"
 
 namespace rsca::domain {
 
 using control::CallResult;
-
-struct NodeRecord {
-  std::string name;
-  std::string address;
-  control::Json body;
-};
 
 // A component process found running that no application of this domain daemon launched: left by
 // a domain daemon that was killed, or by another domain on the same DDS domain and tag.
@@ -61,8 +57,8 @@ struct DomainManager::Impl {
   std::mutex installs;
   std::mutex kept_connections; // a runtime connection and its record in the store change together
 
-  std::mutex nodes_mutex; // guards nodes and unknown
-  std::map<std::string, NodeRecord> nodes;
+  NodeDirectory nodes;
+  std::mutex unknown_mutex; // guards unknown
   std::map<std::string, UnknownComponent> unknown;
 
   ApplicationFactory factory();
@@ -82,11 +78,14 @@ struct DomainManager::Impl {
   CallResult<control::Json> start_or_stop(const control::Json &body, bool start);
   CallResult<control::Json> configure(const control::Json &body);
   CallResult<control::Json> query(const control::Json &body);
+  CallResult<control::Json> configure_at(const std::string &address, control::Json properties);
+  CallResult<control::Json> query_at(const std::string &address, std::vector<std::string> ids);
   CallResult<control::Json> list_applications();
   CallResult<control::Json> show_application(const control::Json &body);
   CallResult<control::Json> plan_application(const control::Json &body);
-  CallResult<control::Json> component_exited(const control::Json &body);
-  CallResult<control::Json> connection_problem(const control::Json &body);
+  CallResult<protocol::Empty> component_exited(const protocol::domain::ComponentExitedReport &r);
+  CallResult<protocol::Empty>
+  connection_problem(const protocol::domain::ConnectionProblemReport &r);
   // Marks the running components `which` selects as exited.
   void mark_exited(const std::function<bool(const ComponentInstance &)> &which,
                    const std::string &why);
@@ -97,9 +96,6 @@ struct DomainManager::Impl {
   void node_alive(const control::AnnouncementEvent &event);
   void node_gone(const std::string &address);
   void component_announced(const control::AnnouncementEvent &event);
-  // A device as its node announced it; null when its node has not registered or has no such
-  // device. Called with `nodes_mutex` held.
-  const control::Json *find_device(const std::string &id) const;
   CallResult<std::string> device_address(const std::string &id);
   CallResult<ResolvedEnd> resolve_end(const PortRef &ref, profile::PortDirection direction);
   CallResult<ResolvedEnd> resolve_component_end(const PortRef &ref,

@@ -7,8 +7,8 @@
 #include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
-#include "common/dds_names.hpp"
 #include "dds/port_qos.hpp"
+#include "protocol/topics.hpp"
 
 namespace rsca::domain {
 namespace {
@@ -27,7 +27,7 @@ std::string_view to_string(ChannelMember::Role role) {
 }
 
 std::string EventChannelManager::topic_of(const std::string &name) const {
-  return fmt::format("rsca_{}_channel_{}", dds_name(domain_), dds_name(name));
+  return protocol::channel_topic(domain_, name);
 }
 
 std::optional<std::string> EventChannelManager::misfit(const EventChannel &channel,

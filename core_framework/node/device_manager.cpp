@@ -9,13 +9,16 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "control/operation.hpp"
 #include "profile/property_binding.hpp"
 #include "profile/property_json.hpp"
+#include "protocol/addresses.hpp"
 
 namespace rsca::node {
 namespace {
 
 using control::Status;
+namespace op = protocol::node;
 
 struct RunningDevice {
   std::string id;
@@ -57,10 +60,13 @@ struct DeviceManager::Impl {
   std::mutex endpoint_mutex; // the endpoint's end against a process exit reported meanwhile
 
   Expected<void> start_devices(const DeviceRegistry &registry);
-  Json announcement() const;
+  op::NodeAnnouncement announcement() const;
   void serve();
   ExecutableDevice *executable_device(const std::string &id) const;
-  void report_exit(const Json &report);
+  void report_exit(const protocol::domain::ComponentExitedReport &report);
+  CallResult<op::ExecuteReply> execute(const op::ExecuteRequest &request) const;
+  CallResult<op::TerminateReply> terminate(const op::TerminateRequest &request) const;
+  op::StatusReply status() const;
 };
 
 Expected<void> DeviceManager::Impl::start_devices(const DeviceRegistry &registry) {
@@ -87,7 +93,7 @@ Expected<void> DeviceManager::Impl::start_devices(const DeviceRegistry &registry
                             options.exec_path,
                             options.log_dir,
                             participant->settings(),
-                            [this](const Json &report) { report_exit(report); }};
+                            [this](const auto &report) { report_exit(report); }};
       auto device = (*factory)(context);
       if (!device)
         return tl::unexpected(device.error());
@@ -103,27 +109,26 @@ Expected<void> DeviceManager::Impl::start_devices(const DeviceRegistry &registry
   return {};
 }
 
-Json DeviceManager::Impl::announcement() const {
-  Json list = Json::array();
-  for (const auto &d : devices) {
-    Json entry{{"id", d.id},
-               {"label", d.label},
-               {"softpkg", d.softpkg},
-               {"kind", d.device->kind()},
-               {"properties", d.device->properties()},
-               {"capacity", d.device->capacity()},
-               {"allocation", d.allocation},
-               {"deployerrequires", d.deployer_requires}};
-    if (auto address = d.device->address(); !address.empty()) {
-      entry["address"] = address;
-      entry["ports"] = d.device->ports();
-    }
-    list.push_back(std::move(entry));
-  }
+op::NodeAnnouncement DeviceManager::Impl::announcement() const {
   char host[256] = {};
   gethostname(host, sizeof(host) - 1);
-  return {
-      {"node", dcd->name}, {"pid", static_cast<long>(getpid())}, {"host", host}, {"devices", list}};
+  op::NodeAnnouncement out{dcd->name, static_cast<std::int64_t>(getpid()), host, {}};
+  for (const auto &d : devices) {
+    op::DeviceRecord record{d.id,
+                            d.label,
+                            d.softpkg,
+                            d.device->kind(),
+                            d.device->properties(),
+                            d.device->capacity(),
+                            d.allocation,
+                            d.deployer_requires,
+                            d.device->address(),
+                            {}};
+    if (!record.address.empty())
+      record.ports = d.device->ports();
+    out.devices.push_back(std::move(record));
+  }
+  return out;
 }
 
 ExecutableDevice *DeviceManager::Impl::executable_device(const std::string &id) const {
@@ -133,51 +138,55 @@ ExecutableDevice *DeviceManager::Impl::executable_device(const std::string &id) 
   return nullptr;
 }
 
-void DeviceManager::Impl::report_exit(const Json &report) {
+void DeviceManager::Impl::report_exit(const protocol::domain::ComponentExitedReport &report) {
   std::lock_guard lock(endpoint_mutex); // the reaper's thread: the endpoint may be going
   if (stopping.load() || !endpoint)
     return;
-  spdlog::warn("process {} exited on its own: {}", report.value("pid", 0L),
-               report.value("status", ""));
+  spdlog::warn("process {} exited on its own: {}", report.pid, report.status);
   // Fire and forget: the reply is not needed, and the reaper that calls this must not block.
-  endpoint->call(options.domain_name + "/domain", "domain.component_exited", report,
-                 std::chrono::seconds(2));
+  control::send<protocol::domain::ComponentExited>(
+      *endpoint, protocol::domain_address(options.domain_name), report, std::chrono::seconds(2));
+}
+
+CallResult<op::ExecuteReply> DeviceManager::Impl::execute(const op::ExecuteRequest &request) const {
+  ExecutableDevice *device = executable_device(request.device);
+  if (device == nullptr)
+    return control::call_error(Status::NotFound, fmt::format("node {} has no executable device {}",
+                                                             dcd->name, request.device));
+  return device->execute(request);
+}
+
+CallResult<op::TerminateReply>
+DeviceManager::Impl::terminate(const op::TerminateRequest &request) const {
+  for (const auto &d : devices) {
+    if (d.executable() == nullptr)
+      continue;
+    auto result = d.executable()->terminate(request);
+    if (result || result.error().status != Status::NotFound)
+      return result;
+  }
+  return control::call_error(
+      Status::NotFound, fmt::format("node {} did not start process {}", dcd->name, request.pid));
+}
+
+op::StatusReply DeviceManager::Impl::status() const {
+  auto a = announcement();
+  op::StatusReply status{std::move(a.node), a.pid, std::move(a.host), std::move(a.devices), {}};
+  for (const auto &d : devices)
+    if (d.executable() != nullptr)
+      for (auto &p : d.executable()->processes())
+        status.processes.push_back(std::move(p));
+  return status;
 }
 
 void DeviceManager::Impl::serve() {
-  endpoint->on("node.execute",
-               [this](const Json &body, const control::RequestContext &) -> CallResult<Json> {
-                 ExecutableDevice *device = executable_device(body.value("device", ""));
-                 if (device == nullptr)
-                   return control::call_error(Status::NotFound,
-                                              fmt::format("node {} has no executable device {}",
-                                                          dcd->name, body.value("device", "")));
-                 return device->execute(body);
-               });
-  endpoint->on("node.terminate",
-               [this](const Json &body, const control::RequestContext &) -> CallResult<Json> {
-                 for (const auto &d : devices) {
-                   if (d.executable() == nullptr)
-                     continue;
-                   auto result = d.executable()->terminate(body);
-                   if (result || result.error().status != Status::NotFound)
-                     return result;
-                 }
-                 return control::call_error(Status::NotFound,
-                                            fmt::format("node {} did not start process {}",
-                                                        dcd->name, body.value("pid", 0L)));
-               });
-  endpoint->on("node.status",
-               [this](const Json &, const control::RequestContext &) -> CallResult<Json> {
-                 Json processes = Json::array();
-                 for (const auto &d : devices)
-                   if (d.executable() != nullptr)
-                     for (const auto &p : d.executable()->processes())
-                       processes.push_back(p);
-                 Json status = announcement();
-                 status["processes"] = processes;
-                 return status;
-               });
+  control::serve<op::Execute>(
+      *endpoint, [this](const auto &request, const auto &) { return execute(request); });
+  control::serve<op::Terminate>(
+      *endpoint, [this](const auto &request, const auto &) { return terminate(request); });
+  control::serve<op::Status>(*endpoint, [this](const auto &, const auto &) {
+    return CallResult<op::StatusReply>(status());
+  });
 }
 
 DeviceManager::DeviceManager(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -213,7 +222,7 @@ DeviceManager::create(std::shared_ptr<dds::Participant> participant, NodeOptions
   control::EndpointOptions endpoint_options;
   endpoint_options.hold_requests = true; // until its devices run and their handlers are there
   auto endpoint = control::Endpoint::open(
-      participant, fmt::format("{}/node/{}", impl->options.domain_name, impl->dcd->name),
+      participant, protocol::node_address(impl->options.domain_name, impl->dcd->name),
       std::move(endpoint_options));
   if (!endpoint)
     return tl::unexpected(endpoint.error());
@@ -224,9 +233,9 @@ DeviceManager::create(std::shared_ptr<dds::Participant> participant, NodeOptions
   impl->endpoint->start_serving();
   // The domain is the node's caller, and the node calls it: both ways are made now, so the
   // first launch does not wait for DDS to match them.
-  impl->endpoint->prepare(impl->options.domain_name + "/domain");
-  impl->endpoint->prepare_replies(impl->options.domain_name + "/domain");
-  if (auto ok = impl->endpoint->announce("node", impl->announcement()); !ok)
+  impl->endpoint->prepare(protocol::domain_address(impl->options.domain_name));
+  impl->endpoint->prepare_replies(protocol::domain_address(impl->options.domain_name));
+  if (auto ok = impl->endpoint->announce("node", protocol::encode(impl->announcement())); !ok)
     return tl::unexpected(ok.error());
   spdlog::info("node {} announced with {} device(s)", impl->dcd->name, impl->devices.size());
   return std::unique_ptr<DeviceManager>(new DeviceManager(std::move(impl)));

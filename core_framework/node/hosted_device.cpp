@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include "allocator/device.hpp"
+#include "protocol/addresses.hpp"
 
 namespace rsca::node {
 namespace {
@@ -28,7 +29,7 @@ Expected<std::unique_ptr<LogicalDevice>> HostedDevice::create(const DeviceContex
       "",
       context.domain,
       context.softpkg->spd_path,
-      fmt::format("{}/device/{}/{}", context.domain, context.node, context.label),
+      protocol::device_address(context.domain, context.node, context.label),
       component::in_process_logger(context.id),
       std::nullopt};
   auto component = component::InProcessComponent::open(factory, component_context, context.softpkg,

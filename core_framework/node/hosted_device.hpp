@@ -20,7 +20,7 @@ public:
   Json properties() const override { return properties_; }
   Json capacity() const override { return capacity_; }
   std::string address() const override { return component_->address(); }
-  Json ports() const override { return component_->ports(); }
+  std::vector<protocol::node::DevicePort> ports() const override { return component_->ports(); }
 
 private:
   HostedDevice(std::unique_ptr<component::InProcessComponent> component, Json properties,

@@ -13,6 +13,8 @@
 #include "dds/dds_settings.hpp"
 #include "dds/participant.hpp"
 #include "profile/profile_loader.hpp"
+#include "protocol/domain_ops.hpp"
+#include "protocol/node_ops.hpp"
 
 namespace rsca::node {
 
@@ -33,7 +35,7 @@ struct DeviceContext {
   std::filesystem::path log_dir;                 // component logs go here
   dds::DdsSettings dds;                          // what launched processes must join
   // Reports a process that exited on its own (a crash, for a component). Must not block.
-  std::function<void(const Json &report)> report_exit;
+  std::function<void(const protocol::domain::ComponentExitedReport &report)> report_exit;
 };
 
 class LogicalDevice {
@@ -44,16 +46,17 @@ public:
   virtual Json capacity() const = 0;    // total capacities, by name
   // Devices with data ports serve them at a control address, as components do.
   virtual std::string address() const { return {}; }
-  virtual Json ports() const { return Json::array(); } // [{"name", "direction", "repid"}]
+  virtual std::vector<protocol::node::DevicePort> ports() const { return {}; }
 };
 
 class ExecutableDevice : public LogicalDevice {
 public:
-  // body: {"application", "component", "entrypoint", "spd_dir", "args": [...]} → {"pid"}
-  virtual CallResult<Json> execute(const Json &body) = 0;
-  // body: {"pid"}; fails with NotFound for a process this device did not start.
-  virtual CallResult<Json> terminate(const Json &body) = 0;
-  virtual Json processes() const = 0;
+  virtual CallResult<protocol::node::ExecuteReply>
+  execute(const protocol::node::ExecuteRequest &request) = 0;
+  // Fails with NotFound for a process this device did not start.
+  virtual CallResult<protocol::node::TerminateReply>
+  terminate(const protocol::node::TerminateRequest &request) = 0;
+  virtual std::vector<protocol::node::ProcessRecord> processes() const = 0;
 };
 
 using DeviceFactory =

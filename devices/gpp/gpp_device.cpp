@@ -7,6 +7,7 @@
 
 #include "common/exec_environment.hpp"
 #include "host_info.hpp"
+#include "protocol/exec_params.hpp"
 
 namespace rsca::gpp {
 
@@ -67,25 +68,13 @@ std::filesystem::path GppDevice::find_executable(const std::string &entrypoint,
   return std::filesystem::path(spd_dir) / ep;
 }
 
-namespace {
-
-// Every component a process serves: one, or all those of a component host.
-std::vector<std::string> control_addresses(const std::vector<std::string> &args) {
-  std::vector<std::string> addresses;
-  for (std::size_t i = 0; i + 1 < args.size(); i += 2)
-    if (args[i] == "CONTROL_ADDRESS")
-      addresses.push_back(args[i + 1]);
-  return addresses;
-}
-
-} // namespace
-
-CallResult<Json> GppDevice::execute(const Json &body) {
-  const std::string application = body.value("application", "");
-  const std::string component = body.value("component", "");
+CallResult<protocol::node::ExecuteReply>
+GppDevice::execute(const protocol::node::ExecuteRequest &r) {
+  const std::string &application = r.application;
+  const std::string &component = r.component;
   ExecRequest request;
-  request.executable = find_executable(body.value("entrypoint", ""), body.value("spd_dir", ""));
-  request.args = body.value("args", std::vector<std::string>{});
+  request.executable = find_executable(r.entrypoint, r.spd_dir);
+  request.args = r.args;
   request.env = context_.dds.component_environment();
   // The component dies with this node: it checks that its parent is still this process.
   request.env.emplace_back(kNodePidVariable, std::to_string(::getpid()));
@@ -97,17 +86,22 @@ CallResult<Json> GppDevice::execute(const Json &body) {
                                fmt::format("{}: {}", context_.id, pid.error().to_string()));
   {
     std::lock_guard lock(mutex_);
-    owners_[*pid] = {{"application", application},
-                     {"component", component},
-                     {"addresses", control_addresses(request.args)}};
+    protocol::domain::ComponentExitedReport owner;
+    owner.application = application;
+    owner.component = component;
+    owner.addresses = protocol::control_addresses(request.args);
+    owners_[*pid] = std::move(owner);
   }
   spdlog::info("{}: executed {} as pid {} (log {})", context_.id, request.executable.string(), *pid,
                request.log_file.string());
-  return Json{{"pid", *pid}, {"log", request.log_file.string()}};
+  return protocol::node::ExecuteReply{*pid, request.log_file.string()};
 }
 
-CallResult<Json> GppDevice::terminate(const Json &body) {
-  const ProcessId pid = body.value("pid", 0);
+CallResult<protocol::node::TerminateReply>
+GppDevice::terminate(const protocol::node::TerminateRequest &r) {
+  const auto pid = static_cast<ProcessId>(r.pid);
+  if (pid != r.pid)
+    return control::call_error(Status::BadRequest, fmt::format("no such pid {}", r.pid));
   {
     std::lock_guard lock(mutex_);
     if (owners_.count(pid) == 0)
@@ -119,34 +113,34 @@ CallResult<Json> GppDevice::terminate(const Json &body) {
     return control::call_error(Status::Failed, ok.error().to_string());
   std::lock_guard lock(mutex_);
   owners_.erase(pid);
-  return Json{{"pid", pid}};
+  return protocol::node::TerminateReply{pid};
 }
 
-Json GppDevice::processes() const {
-  Json list = Json::array();
+std::vector<protocol::node::ProcessRecord> GppDevice::processes() const {
+  std::vector<protocol::node::ProcessRecord> list;
   for (const auto &p : launcher_.list())
     if (p.running)
-      list.push_back({{"pid", p.pid}, {"label", p.label}, {"log", p.log_file.string()}});
+      list.push_back({p.pid, p.label, p.log_file.string()});
   return list;
 }
 
 void GppDevice::on_exit(ProcessId pid, const ExitStatus &status) {
   if (status.requested)
     return;
-  Json report;
+  protocol::domain::ComponentExitedReport report;
   {
     std::lock_guard lock(mutex_);
     auto it = owners_.find(pid);
     if (it == owners_.end())
       return;
-    report = it->second;
+    report = std::move(it->second);
     owners_.erase(it);
   }
-  report["pid"] = pid;
-  report["device"] = context_.id;
-  report["status"] = describe(status);
-  report["exit_code"] = status.exit_code;
-  report["signal"] = status.signal;
+  report.pid = pid;
+  report.device = context_.id;
+  report.status = describe(status);
+  report.exit_code = status.exit_code;
+  report.signal = status.signal;
   context_.report_exit(report);
 }
 

@@ -18,9 +18,11 @@ public:
   std::string kind() const override { return "gpp"; }
   node::Json properties() const override { return properties_; }
   node::Json capacity() const override { return capacity_; }
-  node::CallResult<node::Json> execute(const node::Json &body) override;
-  node::CallResult<node::Json> terminate(const node::Json &body) override;
-  node::Json processes() const override;
+  node::CallResult<protocol::node::ExecuteReply>
+  execute(const protocol::node::ExecuteRequest &request) override;
+  node::CallResult<protocol::node::TerminateReply>
+  terminate(const protocol::node::TerminateRequest &request) override;
+  std::vector<protocol::node::ProcessRecord> processes() const override;
 
   explicit GppDevice(node::DeviceContext context);
 
@@ -33,8 +35,10 @@ private:
   node::Json properties_;
   node::Json capacity_;
   std::mutex mutex_;
-  std::map<ProcessId, node::Json> owners_; // pid → {application, component, address}
-  ProcessLauncher launcher_;               // last: destroyed (terminating children) first
+  // What each process started is, for the report of its exit: its application, component and
+  // the control addresses it serves.
+  std::map<ProcessId, protocol::domain::ComponentExitedReport> owners_;
+  ProcessLauncher launcher_; // last: destroyed (terminating children) first
 };
 
 // Registers the GPP under its SPD names.

@@ -94,9 +94,9 @@ TEST_CASE("a removed application is found no more, and its handle stays usable",
 
 TEST_CASE("launch identities and the incarnation read back from an address",
           "[unit][application-registry]") {
-  using rsca::domain::incarnation_of;
+  using rsca::protocol::incarnation_of;
   const rsca::domain::LaunchIdentity launch{7, 12};
-  CHECK(rsca::domain::to_string(launch) == "7.12");
+  CHECK(rsca::protocol::to_string(launch) == "7.12");
   CHECK(incarnation_of("rsca/component/PC.7.12/Producer_1") == 7u);
   CHECK(incarnation_of("rsca/component/rh.FM.demo.3.1/X") == 3u); // dots in the name
   CHECK(incarnation_of("rsca/host/PC.9.1/node1:GPP_1") == 9u);

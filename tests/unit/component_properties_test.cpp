@@ -276,15 +276,14 @@ TEST_CASE("a component host's exec parameters are its address, then one group pe
   CHECK(host->control_address == "host");
   const auto &hosted = host->components;
   REQUIRE(hosted.size() == 2);
-  CHECK(hosted[0].params.identifier == "A_1");
-  CHECK(hosted[0].params.control_address == "a");
+  CHECK(hosted[0].identifier == "A_1");
+  CHECK(hosted[0].control_address == "a");
   CHECK(hosted[0].library == "liba.so");
   // LIBRARY is the host's; the rest goes to the component.
-  CHECK(hosted[0].params.others ==
-        std::vector<std::pair<std::string, std::string>>{{"rate_hz", "20"}});
-  CHECK(hosted[1].params.control_address == "b");
+  CHECK(hosted[0].others == std::vector<std::pair<std::string, std::string>>{{"rate_hz", "20"}});
+  CHECK(hosted[1].control_address == "b");
   CHECK(hosted[1].library == "/lib/libb.so");
-  CHECK(hosted[1].params.others.empty());
+  CHECK(hosted[1].others.empty());
   // Bad input: a clear error naming what is wrong.
   CHECK(parse_host_params(19, argv).error() == "B_1: the exec parameter LIBRARY is missing");
   CHECK(parse_host_params(14, argv).error() ==

@@ -9,6 +9,7 @@
 
 #include "commands.hpp"
 #include "exit_codes.hpp"
+#include "protocol/addresses.hpp"
 
 namespace rsca::cli {
 
@@ -21,8 +22,7 @@ Expected<DomainClient> DomainClient::connect(const GlobalOptions &global) {
   char host[128] = {};
   gethostname(host, sizeof(host) - 1);
   static std::atomic<int> counter{0};
-  const std::string address =
-      fmt::format("{}/cli/{}-{}-{}", global.domain, host, getpid(), ++counter);
+  const std::string address = protocol::cli_address(global.domain, host, getpid(), ++counter);
   auto endpoint = control::Endpoint::open(
       *participant, address,
       {.workers = 1, .senders = 4, .on_announcement = {}, .aliases = {}, .prepare_kinds = {}});
@@ -38,7 +38,7 @@ Expected<DomainClient> DomainClient::connect(const GlobalOptions &global) {
 std::future<control::CallResult<control::Json>>
 DomainClient::call_async(const std::string &operation, control::Json body,
                          std::chrono::milliseconds timeout) const {
-  return endpoint_->call(domain_ + "/domain", operation, std::move(body), timeout);
+  return endpoint_->call(protocol::domain_address(domain_), operation, std::move(body), timeout);
 }
 
 control::CallResult<control::Json> DomainClient::call(const std::string &operation,
@@ -70,8 +70,9 @@ int report_failure(const GlobalOptions &global, const std::string &what,
                    const control::CallError &error) {
   std::string message = error.message;
   // The hint only when the domain itself did not answer, not a component during a launch.
-  const bool domain_silent = message.find(global.domain + "/domain") != std::string::npos &&
-                             message.find("launch of") == std::string::npos;
+  const bool domain_silent =
+      message.find(protocol::domain_address(global.domain)) != std::string::npos &&
+      message.find("launch of") == std::string::npos;
   if (domain_silent)
     message += fmt::format(" (is the domain \"{}\" up on DDS domain {}? see `rsca domain up`)",
                            global.domain, dds::DdsSettings::from_environment().domain_id);

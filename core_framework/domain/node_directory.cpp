@@ -1,0 +1,71 @@
+#include "domain/node_directory.hpp"
+
+#include <algorithm>
+
+namespace rsca::domain {
+
+bool NodeDirectory::alive(const std::string &address,
+                          protocol::node::NodeAnnouncement announcement) {
+  std::lock_guard lock(mutex_);
+  const std::string name = announcement.node;
+  const bool known = nodes_.count(name) != 0;
+  nodes_[name] = Node{address, std::move(announcement)};
+  return !known;
+}
+
+std::optional<NodeDirectory::Node> NodeDirectory::gone(const std::string &address) {
+  std::lock_guard lock(mutex_);
+  auto it = std::find_if(nodes_.begin(), nodes_.end(),
+                         [&](const auto &n) { return n.second.address == address; });
+  if (it == nodes_.end())
+    return std::nullopt;
+  Node node = std::move(it->second);
+  nodes_.erase(it);
+  return node;
+}
+
+bool NodeDirectory::contains(const std::string &node) const {
+  std::lock_guard lock(mutex_);
+  return nodes_.count(node) != 0;
+}
+
+std::optional<std::string> NodeDirectory::address_of(const std::string &node) const {
+  std::lock_guard lock(mutex_);
+  auto it = nodes_.find(node);
+  if (it == nodes_.end())
+    return std::nullopt;
+  return it->second.address;
+}
+
+std::optional<protocol::node::DeviceRecord> NodeDirectory::device(const std::string &id) const {
+  std::lock_guard lock(mutex_);
+  const auto *device = find_device(id);
+  if (device == nullptr)
+    return std::nullopt;
+  return *device;
+}
+
+std::vector<NodeDirectory::Node> NodeDirectory::snapshot() const {
+  std::lock_guard lock(mutex_);
+  std::vector<Node> out;
+  out.reserve(nodes_.size());
+  for (const auto &[name, node] : nodes_)
+    out.push_back(node);
+  return out;
+}
+
+// Called with mutex_ held.
+const protocol::node::DeviceRecord *NodeDirectory::find_device(const std::string &id) const {
+  const auto colon = id.find(':');
+  if (colon == std::string::npos)
+    return nullptr;
+  auto node = nodes_.find(id.substr(0, colon));
+  if (node == nodes_.end())
+    return nullptr;
+  for (const auto &d : node->second.announcement.devices)
+    if (d.id == id)
+      return &d;
+  return nullptr;
+}
+
+} // namespace rsca::domain

@@ -1,0 +1,41 @@
+// The domain's directory of nodes: what each node daemon last announced of itself and its
+// devices (protocol/node_ops.hpp), by node name. It owns that state alone, under its own lock;
+// readers get copies.
+#pragma once
+
+#include <map>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "protocol/node_ops.hpp"
+
+namespace rsca::domain {
+
+class NodeDirectory {
+public:
+  struct Node {
+    std::string address;
+    protocol::node::NodeAnnouncement announcement; // announcement.node is its name
+  };
+
+  // Records what the node at `address` announced; true when the node is new.
+  bool alive(const std::string &address, protocol::node::NodeAnnouncement announcement);
+  // The node at `address` left: its record, now dropped; nothing for an address no node has.
+  std::optional<Node> gone(const std::string &address);
+
+  bool contains(const std::string &node) const;
+  std::optional<std::string> address_of(const std::string &node) const;
+  // The device of that id ("NODE:LABEL").
+  std::optional<protocol::node::DeviceRecord> device(const std::string &id) const;
+  std::vector<Node> snapshot() const;
+
+private:
+  const protocol::node::DeviceRecord *find_device(const std::string &id) const;
+
+  mutable std::mutex mutex_;
+  std::map<std::string, Node> nodes_; // by name
+};
+
+} // namespace rsca::domain

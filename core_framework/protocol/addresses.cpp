@@ -1,0 +1,63 @@
+#include "protocol/addresses.hpp"
+
+#include <charconv>
+
+#include <fmt/format.h>
+
+namespace rsca::protocol {
+
+std::string to_string(const LaunchIdentity &launch) {
+  return fmt::format("{}.{}", launch.incarnation, launch.number);
+}
+
+std::string domain_address(std::string_view domain) {
+  return fmt::format("{}/domain", domain);
+}
+
+std::string node_address(std::string_view domain, std::string_view node) {
+  return fmt::format("{}/node/{}", domain, node);
+}
+
+std::string device_address(std::string_view domain, std::string_view node, std::string_view label) {
+  return fmt::format("{}/device/{}/{}", domain, node, label);
+}
+
+std::string component_address(std::string_view domain, std::string_view application,
+                              const LaunchIdentity &launch, std::string_view instance) {
+  return fmt::format("{}/component/{}.{}/{}", domain, application, to_string(launch), instance);
+}
+
+std::string host_address(std::string_view domain, std::string_view application,
+                         const LaunchIdentity &launch, std::string_view device) {
+  return fmt::format("{}/host/{}.{}/{}", domain, application, to_string(launch), device);
+}
+
+std::string cli_address(std::string_view domain, std::string_view host, long pid, int number) {
+  return fmt::format("{}/cli/{}-{}-{}", domain, host, pid, number);
+}
+
+std::optional<std::uint64_t> incarnation_of(std::string_view address) {
+  for (std::string_view kind : {"/component/", "/host/"}) {
+    const auto at = address.find(kind);
+    if (at == std::string_view::npos)
+      continue;
+    std::string_view launch = address.substr(at + kind.size());
+    launch = launch.substr(0, launch.find('/'));
+    const auto last = launch.rfind('.');
+    if (last == std::string_view::npos || last == 0)
+      return std::nullopt;
+    const auto before = launch.rfind('.', last - 1);
+    if (before == std::string_view::npos)
+      return std::nullopt;
+    const std::string_view number = launch.substr(before + 1, last - before - 1);
+    std::uint64_t incarnation = 0;
+    const auto [end, ec] =
+        std::from_chars(number.data(), number.data() + number.size(), incarnation);
+    if (ec != std::errc() || end != number.data() + number.size())
+      return std::nullopt;
+    return incarnation;
+  }
+  return std::nullopt;
+}
+
+} // namespace rsca::protocol

@@ -1,0 +1,192 @@
+// The component.* operations: what the domain (and a component's uses port of a control
+// interface) asks of a component, served by the component runtime (component/host.cpp).
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "protocol/codec.hpp"
+
+namespace rsca::protocol::component {
+
+// The end of a connection this component's port is to be: its topic (a DDS connection) or its
+// target (a uses port of a control interface, which calls that component's control address).
+struct ConnectRequest {
+  std::string connection; // unique per port
+  std::string port;
+  std::string direction; // "uses" or "provides"
+  std::string repid;
+  std::optional<std::string> topic;  // a DDS connection
+  std::optional<Json> qos;           // dds/port_qos.hpp's JSON form
+  std::optional<std::string> filter; // a provides port's content filter
+  std::optional<bool> local;         // both ends are in this process: no DDS
+  std::optional<std::string> target; // a control interface's component address
+  static constexpr auto fields() {
+    using R = ConnectRequest;
+    return std::tuple{required("connection", &R::connection), required("port", &R::port),
+                      required("direction", &R::direction),   optional("repid", &R::repid),
+                      optional("topic", &R::topic),           optional("qos", &R::qos),
+                      optional("filter", &R::filter),         optional("local", &R::local),
+                      optional("target", &R::target)};
+  }
+};
+
+struct DisconnectRequest {
+  std::string connection;
+  std::string port;
+  static constexpr auto fields() {
+    return std::tuple{required("connection", &DisconnectRequest::connection),
+                      required("port", &DisconnectRequest::port)};
+  }
+};
+
+struct ConfigureRequest {
+  Json properties = Json::object(); // property id -> value (profile/property_json.hpp)
+  static constexpr auto fields() {
+    return std::tuple{required("properties", &ConfigureRequest::properties)};
+  }
+};
+
+struct QueryRequest {
+  std::vector<std::string> ids; // none: every property
+  static constexpr auto fields() { return std::tuple{optional("ids", &QueryRequest::ids)}; }
+};
+
+struct QueryReply {
+  Json properties = Json::object();
+  static constexpr auto fields() {
+    return std::tuple{required("properties", &QueryReply::properties)};
+  }
+};
+
+// One connection of a port, as the component sees it.
+struct ConnectionStatus {
+  std::string connection;
+  std::optional<std::string> topic;
+  std::optional<std::int64_t> matched;
+  std::optional<std::uint64_t> samples;
+  std::optional<std::uint64_t> filtered;
+  std::optional<std::uint64_t> deadline_missed;
+  std::optional<bool> in_host;
+  std::optional<std::string> target; // a control interface's connection: whom it calls
+  std::optional<std::uint64_t> calls;
+  static constexpr auto fields() {
+    using R = ConnectionStatus;
+    return std::tuple{required("connection", &R::connection),
+                      optional("topic", &R::topic),
+                      optional("matched", &R::matched),
+                      optional("samples", &R::samples),
+                      optional("filtered", &R::filtered),
+                      optional("deadline_missed", &R::deadline_missed),
+                      optional("in_host", &R::in_host),
+                      optional("target", &R::target),
+                      optional("calls", &R::calls)};
+  }
+};
+
+struct PortStatus {
+  std::string name;
+  std::string direction;
+  std::vector<ConnectionStatus> connections;
+  static constexpr auto fields() {
+    return std::tuple{required("name", &PortStatus::name),
+                      required("direction", &PortStatus::direction),
+                      required("connections", &PortStatus::connections)};
+  }
+};
+
+struct StatusReply {
+  std::string state;
+  std::vector<PortStatus> ports;
+  static constexpr auto fields() {
+    return std::tuple{required("state", &StatusReply::state),
+                      required("ports", &StatusReply::ports)};
+  }
+};
+
+// A connection whose peers the caller waits for: `peers` matched readers or writers.
+struct AwaitedConnection {
+  std::string port;
+  std::string connection;
+  std::int32_t peers = 1;
+  std::int32_t matched = 0; // in the reply
+  static constexpr auto fields() {
+    using R = AwaitedConnection;
+    return std::tuple{required("port", &R::port), required("connection", &R::connection),
+                      optional("peers", &R::peers), optional("matched", &R::matched)};
+  }
+};
+
+struct AwaitMatchedRequest {
+  std::vector<AwaitedConnection> connections;
+  std::int64_t timeout_ms = 2000; // counted from the request's arrival
+  static constexpr auto fields() {
+    return std::tuple{required("connections", &AwaitMatchedRequest::connections),
+                      optional("timeout_ms", &AwaitMatchedRequest::timeout_ms)};
+  }
+};
+
+struct AwaitMatchedReply {
+  bool complete = false; // every connection matched its peers in time
+  std::vector<AwaitedConnection> connections;
+  static constexpr auto fields() {
+    return std::tuple{required("complete", &AwaitMatchedReply::complete),
+                      required("connections", &AwaitMatchedReply::connections)};
+  }
+};
+
+struct Initialize {
+  static constexpr std::string_view name = "component.initialize";
+  using Request = Empty;
+  using Reply = Empty;
+};
+struct Configure {
+  static constexpr std::string_view name = "component.configure";
+  using Request = ConfigureRequest;
+  using Reply = Empty;
+};
+struct Query {
+  static constexpr std::string_view name = "component.query";
+  using Request = QueryRequest;
+  using Reply = QueryReply;
+};
+struct Connect {
+  static constexpr std::string_view name = "component.connect";
+  using Request = ConnectRequest;
+  using Reply = Empty;
+};
+struct Disconnect {
+  static constexpr std::string_view name = "component.disconnect";
+  using Request = DisconnectRequest;
+  using Reply = Empty;
+};
+struct Start {
+  static constexpr std::string_view name = "component.start";
+  using Request = Empty;
+  using Reply = Empty;
+};
+struct Stop {
+  static constexpr std::string_view name = "component.stop";
+  using Request = Empty;
+  using Reply = Empty;
+};
+struct Status {
+  static constexpr std::string_view name = "component.status";
+  using Request = Empty;
+  using Reply = StatusReply;
+};
+struct AwaitMatched {
+  static constexpr std::string_view name = "component.await_matched";
+  using Request = AwaitMatchedRequest;
+  using Reply = AwaitMatchedReply;
+};
+struct Release {
+  static constexpr std::string_view name = "component.release";
+  using Request = Empty;
+  using Reply = Empty;
+};
+
+} // namespace rsca::protocol::component

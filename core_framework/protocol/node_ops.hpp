@@ -1,0 +1,144 @@
+// The node.* operations: what the domain asks of a node daemon (its DeviceManager), and what a
+// node announces of itself.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "protocol/codec.hpp"
+
+namespace rsca::protocol::node {
+
+// Start one process on an executable device: a component, or a component host for several.
+struct ExecuteRequest {
+  std::string application;
+  std::string component; // the component's id, or the host's name: names its log
+  std::string device;    // the executable device; empty: the node's first
+  std::string entrypoint;
+  std::string spd_dir;           // where the SPD is, that a relative entry point is found from
+  std::vector<std::string> args; // the exec parameters (protocol/exec_params.hpp)
+  static constexpr auto fields() {
+    using R = ExecuteRequest;
+    return std::tuple{
+        required("application", &R::application), required("component", &R::component),
+        optional("device", &R::device),           required("entrypoint", &R::entrypoint),
+        optional("spd_dir", &R::spd_dir),         required("args", &R::args)};
+  }
+};
+
+struct ExecuteReply {
+  std::int64_t pid = 0;
+  std::string log; // the process's log file
+  static constexpr auto fields() {
+    return std::tuple{required("pid", &ExecuteReply::pid), required("log", &ExecuteReply::log)};
+  }
+};
+
+struct TerminateRequest {
+  std::int64_t pid = 0;
+  static constexpr auto fields() { return std::tuple{required("pid", &TerminateRequest::pid)}; }
+};
+
+struct TerminateReply {
+  std::int64_t pid = 0;
+  static constexpr auto fields() { return std::tuple{required("pid", &TerminateReply::pid)}; }
+};
+
+// A process an executable device runs.
+struct ProcessRecord {
+  std::int64_t pid = 0;
+  std::string label; // APPLICATION/COMPONENT
+  std::string log;
+  static constexpr auto fields() {
+    return std::tuple{required("pid", &ProcessRecord::pid),
+                      required("label", &ProcessRecord::label),
+                      required("log", &ProcessRecord::log)};
+  }
+};
+
+// A port of a device that components connect to.
+struct DevicePort {
+  std::string name;
+  std::string direction; // "uses" or "provides"
+  std::string repid;
+  static constexpr auto fields() {
+    return std::tuple{required("name", &DevicePort::name),
+                      required("direction", &DevicePort::direction),
+                      required("repid", &DevicePort::repid)};
+  }
+};
+
+// One device of a node, as its node announces it.
+struct DeviceRecord {
+  std::string id;
+  std::string label;
+  std::string softpkg;
+  std::string kind;                 // "gpp" runs components; "device" is used by them
+  Json properties = Json::object(); // matching properties, by name
+  Json capacity = Json::object();   // total capacities, by name
+  Json allocation = Json::object(); // allocation properties (allocator/plan_json.hpp)
+  Json deployer_requires = Json::object();
+  std::string address; // a device with ports: where it serves them
+  std::vector<DevicePort> ports;
+  static constexpr auto fields() {
+    using R = DeviceRecord;
+    return std::tuple{required("id", &R::id),
+                      required("label", &R::label),
+                      required("softpkg", &R::softpkg),
+                      required("kind", &R::kind),
+                      required("properties", &R::properties),
+                      required("capacity", &R::capacity),
+                      required("allocation", &R::allocation),
+                      required("deployerrequires", &R::deployer_requires),
+                      optional("address", &R::address),
+                      optional("ports", &R::ports)};
+  }
+};
+
+// What a node announces (announcement kind "node").
+struct NodeAnnouncement {
+  std::string node;
+  std::int64_t pid = 0;
+  std::string host;
+  std::vector<DeviceRecord> devices;
+  static constexpr auto fields() {
+    using R = NodeAnnouncement;
+    return std::tuple{required("node", &R::node), required("pid", &R::pid),
+                      required("host", &R::host), required("devices", &R::devices)};
+  }
+};
+
+struct StatusReply {
+  std::string node;
+  std::int64_t pid = 0;
+  std::string host;
+  std::vector<DeviceRecord> devices;
+  std::vector<ProcessRecord> processes;
+  static constexpr auto fields() {
+    using R = StatusReply;
+    return std::tuple{required("node", &R::node), required("pid", &R::pid),
+                      required("host", &R::host), required("devices", &R::devices),
+                      required("processes", &R::processes)};
+  }
+};
+
+struct Execute {
+  static constexpr std::string_view name = "node.execute";
+  using Request = ExecuteRequest;
+  using Reply = ExecuteReply;
+};
+struct Terminate {
+  static constexpr std::string_view name = "node.terminate";
+  using Request = TerminateRequest;
+  using Reply = TerminateReply;
+};
+struct Status {
+  static constexpr std::string_view name = "node.status";
+  using Request = Empty;
+  using Reply = StatusReply;
+};
+
+} // namespace rsca::protocol::node

@@ -1,0 +1,28 @@
+#include "protocol/topics.hpp"
+
+#include <fmt/format.h>
+
+#include "common/dds_names.hpp"
+
+namespace rsca::protocol {
+
+std::string domain_events_topic(std::string_view domain) {
+  return fmt::format("rsca_{}_domain_events", dds_name(domain));
+}
+
+std::string connection_topic(std::string_view domain, std::string_view application,
+                             const LaunchIdentity &launch, std::string_view connection) {
+  return fmt::format("rsca_{}_{}_{}", dds_name(domain),
+                     dds_name(fmt::format("{}_{}", application, to_string(launch))),
+                     dds_name(connection));
+}
+
+std::string runtime_connection_topic(std::string_view domain, std::string_view connection) {
+  return fmt::format("rsca_{}_runtime_{}", dds_name(domain), dds_name(connection));
+}
+
+std::string channel_topic(std::string_view domain, std::string_view channel) {
+  return fmt::format("rsca_{}_channel_{}", dds_name(domain), dds_name(channel));
+}
+
+} // namespace rsca::protocol

@@ -1,0 +1,27 @@
+// The DDS topic names of rsca, made here only. Names from profiles and users go through
+// dds_name (common/dds_names.hpp), so that none makes an invalid or ambiguous topic name.
+#pragma once
+
+#include <string>
+#include <string_view>
+
+#include "protocol/addresses.hpp"
+
+namespace rsca::protocol {
+
+// The control plane's three topics, shared by every domain (partitions keep domains apart).
+inline constexpr const char *kRequestTopic = "rsca_ctl_Request";
+inline constexpr const char *kReplyTopic = "rsca_ctl_Reply";
+inline constexpr const char *kAnnouncementTopic = "rsca_ctl_Announcement";
+
+// A domain's events (control/domain_events.hpp).
+std::string domain_events_topic(std::string_view domain);
+// A connection of a SAD, in one launch of its application.
+std::string connection_topic(std::string_view domain, std::string_view application,
+                             const LaunchIdentity &launch, std::string_view connection);
+// A connection made at run time (rsca connect).
+std::string runtime_connection_topic(std::string_view domain, std::string_view connection);
+// An event channel.
+std::string channel_topic(std::string_view domain, std::string_view channel);
+
+} // namespace rsca::protocol

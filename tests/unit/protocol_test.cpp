@@ -1,0 +1,230 @@
+// The wire contracts (core_framework/protocol/): messages round-trip, a malformed request is a
+// clear bad request naming the field, addresses and exec parameters are made and read back.
+#include <catch2/catch.hpp>
+
+#include "control/operation.hpp"
+#include "protocol/addresses.hpp"
+#include "protocol/component_ops.hpp"
+#include "protocol/domain_ops.hpp"
+#include "protocol/exec_params.hpp"
+#include "protocol/node_ops.hpp"
+#include "protocol/topics.hpp"
+
+using namespace rsca;
+using protocol::Json;
+
+namespace {
+
+template <typename M>
+M round_trip(const M &message) {
+  auto decoded = protocol::decode<M>(protocol::encode(message));
+  REQUIRE(decoded.has_value());
+  return *decoded;
+}
+
+} // namespace
+
+TEST_CASE("protocol: a connect request round-trips, its empty optionals left out", "[protocol]") {
+  protocol::component::ConnectRequest r;
+  r.connection = "samples";
+  r.port = "samples_out";
+  r.direction = "uses";
+  r.repid = "IDL:rsca/Samples:1.0";
+  r.topic = "rsca_d_app_1_2_samples";
+  r.qos = Json{{"reliability", "reliable"}};
+  r.local = true;
+  const Json encoded = protocol::encode(r);
+  CHECK_FALSE(encoded.contains("filter"));
+  CHECK_FALSE(encoded.contains("target"));
+  const auto back = round_trip(r);
+  CHECK(back.connection == "samples");
+  CHECK(back.topic == r.topic);
+  CHECK(back.qos == r.qos);
+  CHECK(back.local == std::optional<bool>(true));
+  CHECK_FALSE(back.filter.has_value());
+}
+
+TEST_CASE("protocol: nested messages round-trip", "[protocol]") {
+  protocol::node::StatusReply status{"node1", 42, "robot", {}, {{7, "app/C_1", "/tmp/c.log"}}};
+  protocol::node::DeviceRecord gpp{
+      "node1:GPP_1",  "GPP_1",        "GPP",          "gpp", Json{{"os_name", "Linux"}},
+      Json::object(), Json::object(), Json::object(), "",    {}};
+  protocol::node::DeviceRecord sensor = gpp;
+  sensor.id = "node1:IR_1";
+  sensor.address = "d/device/node1/IR_1";
+  sensor.ports = {{"range_out", "uses", "IDL:Range:1.0"}};
+  status.devices = {gpp, sensor};
+  const auto back = round_trip(status);
+  REQUIRE(back.devices.size() == 2);
+  CHECK(back.devices[0].properties.at("os_name") == "Linux");
+  CHECK(back.devices[1].ports.at(0).repid == "IDL:Range:1.0");
+  REQUIRE(back.processes.size() == 1);
+  CHECK(back.processes[0].pid == 7);
+}
+
+TEST_CASE("protocol: a malformed message names the field and what is wrong", "[protocol]") {
+  using protocol::decode;
+  using protocol::node::ExecuteRequest;
+  const Json good{{"application", "a"}, {"component", "c"}, {"entrypoint", "e"}, {"args", {"X"}}};
+  REQUIRE(decode<ExecuteRequest>(good).has_value());
+
+  Json missing = good;
+  missing.erase("entrypoint");
+  CHECK(decode<ExecuteRequest>(missing).error() == "missing field \"entrypoint\"");
+
+  Json unknown = good;
+  unknown["entry_point"] = "typo";
+  CHECK(decode<ExecuteRequest>(unknown).error() == "unknown field \"entry_point\"");
+
+  Json wrong = good;
+  wrong["args"] = {"X", 3};
+  CHECK(decode<ExecuteRequest>(wrong).error() ==
+        "field \"args[1]\": expected a string, found number");
+
+  CHECK(decode<ExecuteRequest>(Json::array()).error() == "expected an object, found array");
+
+  using protocol::component::AwaitMatchedRequest;
+  const Json nested{{"connections", {{{"port", "p"}, {"connection", 5}}}}};
+  CHECK(decode<AwaitMatchedRequest>(nested).error() ==
+        "field \"connections[0].connection\": expected a string, found number");
+}
+
+TEST_CASE("protocol: integers out of range and of the wrong sign are refused", "[protocol]") {
+  using protocol::component::AwaitMatchedRequest;
+  Json awaited{{"connections", {{{"port", "p"}, {"connection", "c"}, {"peers", 1}}}}};
+  REQUIRE(protocol::decode<AwaitMatchedRequest>(awaited).has_value());
+  awaited["connections"][0]["peers"] = 5'000'000'000LL; // an int32
+  CHECK(protocol::decode<AwaitMatchedRequest>(awaited).error() ==
+        "field \"connections[0].peers\": 5000000000 is out of range");
+  awaited["connections"][0]["peers"] = 1.5;
+  CHECK(protocol::decode<AwaitMatchedRequest>(awaited).error() ==
+        "field \"connections[0].peers\": expected an integer, found number");
+  Json status{{"state", "Started"},
+              {"ports",
+               {{{"name", "p"},
+                 {"direction", "uses"},
+                 {"connections", {{{"connection", "c"}, {"samples", -1}}}}}}}};
+  CHECK(protocol::decode<protocol::component::StatusReply>(status).error() ==
+        "field \"ports[0].connections[0].samples\": -1 is out of range");
+}
+
+TEST_CASE("protocol: a typed handler answers a malformed request with bad request", "[protocol]") {
+  int ran = 0;
+  auto handler = control::typed_handler<protocol::node::Terminate>(
+      [&ran](const protocol::node::TerminateRequest &r, const control::RequestContext &)
+          -> control::CallResult<protocol::node::TerminateReply> {
+        ++ran;
+        return protocol::node::TerminateReply{r.pid};
+      });
+  const control::RequestContext context;
+  auto bad = handler(Json{{"pid", "12"}}, context);
+  REQUIRE_FALSE(bad.has_value());
+  CHECK(bad.error().status == control::Status::BadRequest);
+  CHECK(bad.error().message == "node.terminate: field \"pid\": expected an integer, found string");
+  CHECK(ran == 0);
+  auto good = handler(Json{{"pid", 12}}, context);
+  REQUIRE(good.has_value());
+  CHECK(*good == Json{{"pid", 12}});
+  CHECK(ran == 1);
+}
+
+TEST_CASE("protocol: a reply that does not fit its contract fails the call", "[protocol]") {
+  auto reply = control::reply_of<protocol::node::Execute>(Json{{"pid", 3}});
+  REQUIRE_FALSE(reply.has_value());
+  CHECK(reply.error().status == control::Status::Failed);
+  CHECK(reply.error().message == "malformed reply to node.execute: missing field \"log\"");
+  auto failed = control::reply_of<protocol::node::Execute>(
+      control::call_error(control::Status::NotFound, "no such device"));
+  REQUIRE_FALSE(failed.has_value());
+  CHECK(failed.error().status == control::Status::NotFound);
+}
+
+TEST_CASE("protocol: addresses are made in one scheme and read back", "[protocol]") {
+  const protocol::LaunchIdentity launch{7, 12};
+  CHECK(protocol::domain_address("rsca") == "rsca/domain");
+  CHECK(protocol::node_address("rsca", "node1") == "rsca/node/node1");
+  CHECK(protocol::device_address("rsca", "robot", "IRSensor_1") == "rsca/device/robot/IRSensor_1");
+  const auto component = protocol::component_address("rsca", "rh.FM.demo", launch, "X_1");
+  CHECK(component == "rsca/component/rh.FM.demo.7.12/X_1");
+  CHECK(protocol::incarnation_of(component) == 7u);
+  const auto host = protocol::host_address("rsca", "PC", {9, 1}, "node1:GPP_1");
+  CHECK(host == "rsca/host/PC.9.1/node1:GPP_1");
+  CHECK(protocol::incarnation_of(host) == 9u);
+  CHECK_FALSE(protocol::incarnation_of(protocol::node_address("rsca", "n")).has_value());
+  CHECK(protocol::cli_address("rsca", "robot", 100, 2) == "rsca/cli/robot-100-2");
+}
+
+TEST_CASE("protocol: topic names keep only letters and digits of what users name", "[protocol]") {
+  CHECK(protocol::connection_topic("my-domain", "rh.FM", {3, 4}, "conn 1") ==
+        "rsca_my_domain_rh_FM_3_4_conn_1");
+  CHECK(protocol::runtime_connection_topic("rsca", "runtime_1") == "rsca_rsca_runtime_runtime_1");
+  CHECK(protocol::channel_topic("rsca", "ev/chan") == "rsca_rsca_channel_ev_chan");
+  CHECK(protocol::domain_events_topic("rsca") == "rsca_rsca_domain_events");
+}
+
+namespace {
+
+tl::expected<protocol::ExecParams, std::string> parse(const std::vector<std::string> &args) {
+  std::vector<const char *> argv{"component"};
+  for (const auto &a : args)
+    argv.push_back(a.c_str());
+  return protocol::parse_exec_params(static_cast<int>(argv.size()), argv.data());
+}
+
+} // namespace
+
+TEST_CASE("protocol: exec parameters are read back as they were made", "[protocol]") {
+  protocol::ExecParams p;
+  p.identifier = "Producer_1";
+  p.name_binding = "Producer";
+  p.profile = "/sdr/Producer.spd.xml";
+  p.domain = "rsca";
+  p.application = "PC";
+  p.control_address = "rsca/component/PC.1.1/Producer_1";
+  p.schedule = protocol::Schedule{1, 80, std::chrono::milliseconds(10),
+                                  std::chrono::milliseconds(2), std::chrono::milliseconds(10)};
+  p.others = {{"rate_hz", "20"}};
+  auto back = parse(protocol::to_args(p));
+  REQUIRE(back.has_value());
+  CHECK(back->identifier == p.identifier);
+  CHECK(back->name_binding == p.name_binding);
+  CHECK(back->control_address == p.control_address);
+  REQUIRE(back->schedule.has_value());
+  CHECK(back->schedule->priority == 80);
+  CHECK(back->schedule->budget == std::chrono::milliseconds(2));
+  CHECK(back->others == p.others);
+
+  CHECK(parse({"COMPONENT_IDENTIFIER", "a", "PROFILE_NAME"}).error() ==
+        "exec parameters come in pairs: \"PROFILE_NAME\" has no value");
+  CHECK(parse({"COMPONENT_IDENTIFIER", "a", "PROFILE_NAME", "p"}).error() ==
+        "the exec parameter CONTROL_ADDRESS is missing");
+  CHECK(parse({"COMPONENT_IDENTIFIER", "a", "PROFILE_NAME", "p", "CONTROL_ADDRESS", "c", "RSCA_CPU",
+               "one"})
+            .error() == "the exec parameter RSCA_CPU is not a number: \"one\"");
+}
+
+TEST_CASE("protocol: a host's exec parameters are read back, and its addresses found",
+          "[protocol]") {
+  protocol::HostParams host{"rsca/host/PC.1.1/node1:GPP_1", {}};
+  for (const char *id : {"A_1", "B_1"}) {
+    protocol::ExecParams p;
+    p.identifier = id;
+    p.profile = std::string("/sdr/") + id + ".spd.xml";
+    p.control_address = std::string("rsca/component/PC.1.1/") + id;
+    p.library = std::string("lib") + id + ".so";
+    host.components.push_back(p);
+  }
+  const auto args = protocol::to_args(host);
+  std::vector<const char *> argv{"rsca-component-host"};
+  for (const auto &a : args)
+    argv.push_back(a.c_str());
+  auto back = protocol::parse_host_params(static_cast<int>(argv.size()), argv.data());
+  REQUIRE(back.has_value());
+  CHECK(back->control_address == host.control_address);
+  REQUIRE(back->components.size() == 2);
+  CHECK(back->components[1].library == "libB_1.so");
+  CHECK(back->components[1].name_binding == "B_1"); // the identifier when not given
+  CHECK(protocol::control_addresses(args) == std::vector<std::string>{host.control_address,
+                                                                      "rsca/component/PC.1.1/A_1",
+                                                                      "rsca/component/PC.1.1/B_1"});
+}
