@@ -22,6 +22,7 @@
 #include <tl/expected.hpp>
 
 #include "common/diagnostic.hpp"
+#include "control/caller.hpp"
 #include "dds/participant.hpp"
 #include "protocol/status.hpp"
 
@@ -75,14 +76,7 @@ struct EndpointOptions {
   bool hold_requests = false;
 };
 
-// One call of many made at once (Endpoint::call_all).
-struct Call {
-  std::string target;
-  std::string operation;
-  Json body;
-};
-
-class Endpoint {
+class Endpoint final : public Caller {
 public:
   static Expected<std::unique_ptr<Endpoint>> open(std::shared_ptr<dds::Participant> participant,
                                                   std::string address,
@@ -90,7 +84,7 @@ public:
   // Closes: running handlers finish and write their replies, then the endpoint's DDS entities
   // go. Cyclone lingers a deleted reliable writer until its data is acknowledged (bounded by
   // WriterLingerDuration), so the last replies still reach their callers.
-  ~Endpoint();
+  ~Endpoint() override;
   Endpoint(const Endpoint &) = delete;
   Endpoint &operator=(const Endpoint &) = delete;
 
@@ -120,14 +114,14 @@ public:
   // addresses routed through the same endpoint travel as one request ("endpoint.batch"), whose
   // handlers run one after another.
   std::vector<CallResult<Json>> call_all(const std::vector<Call> &calls,
-                                         std::chrono::milliseconds timeout);
+                                         std::chrono::milliseconds timeout) override;
 
   // Calls to `target` go to `via`, the endpoint that serves it as an alias.
-  void route(const std::string &target, const std::string &via);
+  void route(const std::string &target, const std::string &via) override;
 
   // Creates the way to `target` ahead of the first call, so that DDS discovery of an endpoint
   // that is about to appear overlaps with whatever happens before that call.
-  void prepare(const std::string &target);
+  void prepare(const std::string &target) override;
   // The same for the replies to `caller` (the domain, for a node or component), whose first
   // call then does not wait for DDS to match a new reply writer.
   void prepare_replies(const std::string &caller);
@@ -135,7 +129,7 @@ public:
   // (its node saw it exit) sooner than DDS would (the addressee's lease).
   void abandon(const std::string &target, const std::string &why);
   // Drops the way to and from `target` (an endpoint that is gone for good), and its route.
-  void forget(const std::string &target);
+  void forget(const std::string &target) override;
 
   // Publishes (or updates) this endpoint's announcement; `withdraw` removes it.
   Expected<void> announce(const std::string &kind, const Json &body);

@@ -14,7 +14,7 @@
 #include <string>
 
 #include "allocator/resource_allocator.hpp"
-#include "control/endpoint.hpp"
+#include "control/caller.hpp"
 #include "domain/application.hpp"
 #include "domain/component_registry.hpp"
 #include "domain/event_channel_manager.hpp"
@@ -55,7 +55,7 @@ using protocol::LaunchIdentity;
 // What the factory uses of the domain.
 struct DomainServices {
   std::string domain_name;
-  control::Endpoint *endpoint = nullptr;
+  control::Caller *endpoint = nullptr; // the domain's Endpoint; a fake in unit tests
   allocator::ResourceAllocator *allocator = nullptr;
   ComponentRegistry *components = nullptr;
   EventChannelManager *channels = nullptr;
@@ -89,7 +89,10 @@ public:
 
 private:
   class Launch;
-  void disconnect_devices(const Application &app);
+  // The undoable parts of a release, which a failed launch also runs (its saga): the devices'
+  // ends of the application's connections (how many), and its processes.
+  std::size_t disconnect_devices(const Application &app);
+  control::CallResult<std::vector<std::string>> release_processes(Application &app);
   DomainServices services_;
 };
 
