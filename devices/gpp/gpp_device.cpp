@@ -73,7 +73,7 @@ GppDevice::execute(const protocol::node::ExecuteRequest &r) {
   const std::string &application = r.application;
   const std::string &component = r.component;
   ExecRequest request;
-  request.executable = find_executable(r.entrypoint, r.spd_dir);
+  request.program = find_executable(r.entrypoint, r.spd_dir);
   request.args = r.args;
   request.env = context_.dds.component_environment();
   // The component dies with this node: it checks that its parent is still this process.
@@ -92,7 +92,7 @@ GppDevice::execute(const protocol::node::ExecuteRequest &r) {
     owner.addresses = protocol::control_addresses(request.args);
     owners_[*pid] = std::move(owner);
   }
-  spdlog::info("{}: executed {} as pid {} (log {})", context_.id, request.executable.string(), *pid,
+  spdlog::info("{}: executed {} as pid {} (log {})", context_.id, request.program.string(), *pid,
                request.log_file.string());
   return protocol::node::ExecuteReply{*pid, request.log_file.string()};
 }

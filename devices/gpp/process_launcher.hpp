@@ -23,22 +23,18 @@
 #include <sys/types.h>
 
 #include "common/diagnostic.hpp"
+#include "process/spawn.hpp"
 
 namespace rsca::gpp {
 
 // The process id of a launched process; also the id of its process group.
 using ProcessId = pid_t;
 
-struct ExecRequest {
-  std::filesystem::path executable; // run as is: no PATH search
-  std::vector<std::string> args;    // argv[1..]; argv[0] is the executable's path
-  // Added to the environment this process has; a name already there is overridden.
-  std::vector<std::pair<std::string, std::string>> env;
-  std::filesystem::path working_dir; // empty: this process's working directory
-  // stdout and stderr are appended to this file, its directories created if missing. Empty:
-  // the child shares this process's stdout and stderr. stdin is always /dev/null.
-  std::filesystem::path log_file;
-  std::string label; // names the process in logs; empty: the executable's file name
+// What execute() starts (process/spawn.hpp says how: stdin from /dev/null, default signal
+// dispositions, no inherited descriptor; here always in a process group of its own), and the
+// name it goes by in logs.
+struct ExecRequest : process::Command {
+  std::string label; // names the process in logs; empty: the program's file name
 };
 
 struct ExitStatus {

@@ -5,6 +5,7 @@
 #include "profile/profile_loader.hpp"
 #include "profile/property_binding.hpp"
 #include "profile/sdr_root.hpp"
+#include "temp_dir.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -13,7 +14,6 @@
 #include <filesystem>
 #include <functional>
 #include <map>
-#include <random>
 #include <set>
 #include <string>
 #include <variant>
@@ -23,6 +23,7 @@ using namespace rsca;
 using namespace rsca::profile;
 using Catch::Matchers::Contains;
 using Catch::Matchers::EndsWith;
+using rsca::test::TempDir;
 
 namespace fs = std::filesystem;
 
@@ -143,26 +144,6 @@ T member_as(const PropertyValue &value, std::string_view member) {
   FAIL("no member " << member);
   throw;
 }
-
-// A directory of its own under the system's temporary directory, removed afterwards.
-class TempDir {
-public:
-  TempDir() {
-    std::random_device random;
-    path_ = fs::temp_directory_path() / ("rsca_corpus_test_" + std::to_string(random()));
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  TempDir(const TempDir &) = delete;
-  TempDir &operator=(const TempDir &) = delete;
-  const fs::path &path() const { return path_; }
-
-private:
-  fs::path path_;
-};
 
 } // namespace
 

@@ -20,7 +20,6 @@
 #include <poll.h>
 #include <signal.h>
 #include <sys/stat.h>
-#include <sys/syscall.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -28,6 +27,8 @@
 
 #include "gpp/host_info.hpp"
 #include "gpp/process_launcher.hpp"
+#include "process/spawn.hpp"
+#include "temp_dir.hpp"
 
 using namespace std::chrono_literals;
 using rsca::gpp::ExecRequest;
@@ -35,30 +36,12 @@ using rsca::gpp::ExitStatus;
 using rsca::gpp::ProcessId;
 using rsca::gpp::ProcessLauncher;
 using rsca::gpp::TerminateOptions;
+using rsca::test::TempDir;
 namespace fs = std::filesystem;
 
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-class TempDir {
-public:
-  TempDir() {
-    auto pattern = (fs::temp_directory_path() / "rsca_launcher_test_XXXXXX").string();
-    REQUIRE(::mkdtemp(pattern.data()) != nullptr);
-    path_ = fs::canonical(pattern);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  TempDir(const TempDir &) = delete;
-  TempDir &operator=(const TempDir &) = delete;
-  const fs::path &path() const { return path_; }
-
-private:
-  fs::path path_;
-};
 
 // Collects what on_exit reports, for the test thread to wait on.
 class ExitLog {
@@ -186,7 +169,7 @@ std::vector<pid_t> zombie_children() {
 
 ExecRequest shell(std::string script, std::vector<std::string> parameters = {}) {
   ExecRequest request;
-  request.executable = "/bin/sh";
+  request.program = "/bin/sh";
   request.args = {"-c", std::move(script), "sh"};
   request.args.insert(request.args.end(), parameters.begin(), parameters.end());
   return request;
@@ -197,12 +180,6 @@ ProcessId launch(ProcessLauncher &launcher, const ExecRequest &request) {
   INFO((pid ? std::string{} : pid.error().to_string()));
   REQUIRE(pid.has_value());
   return *pid;
-}
-
-// Waits until the process with this pidfd has exited; false on timeout.
-bool wait_pidfd(int pidfd, std::chrono::milliseconds timeout) {
-  pollfd pfd{pidfd, POLLIN, 0};
-  return ::poll(&pfd, 1, static_cast<int>(timeout.count())) == 1;
 }
 
 void check_gone(pid_t pid) {
@@ -217,7 +194,7 @@ TEST_CASE("a process that exits on its own is reported through on_exit", "[proce
   ExitLog exits;
   ProcessLauncher launcher(exits.callback());
   ExecRequest request;
-  request.executable = "/bin/true";
+  request.program = "/bin/true";
   const auto pid = launch(launcher, request);
 
   const auto status = exits.wait(pid, 10s);
@@ -305,18 +282,18 @@ TEST_CASE("what cannot be executed is an error and starts nothing", "[process]")
   };
 
   ExecRequest missing;
-  missing.executable = "/nonexistent/rsca/component";
+  missing.program = "/nonexistent/rsca/component";
   CHECK(error_of(missing) == "cannot execute /nonexistent/rsca/component: no such file");
 
   const auto script = dir.path() / "not_executable.sh";
   std::ofstream(script) << "#!/bin/sh\nexit 0\n";
   fs::permissions(script, fs::perms::owner_read | fs::perms::owner_write);
   ExecRequest not_executable;
-  not_executable.executable = script;
+  not_executable.program = script;
   CHECK(error_of(not_executable) == "cannot execute " + script.string() + ": permission denied");
 
   ExecRequest directory;
-  directory.executable = dir.path();
+  directory.program = dir.path();
   CHECK(error_of(directory) == "cannot execute " + dir.path().string() + ": is a directory");
 
   auto bad_directory = shell("exit 0");
@@ -424,11 +401,10 @@ TEST_CASE("what a process leaves in its group when it exits on its own is killed
   const auto line = fifo.read_line(10s);
   REQUIRE(line.has_value());
   const pid_t grandchild = std::stoi(*line);
-  const int pidfd = static_cast<int>(::syscall(SYS_pidfd_open, grandchild, 0));
+  const auto pidfd = rsca::process::open_pidfd(grandchild);
   // Killed by the launcher (nothing else here would kill it), or already killed and reaped.
-  if (pidfd >= 0) {
-    CHECK(wait_pidfd(pidfd, 10s));
-    ::close(pidfd);
+  if (pidfd) {
+    CHECK(rsca::process::wait_exited(pidfd, 10s));
   } else {
     CHECK(errno == ESRCH);
   }
@@ -470,7 +446,7 @@ TEST_CASE("the destructor stops every running process", "[process]") {
     ProcessLauncher launcher(exits.callback());
     for (int i = 0; i < 3; ++i) {
       ExecRequest request;
-      request.executable = "/bin/sleep";
+      request.program = "/bin/sleep";
       request.args = {"1000"};
       pids.push_back(launch(launcher, request));
     }
@@ -520,7 +496,7 @@ TEST_CASE("list, running and wait_for_exit describe the launched processes", "[p
   TempDir dir;
   ProcessLauncher launcher;
   ExecRequest request;
-  request.executable = "/bin/sleep";
+  request.program = "/bin/sleep";
   request.args = {"1000"};
   request.label = "sleeper";
   request.log_file = dir.path() / "sleeper.log";

@@ -1,10 +1,6 @@
 // rsca domain up|down: a local domain daemon and N node daemons in the background, with their
 // logs and pid files in a run folder.
-#include <fcntl.h>
-#include <poll.h>
 #include <signal.h>
-#include <spawn.h>
-#include <sys/syscall.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -17,8 +13,7 @@
 #include "commands.hpp"
 #include "domain_client.hpp"
 #include "exit_codes.hpp"
-
-extern char **environ;
+#include "process/spawn.hpp"
 
 namespace rsca::cli {
 namespace {
@@ -61,43 +56,24 @@ std::optional<pid_t> read_pid(const fs::path &file) {
 }
 
 // Starts a daemon in its own session (so the terminal's Ctrl-C does not reach it), with stdout
-// and stderr in `log`, and records its pid in `pid_file`.
+// and stderr in `log`, and records its pid in `pid_file`. It outlives this command: nobody here
+// reaps it.
 Expected<pid_t> spawn_daemon(const fs::path &program, const std::vector<std::string> &args,
                              const fs::path &log, const fs::path &pid_file) {
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
-  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(),
-                                   O_WRONLY | O_CREAT | O_APPEND, 0644);
-  posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
-  posix_spawnattr_t attributes;
-  posix_spawnattr_init(&attributes);
-  posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETSID);
-  std::vector<std::string> argv_strings{program.string()};
-  argv_strings.insert(argv_strings.end(), args.begin(), args.end());
-  std::vector<char *> argv;
-  for (auto &a : argv_strings)
-    argv.push_back(a.data());
-  argv.push_back(nullptr);
-  pid_t pid = 0;
-  const int rc = posix_spawn(&pid, program.c_str(), &actions, &attributes, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  posix_spawnattr_destroy(&attributes);
-  if (rc != 0)
-    return make_error({program.string(), 0, 0}, "spawn", std::strerror(rc));
-  std::ofstream(pid_file) << pid << '\n';
-  return pid;
+  auto daemon =
+      process::spawn({.program = program, .args = args, .log_file = log}, process::Group::Session);
+  if (!daemon)
+    return tl::unexpected(std::move(daemon.error()));
+  std::ofstream(pid_file) << daemon->pid << '\n';
+  return daemon->pid;
 }
 
 // Waits for a process to exit, without polling by sleeping: a pidfd becomes readable at exit.
 bool wait_exit(pid_t pid, std::chrono::milliseconds timeout) {
-  const int fd = static_cast<int>(::syscall(SYS_pidfd_open, pid, 0));
-  if (fd < 0)
+  const auto pidfd = process::open_pidfd(pid);
+  if (!pidfd)
     return !alive(pid);
-  pollfd p{fd, POLLIN, 0};
-  const int ready = ::poll(&p, 1, static_cast<int>(timeout.count()));
-  ::close(fd);
-  return ready > 0 || !alive(pid);
+  return process::wait_exited(pidfd, timeout) || !alive(pid);
 }
 
 std::string tail(const fs::path &log, std::size_t lines = 8) {

@@ -1,0 +1,79 @@
+// One way to start a process. Whatever rsca starts, a component process from the GPP, the
+// daemons of `rsca domain up`, the programs of the integration tests, is started here, the same
+// careful way:
+// - the program is run as given, never looked up in PATH; argv[0] is its path;
+// - whatever can be checked in this process is checked before anything starts (the program is an
+//   executable regular file, the working directory exists, the variable names are names, the log
+//   file opens), so a mistake is an error naming the program and no child is left behind; exec
+//   failures come back from posix_spawn itself (glibc starts the child vfork-style and reports
+//   the exec's errno);
+// - the child gets stdin from /dev/null, stdout and stderr appended to the log file (or this
+//   process's), and no other descriptor of this process, close-on-exec or not;
+// - an empty signal mask and every signal's default action: an ignored signal would stay ignored
+//   across exec, and a blocked one blocked (a daemon started from a shell that ignores SIGINT
+//   would never stop on it). Only glibc's own two signals below SIGRTMIN stay ignored when this
+//   process handles them: no spawn attribute reaches them, and a glibc program handles them itself;
+// - the process group or session the caller asks for.
+// It returns the child's pid and a pidfd (readable once the child has exited): reaping is the
+// caller's business, since the GPP reaps whole process groups and `rsca domain up` leaves its
+// daemons running when it exits.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <sys/types.h>
+
+#include "common/diagnostic.hpp"
+#include "process/fd.hpp"
+
+namespace rsca::process {
+
+// Where the child stands among process groups and sessions.
+enum class Group : std::uint8_t {
+  Own,     // leads a process group of its own (its pid is the group's id): signalled as a whole
+  Session, // leads a session of its own, so a terminal's Ctrl-C does not reach it (daemons)
+  Caller,  // stays in the caller's process group, so it goes with it (test programs)
+};
+
+// What to run, with what, where, and where its output goes. Every member has a default, so a
+// designated initializer names only what it sets.
+struct Command {
+  std::filesystem::path program{}; // run as is: no PATH search
+  std::vector<std::string> args{}; // argv[1..]; argv[0] is the program's path
+  // Added to the environment this process has; a name already there is overridden, and of a
+  // name given twice the last value wins.
+  std::vector<std::pair<std::string, std::string>> env{};
+  std::filesystem::path working_dir{}; // empty: this process's working directory
+  // stdout and stderr are appended to this file, its directories created if missing. Empty:
+  // the child shares this process's stdout and stderr. stdin is always /dev/null.
+  std::filesystem::path log_file{};
+};
+
+// A started process. Not reaped by its destructor: whoever started it reaps it, or leaves it to
+// outlive this process.
+struct Child {
+  pid_t pid = 0;
+  Fd pidfd; // close-on-exec; readable once the process has exited
+};
+
+// Starts the command's program in `group`; returns once the child runs it. Every failure is an
+// error at the program (rule "execute"), e.g. "cannot execute /opt/x: no such file", and starts
+// nothing.
+Expected<Child> spawn(const Command &command, Group group);
+
+// A pidfd for `pid` (close-on-exec), which need not be this process's child; empty on failure
+// (errno says why).
+Fd open_pidfd(pid_t pid);
+
+// Waits until the process behind `pidfd` has exited; false when it still runs after `timeout`.
+bool wait_exited(const Fd &pidfd, std::chrono::milliseconds timeout);
+
+// An errno value as a message: "no such file", "permission denied", else strerror's text.
+std::string errno_text(int error);
+
+} // namespace rsca::process

@@ -1,0 +1,207 @@
+"""The port benchmarks' helpers (tests/bench/port_bench.py): the SDR root and DDS leases of a run,
+result files and their statistics, the host's state, the QoS the domain gave, and the two sides
+of the latency benchmark: the rsca components (LatencyRsca) and the raw programs (LatencyRaw),
+each run one round at a time."""
+import array
+import json
+import math
+import os
+import statistics
+import subprocess
+import time
+
+from local_domain import Processes, percentile
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+SDRROOT = os.path.join(HERE, "profiles")
+# The fan-out runs every process (daemons, components, raw programs alike) with a DDS participant
+# lease of 10 s instead of the project's 1 s: with the 1 s lease, Cyclone's discovery traffic
+# grows with the square of the participants, and a hundred idle participants on one host take two
+# cores by themselves (50: ~0.8 core, 100: ~2 cores, measured); the daemons then miss their own
+# leases and the domain drops its nodes. --lease-ms 1000 runs it with the default anyway.
+FANOUT_LEASE_MS = 10000
+
+
+def lease_env(lease_ms):
+    """The environment that gives every process of the run this DDS lease: the daemons and the CLI
+    (RSCA_DDS_LEASE_MS), the components and the raw programs that stand in for them
+    (RSCA_DDS_COMPONENT_LEASE_MS). None: the project's own leases."""
+    if not lease_ms:
+        return {}
+    return {"RSCA_DDS_LEASE_MS": str(lease_ms), "RSCA_DDS_COMPONENT_LEASE_MS": str(lease_ms)}
+# A launch the domain rolled back (e.g. a component not registered within the domain's 10 s while
+# the host is busy) is tried again, this many times in all.
+LAUNCH_ATTEMPTS = 3
+
+
+def read_u64(path):
+    values = array.array("Q")
+    with open(path, "rb") as f:
+        values.frombytes(f.read())
+    return values
+
+
+def wait_for_file(path, size, timeout, why):
+    """Waits for a result file to be complete. Files, not control calls: a CLI call during a
+    measurement would start a DDS participant, whose discovery every process would feel."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        try:
+            if os.path.getsize(path) >= size:
+                return
+        except OSError:
+            pass
+        time.sleep(0.05)  # pacing a poll of the file system
+    raise RuntimeError(f"{why}: no complete {path} after {timeout:.0f} s")
+
+
+def latency_stats(values_ns):
+    us = [v / 1e3 for v in values_ns]
+    return {"p50_us": percentile(us, 50), "p90_us": percentile(us, 90),
+            "p99_us": percentile(us, 99), "p999_us": percentile(us, 99.9),
+            "min_us": min(us), "max_us": max(us), "mean_us": statistics.fmean(us),
+            "count": len(us)}
+
+
+def ratio(a, b):
+    return a / b if b else math.inf
+
+
+def host_state():
+    """How busy the host's CPUs are now (over one second, from /proc/stat), its load average and
+    CPU count."""
+    def times():
+        with open("/proc/stat") as f:
+            values = [int(v) for v in f.readline().split()[1:]]
+        return sum(values), values[3] + values[4]  # all, idle + iowait
+    total0, idle0 = times()
+    time.sleep(1.0)  # the sampling interval itself
+    total1, idle1 = times()
+    busy = 100.0 * (1 - (idle1 - idle0) / max(1, total1 - total0))
+    return {"cpus": os.cpu_count(), "busy_percent": round(busy, 1),
+            "loadavg": [round(x, 2) for x in os.getloadavg()]}
+
+
+def busy_note(results):
+    """A line saying the host was busy just before the run (other processes then compete for the
+    CPUs with the benchmark, and latencies say more about the scheduler than about the data path),
+    or nothing."""
+    state = results["host_before"]
+    if state["busy_percent"] > 20:
+        return (f"note: the host's CPUs were {state['busy_percent']:.0f}% busy just before the run "
+                f"(load average {state['loadavg'][0]:.1f} on {state['cpus']} CPUs): the figures "
+                "are noisy.")
+    return None
+
+
+def connection_qos(domain, app):
+    """The QoS the domain gave the connections of `app` (all the same here), as component.connect
+    carries it: what the raw programs use."""
+    reply, _ = domain.cli("ls", "connections", app)
+    qos = [c["qos"] for c in reply.get("connections", []) if "qos" in c]
+    if not qos:
+        raise RuntimeError(f"no connection QoS in `rsca ls connections {app}`: {reply}")
+    if any(q != qos[0] for q in qos):
+        raise RuntimeError(f"the connections of {app} differ in QoS: {qos}")
+    return qos[0]
+
+
+def raw_sizes(raw, env):
+    out = subprocess.run([raw, "sizes"], env=env, capture_output=True, text=True, check=True,
+                         timeout=60)
+    return json.loads(out.stdout)
+
+
+# ---- latency ----------------------------------------------------------------------------------
+
+def cpu_us(pid):
+    """CPU time (user + system, all threads) of a live process so far, in microseconds."""
+    with open(f"/proc/{pid}/stat") as f:
+        fields = f.read().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) * 1e6 / os.sysconf("SC_CLK_TCK")
+
+
+class LatencyRsca:
+    """BenchPing_1 and BenchEcho_1 launched once (not started); each round configures the ping's
+    output, starts the application, waits for the file and stops it."""
+
+    def __init__(self, domain, work, count, warmup):
+        self.domain, self.work, self.count, self.warmup = domain, work, count, warmup
+        sad = os.path.join(SDRROOT, "dom/waveforms/BenchPortLatency/BenchPortLatency.sad.xml")
+        domain.cli("install", sad)
+        reply, _ = domain.cli("launch", "BenchPortLatency", "--name", "latency", "--no-start")
+        self.pids = {c["id"]: c["pid"] for c in reply["components"]}
+        self.qos = connection_qos(domain, "latency")
+        domain.cli("configure", "latency/BenchPing_1", f"count={count}", f"warmup={warmup}")
+        self.cpu_us = 0.0
+        self.round_trips = 0
+        self.resent = 0
+
+    def run(self, index):
+        output = os.path.join(self.work, f"rsca-rtt-{index}.bin")
+        self.domain.cli("configure", "latency/BenchPing_1", f"output={output}")
+        before = sum(cpu_us(p) for p in self.pids.values())
+        self.domain.cli("start", "latency")
+        wait_for_file(output, 8 * self.count, 60 + self.count * 0.01, "BenchPing_1")
+        self.cpu_us += sum(cpu_us(p) for p in self.pids.values()) - before
+        props, _ = self.domain.cli("query", "latency/BenchPing_1", "completed", "resent")
+        self.domain.cli("stop", "latency")
+        self.round_trips += props["properties"]["completed"]
+        self.resent += props["properties"]["resent"]
+        return read_u64(output)
+
+    def close(self):
+        self.domain.cli("release", "latency", check=False)
+
+
+class LatencyRaw:
+    """`rsca-bench-raw echo` for the whole run; each round runs `rsca-bench-raw ping` to its end.
+    The two share a session of their own, as BenchPing_1 and BenchEcho_1 share the session of the
+    node that started them (local_domain.Processes says why that matters)."""
+
+    def __init__(self, domain, raw, work, qos, count, warmup, wake):
+        self.domain, self.raw, self.work, self.count, self.warmup = domain, raw, work, count, warmup
+        self.wake = wake
+        self.procs = Processes(shared_session=True)
+        self.ping_topic = f"rsca_bench_raw_ping_{wake}_{os.getpid()}"
+        self.echo_topic = f"rsca_bench_raw_echo_{wake}_{os.getpid()}"
+        self.qos = json.dumps(qos)
+        try:
+            self.echo = self.procs.start(
+                [raw, "echo", "--in", self.ping_topic, "--out", self.echo_topic, "--qos",
+                 self.qos, "--wake", wake], domain.env, os.path.join(work, f"raw-{wake}-echo.log"))
+        except BaseException:
+            self.procs.close()
+            raise
+        self.cpu_us = 0.0
+        self.round_trips = 0
+        self.resent = 0
+
+    def run(self, index):
+        output = os.path.join(self.work, f"raw-{self.wake}-rtt-{index}.bin")
+        echo_before = cpu_us(self.echo.pid)
+        ping = self.procs.start(
+            [self.raw, "ping", "--out", self.ping_topic, "--in", self.echo_topic, "--qos",
+             self.qos, "--wake", self.wake, "--count", str(self.count), "--warmup",
+             str(self.warmup), "--output", output], self.domain.env,
+            os.path.join(self.work, f"raw-{self.wake}-ping-{index}.log"))
+        try:
+            out, _ = ping.communicate(timeout=60 + self.count * 0.01)
+        except subprocess.TimeoutExpired:
+            raise RuntimeError("rsca-bench-raw ping did not finish") from None
+        if ping.returncode != 0:
+            raise RuntimeError(f"rsca-bench-raw ping failed ({ping.returncode}); see {self.work}")
+        summary_ = json.loads(out)
+        # The echo's CPU over the ping's whole life (its start-up included: the echo idles then).
+        self.cpu_us += summary_["cpu_us"] + cpu_us(self.echo.pid) - echo_before
+        self.round_trips += summary_["completed"]
+        self.resent += summary_["resent"]
+        return read_u64(output)
+
+    def close(self):
+        self.procs.close()
+
+
+# The latency benchmark's sides: the rsca components, the raw programs with a waitset (the baseline
+# of the ratio lines), and the raw programs woken the way rsca's receive loop wakes.
+SIDES = ("rsca", "raw", "raw_listener")

@@ -1,0 +1,154 @@
+// The whole product with real processes (domain_fixture.hpp), continued from domain_test.cpp:
+// launches that fail (a missing executable, a component that crashes at start or never
+// registers, a property of the wrong type, no device that matches) or are cancelled (the CLI
+// stops waiting, Ctrl-C, a cancel that overtakes its launch) roll back and leave nothing behind.
+#include <signal.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <fstream>
+#include <sstream>
+
+#include <catch2/catch.hpp>
+#include <fmt/format.h>
+
+#include "domain_fixture.hpp"
+
+using namespace rsca::test;
+using namespace std::chrono_literals;
+using rsca::control::Json;
+
+TEST_CASE("a missing executable fails the launch at execute and rolls back",
+          "[integration][domain][failure]") {
+  TestDomain domain;
+  domain.install("MissingExecutable");
+  auto [rc, out] = domain.cli({"launch", "MissingExecutable"});
+  CHECK(rc == 6);
+  CHECK_THAT(out, Catch::Contains("failed at step 'execute'"));
+  CHECK_THAT(out, Catch::Contains("rsca-no-such-program"));
+  CHECK_THAT(out, Catch::Contains("rolled back"));
+  domain.require_clean({});
+  CHECK(domain.running_pids().empty());
+}
+
+TEST_CASE("a component crashing at start fails the launch and rolls back",
+          "[integration][domain][failure]") {
+  TestDomain domain;
+  domain.install("CrashAtStart");
+  auto [rc, out] = domain.cli({"launch", "CrashAtStart"});
+  CHECK(rc != 0);
+  CHECK_THAT(out, Catch::Contains("failed at step 'start'"));
+  CHECK_THAT(out, Catch::Contains("Victim_1"));
+  CHECK(TestDomain::wait_for([&] { return domain.running_pids().empty(); }));
+  domain.require_clean({});
+}
+
+TEST_CASE("a component that never registers fails the launch at register",
+          "[integration][domain][failure]") {
+  TestDomain domain(2, /*registration_timeout_ms=*/1500);
+  domain.install("NeverRegisters");
+  auto [rc, out] = domain.cli({"launch", "NeverRegisters"});
+  // The domain answered: a launch that failed and was rolled back (6), not an unreachable domain.
+  CHECK(rc == 6);
+  CHECK_THAT(out, Catch::Contains("failed at step 'register'"));
+  CHECK_THAT(out, Catch::Contains("Victim_1"));
+  domain.require_clean({});
+  CHECK(domain.running_pids().empty());
+}
+
+TEST_CASE("a launch the CLI stops waiting for is cancelled and rolled back",
+          "[integration][domain][failure]") {
+  // The domain would wait a minute for the registration that never comes; only the cancel ends
+  // the launch within wait_for's limit.
+  TestDomain domain(2, /*registration_timeout_ms=*/60000);
+  domain.install("NeverRegisters");
+  // The CLI waits six of its 1 s timeouts, then cancels the launch. (Not shorter: the request
+  // must reach the domain within the CLI's timeout on a loaded machine too.)
+  auto [rc, out] = domain.cli({"--timeout-ms", "1000", "launch", "NeverRegisters"});
+  CHECK(rc == 4); // a timeout
+  CHECK_THAT(out, Catch::Contains("had not finished launching NeverRegisters after 6000 ms"));
+  CHECK_THAT(out, Catch::Contains("the launch is cancelled"));
+  CHECK_THAT(out, !Catch::Contains("rsca domain up"));
+  CHECK(TestDomain::wait_for([&] { return domain.running_pids().empty(); }));
+  domain.require_clean({});
+}
+
+TEST_CASE("Ctrl-C on rsca launch cancels the launch, which rolls back",
+          "[integration][domain][failure]") {
+  TestDomain domain(2, /*registration_timeout_ms=*/60000);
+  domain.install("NeverRegisters");
+  const fs::path out = domain.run_dir() / "interrupted.out";
+  // exec: the signal goes to rsca itself, not to a shell around it.
+  ChildProcess cli("/bin/sh",
+                   {"-c", "exec \"$0\" \"$@\" > " + out.string() + " 2>&1",
+                    (kBin / "rsca").string(), "launch", "NeverRegisters"},
+                   domain.env());
+  // The launch is waiting for the registration that never comes once its process runs.
+  REQUIRE(TestDomain::wait_for([&] { return !domain.running_pids().empty(); }));
+  ::kill(cli.pid(), SIGINT);
+  const auto status = cli.wait_exit(20s);
+  std::ifstream in(out);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  INFO(text);
+  REQUIRE(status.has_value());
+  REQUIRE(WIFEXITED(*status));
+  CHECK(WEXITSTATUS(*status) == 6); // failed, rolled back
+  CHECK_THAT(text, Catch::Contains("interrupted; the launch is cancelled"));
+  // "cancelled while N of M had registered", or "cancelled before this step" when the cancel
+  // came while the second node was still starting its process.
+  CHECK_THAT(text, Catch::Contains("failed at step 'register': cancelled"));
+  CHECK_THAT(text, Catch::Contains("rolled back"));
+  CHECK(TestDomain::wait_for([&] { return domain.running_pids().empty(); }));
+  domain.require_clean({});
+}
+
+TEST_CASE("a cancel that overtakes its launch's request keeps the launch from beginning",
+          "[integration][domain][failure]") {
+  // The CLI's cancel and its create travel apart; a create that arrives after its cancel must
+  // not launch an application its caller was told would not run.
+  TestDomain domain(2);
+  domain.install("Healthy");
+  auto cancelled = domain.call("app.cancel", Json{{"launch_id", "overtaken-1"}});
+  REQUIRE(cancelled.has_value());
+  CHECK(cancelled->at("cancelled") == true);
+  CHECK(cancelled->at("begun") == false);
+  auto created =
+      domain.call("app.create", Json{{"application", "Healthy"}, {"launch_id", "overtaken-1"}});
+  REQUIRE_FALSE(created.has_value());
+  CHECK_THAT(created.error().message, Catch::Contains("cancelled before it began"));
+  CHECK(domain.running_pids().empty());
+  domain.require_clean({});
+  // The name was not kept: the next launch takes it.
+  auto next = domain.call("app.create", Json{{"application", "Healthy"}, {"launch_id", "after-1"}});
+  REQUIRE(next.has_value());
+  CHECK(next->at("name") == "Healthy");
+  REQUIRE(domain.call("app.release", Json{{"app", "Healthy"}}).has_value());
+}
+
+TEST_CASE("a property value of the wrong type is refused at install, before anything runs",
+          "[integration][domain][failure]") {
+  TestDomain domain;
+  auto [rc, out] =
+      domain.cli({"install", "--sdrroot", kTestSdr.string(),
+                  (kTestSdr / "dom/waveforms/WrongValueType/WrongValueType.sad.xml").string()});
+  CHECK(rc == 1);
+  CHECK_THAT(out, Catch::Contains("WrongValueType.sad.xml:26:52"));
+  CHECK_THAT(out, Catch::Contains("\"eleven\" is not a valid ulong"));
+  auto installed = domain.call("domain.installed");
+  REQUIRE(installed.has_value());
+  CHECK(installed->at("applications").empty());
+}
+
+TEST_CASE("no device that matches: the launch is rejected with the reason per device",
+          "[integration][domain][failure]") {
+  TestDomain domain;
+  domain.install("NoMatchingDevice");
+  auto [rc, out] = domain.cli({"launch", "NoMatchingDevice"});
+  CHECK(rc == 5);
+  CHECK_THAT(out, Catch::Contains("failed at step 'allocate'"));
+  CHECK_THAT(out, Catch::Contains(
+                      "node1:GPP_1 (cpp): os_name is Linux, implementation cpp needs VxWorks"));
+  CHECK_THAT(out, Catch::Contains("node2:GPP_1"));
+  domain.require_clean({});
+}

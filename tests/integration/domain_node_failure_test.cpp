@@ -1,0 +1,195 @@
+// The whole product with real processes (domain_fixture.hpp), continued from domain_test.cpp:
+// daemons and components that die or stop (a node daemon killed during a launch, a restarted
+// domain daemon, a component that crashes after launch, a node that dies with its components, a
+// node daemon stopped while it ends a process), and what the domain does about each.
+#include <signal.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <fstream>
+#include <sstream>
+
+#include <catch2/catch.hpp>
+#include <fmt/format.h>
+
+#include "domain_fixture.hpp"
+
+using namespace rsca::test;
+using namespace std::chrono_literals;
+using rsca::control::Json;
+
+TEST_CASE("a node daemon killed during a launch fails it, and the rest is rolled back",
+          "[integration][domain][failure]") {
+  TestDomain domain;
+  domain.install("HangAtConfigure");
+  // Both components land on node1 (first fit); the launch hangs in configure, and node1 dies.
+  auto launch = std::async(std::launch::async, [&] {
+    return domain.cli({"launch", "HangAtConfigure"});
+  });
+  REQUIRE(TestDomain::wait_for([&] { return domain.running_pids().size() == 2; }));
+  const auto pids = domain.running_pids();
+  domain.kill_node(1);
+  auto [rc, out] = launch.get();
+  INFO(out);
+  CHECK(rc != 0);
+  CHECK_THAT(out, Catch::Contains("failed at step"));
+  // The node's components die with it; nothing stays allocated; the domain forgot node1.
+  domain.require_clean(pids);
+  auto nodes = domain.call("domain.nodes");
+  REQUIRE(nodes.has_value());
+  CHECK(nodes->at("nodes").size() == 1);
+}
+
+TEST_CASE("a restarted domain daemon sees every node again and keeps what was installed",
+          "[integration][domain][recovery]") {
+  TestDomain domain;
+  domain.install("Healthy");
+  // Models lost while the domain was down are written again when it starts.
+  std::vector<fs::path> models;
+  for (const auto &entry : fs::recursive_directory_iterator(domain.run_dir() / "repository"))
+    if (entry.path().string().ends_with(".model.json"))
+      models.push_back(entry.path());
+  REQUIRE_FALSE(models.empty());
+  for (const auto &model : models)
+    fs::remove(model);
+  domain.restart_domaind();
+  // The nodes do nothing: their durable announcements reach the new domain daemon.
+  CHECK(TestDomain::wait_for([&] {
+    auto nodes = domain.call("domain.nodes", Json::object(), 2s);
+    return nodes && nodes->at("nodes").size() == 2;
+  }));
+  // It answers only once it has loaded what was installed.
+  for (const auto &model : models)
+    CHECK(fs::exists(model));
+  auto installed = domain.call("domain.installed");
+  REQUIRE(installed.has_value());
+  REQUIRE(installed->at("applications").size() == 1);
+  CHECK(installed->at("applications")[0].at("name") == "Healthy");
+  auto app = domain.call("app.create", Json{{"application", "Healthy"}});
+  INFO((app ? std::string() : app.error().message));
+  REQUIRE(app.has_value());
+  // The launch reports every step it took, in SCA order, with its time.
+  std::vector<std::string> steps;
+  for (const auto &s : app->at("launch").at("steps"))
+    steps.push_back(s.at("step"));
+  CHECK(steps == std::vector<std::string>{"check", "allocate", "execute", "register", "initialize",
+                                          "configure", "connect", "start"});
+  CHECK(app->at("launch").at("ms").get<double>() > 0);
+  const auto pids = pids_of(*app);
+  REQUIRE(domain.call("app.release", Json{{"app", "Healthy"}}).has_value());
+  domain.require_clean(pids);
+}
+
+TEST_CASE("a component that crashes after launch is reported to the domain",
+          "[integration][domain][failure]") {
+  TestDomain domain;
+  const Json app = domain.create("Healthy");
+  long victim = 0;
+  for (const auto &c : app.at("components"))
+    if (c.at("id") == "Victim_1")
+      victim = c.at("pid").get<long>();
+  REQUIRE(victim > 0);
+  ::kill(static_cast<pid_t>(victim), SIGSEGV);
+  CHECK(TestDomain::wait_for([&] {
+    auto shown = domain.call("app.show", Json{{"app", "Healthy"}});
+    if (!shown)
+      return false;
+    for (const auto &c : shown->at("components"))
+      if (c.at("id") == "Victim_1")
+        return c.at("state") == "exited";
+    return false;
+  }));
+  REQUIRE(domain.call("app.release", Json{{"app", "Healthy"}}).has_value());
+  domain.require_clean(pids_of(app));
+}
+
+TEST_CASE("the components of a node that dies are reported exited, with the node as the reason",
+          "[integration][domain][failure]") {
+  TestDomain domain;
+  const Json app = domain.create("Healthy");
+  const std::string node = app.at("components")[0].at("node");
+  int on_node = 0;
+  for (const auto &c : app.at("components"))
+    on_node += c.at("node") == node ? 1 : 0;
+  domain.kill_node(node == "node1" ? 1 : 2);
+  // A component's own lease is long (its node watches it); the node's loss is what tells.
+  // Events: two nodes added, the application created, the node removed, its components exited.
+  auto [rc, out] = domain.cli(
+      {"--json", "events", "--count", std::to_string(4 + on_node), "--wait-ms", "10000"});
+  INFO(out);
+  REQUIRE(rc == 0);
+  std::istringstream lines(out);
+  int exited = 0;
+  for (std::string line; std::getline(lines, line);) {
+    const Json event = Json::parse(line);
+    if (event.at("kind") != "component.exited")
+      continue;
+    CHECK(event.at("details").at("why") == fmt::format("its node {} is gone", node));
+    ++exited;
+  }
+  CHECK(exited == on_node);
+  auto shown = domain.call("app.show", Json{{"app", "Healthy"}});
+  REQUIRE(shown.has_value());
+  for (const auto &c : shown->at("components"))
+    CHECK((c.at("state") == "exited") == (c.at("node") == node));
+  REQUIRE(domain.call("app.release", Json{{"app", "Healthy"}}).has_value());
+  domain.require_clean(pids_of(app));
+}
+
+TEST_CASE("a node daemon stopped after or while it ends a process exits cleanly, the process gone",
+          "[integration][node][failure]") {
+  // The process dies of its first signal, or ignores SIGINT and SIGTERM, so that ending it runs
+  // through the whole escalation to SIGKILL and the node is stopped in the middle of it. (The
+  // shutdown once destroyed the devices before the endpoint whose handlers use them, a double
+  // free seen under a launch storm; with that order restored on purpose, this scenario did not
+  // show it under ASan: it guards the shutdown's behaviour, not that race.)
+  const bool stubborn = GENERATE(false, true);
+  INFO((stubborn ? "stopped while ending it" : "stopped after ending it"));
+  TestDomain domain(1);
+  auto nodes = domain.call("domain.nodes");
+  REQUIRE(nodes.has_value());
+  REQUIRE(nodes->at("nodes").size() == 1);
+  const std::string node = nodes->at("nodes")[0].at("address");
+  auto devices = domain.call("domain.devices");
+  REQUIRE(devices.has_value());
+  std::string gpp;
+  for (const auto &d : devices->at("devices"))
+    if (d.at("kind") == "gpp")
+      gpp = d.at("id");
+  REQUIRE_FALSE(gpp.empty());
+  const fs::path marker =
+      fs::temp_directory_path() / fmt::format("rsca-it-signalled-{}", ::getpid());
+  fs::remove(marker);
+  fs::remove(marker.string() + ".ready");
+  auto executed =
+      domain.client().call_sync(node, "node.execute",
+                                Json{{"application", "ShutdownRace"},
+                                     {"component", "Stubborn_1"},
+                                     {"device", gpp},
+                                     {"entrypoint", "rsca-test-faulty"},
+                                     {"spd_dir", ""},
+                                     {"args",
+                                      {"fault", "mark_signals", "marker", marker.string(),
+                                       "on_signal", stubborn ? "ignore" : "exit"}}},
+                                5s);
+  REQUIRE(executed.has_value());
+  const long pid = executed->at("pid").get<long>();
+  // Its handlers are in place.
+  REQUIRE(TestDomain::wait_for([&] { return fs::exists(marker.string() + ".ready"); }));
+  auto terminating = domain.client().call(node, "node.terminate", Json{{"pid", pid}}, 15s);
+  // The escalation is under way once the process has had its first signal.
+  REQUIRE(TestDomain::wait_for([&] { return fs::exists(marker); }));
+  if (!stubborn)
+    CHECK(terminating.get().has_value()); // it exited at SIGINT
+  const auto status = domain.stop_node(1);
+  INFO(ChildProcess::describe(status));
+  REQUIRE(status.has_value());
+  CHECK(WIFEXITED(*status));
+  CHECK(WEXITSTATUS(*status) == 0);
+  CHECK_FALSE(process_exists(pid));
+  if (stubborn)
+    terminating.wait(); // answered or failed, not left hanging
+  fs::remove(marker);
+  fs::remove(marker.string() + ".ready");
+}

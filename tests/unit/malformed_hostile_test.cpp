@@ -1,0 +1,193 @@
+// Malformed profiles, continued from malformed_test.cpp: hostile input (huge files, deep nesting,
+// entity bombs, DTDs and external entities, UTF-16) fails fast and cleanly, never fetching or
+// reading anything else, and a bad file yields no partial model while every independent error in
+// it is reported. Huge and deeply nested files are generated in a temporary folder.
+#include "profile/descriptor.hpp"
+#include "profile/profile_loader.hpp"
+#include "profile/xml_document.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+#include "malformed_fixture.hpp"
+
+namespace fs = std::filesystem;
+using namespace rsca;
+using namespace rsca::profile;
+using namespace rsca::test;
+using Catch::Contains;
+
+// ---------------------------------------------------------------------------------------------
+// Hostile input: huge, deep, entity bombs, DTDs and external entities.
+
+TEST_CASE("a file over the size limit is refused before parsing", "[malformed][too-large]") {
+  const std::size_t overhead = padded_sad(0).size();
+  TempDir dir;
+
+  SECTION("one byte over") {
+    const fs::path file = dir.path() / "huge.sad.xml";
+    write_file(file, padded_sad(kMaxProfileBytes + 1 - overhead));
+    REQUIRE(fs::file_size(file) == kMaxProfileBytes + 1);
+    auto result = read_descriptor(file);
+    const Error &error = error_of(result);
+    REQUIRE(error.diagnostics().size() == 1);
+    check(error.diagnostics().front(), "too-large", file.string(), 0, 0,
+          {"the file is 8388609 bytes", "limited to 8388608 bytes"});
+
+    ProfileLoader loader;
+    auto validated = loader.validate(file);
+    check(find_rule(error_of(validated), "too-large"), "too-large", loader_name(file), 0, 0, {});
+  }
+  SECTION("exactly at the limit is read") {
+    const fs::path file = dir.path() / "limit.sad.xml";
+    write_file(file, padded_sad(kMaxProfileBytes - overhead));
+    REQUIRE(fs::file_size(file) == kMaxProfileBytes);
+    auto result = read_descriptor(file);
+    INFO((result ? std::string() : result.error().to_string()));
+    REQUIRE(result.has_value());
+    CHECK(std::get<SoftwareAssembly>(*result).id == "DCE:big");
+  }
+}
+
+TEST_CASE("deeply nested elements fail cleanly", "[malformed][deep]") {
+  // Far deeper than any profile: refused at the depth limit, fast, without exhausting the stack.
+  constexpr std::size_t kDepth = 100000;
+  TempDir dir;
+  const fs::path file = dir.path() / "deep.sad.xml";
+  std::string text = "<?xml version=\"1.0\"?>\n<softwareassembly id=\"DCE:deep\">";
+  text.reserve(text.size() + kDepth * 7 + 32);
+  for (std::size_t i = 0; i < kDepth; ++i)
+    text += "<a>";
+  for (std::size_t i = 0; i < kDepth; ++i)
+    text += "</a>";
+  text += "</softwareassembly>\n";
+  write_file(file, text);
+
+  const auto start = std::chrono::steady_clock::now();
+  auto result = read_descriptor(file);
+  const Error &error = error_of(result);
+  for (const auto &d : error.diagnostics()) {
+    INFO("diagnostic: " << to_string(d));
+    CHECK((d.rule == "schema" || d.rule == "xml"));
+    CHECK(d.where.file == file.string());
+  }
+  CHECK_THAT(error.to_string(), Contains("nest deeper than 64 levels"));
+  // Refused at the limit rather than after reading all 100000 levels (which took seconds).
+  CHECK(std::chrono::steady_clock::now() - start < std::chrono::seconds(5));
+  // The reader is still usable afterwards.
+  auto next = read_descriptor(fixture("duplicate/property_id.prf.xml"));
+  check(error_of(next).diagnostics().front(), "duplicate-id",
+        fixture("duplicate/property_id.prf.xml").string(), 8, 53, {});
+}
+
+TEST_CASE("a billion laughs entity bomb fails fast", "[malformed][entities]") {
+  const fs::path file = fixture("entities/billion_laughs.sad.xml");
+  const auto start = std::chrono::steady_clock::now();
+  auto result = read_descriptor(file);
+  const auto elapsed = std::chrono::steady_clock::now() - start;
+  // Refused either by the entity-expansion limit or because the DTD is never read; both are
+  // well-formedness errors where the bomb is used.
+  const Diagnostic &d = error_of(result).diagnostics().front();
+  INFO("diagnostic: " << to_string(d));
+  CHECK((d.rule == "xml" || d.rule == "schema"));
+  CHECK(d.where.file == file.string());
+  CHECK(d.where.line == 16);
+  CHECK(elapsed < std::chrono::seconds(5));
+}
+
+TEST_CASE("a DOCTYPE naming a remote DTD is never fetched", "[malformed][entities]") {
+  // example.invalid cannot resolve: if any DTD were fetched, these files would fail.
+  const fs::path root = fixture("entities/remote_dtd");
+  const fs::path sad = root / "dom/waveforms/app/app.sad.xml";
+  ProfileLoader loader(root);
+  auto result = loader.load_application(sad);
+  INFO((result ? std::string() : result.error().to_string()));
+  REQUIRE(result.has_value());
+  CHECK(result->warnings.empty());
+  REQUIRE(result->component_files.count("comp_spd") == 1);
+  const auto &pkg = result->component_files.at("comp_spd");
+  REQUIRE(pkg->properties != nullptr);
+  CHECK(pkg->find_property("count") != nullptr);
+}
+
+TEST_CASE("an external entity is never read", "[malformed][entities]") {
+  const fs::path file = fixture("entities/external_entity.sad.xml");
+  REQUIRE(fs::is_regular_file(fixture("entities/secret.txt")));
+  auto result = read_descriptor(file);
+  // Refusing the file would be fine too; what must not happen is the secret in the model.
+  if (result)
+    CHECK(std::get<SoftwareAssembly>(*result).description.find("SECRET") == std::string::npos);
+}
+
+// ---------------------------------------------------------------------------------------------
+// No partial model; every independent error reported.
+
+TEST_CASE("one dangling reference deep inside leaves no partial model", "[malformed][partial]") {
+  const fs::path file = fixture("partial/dangling_deep.sad.xml");
+
+  // The file is well-formed and schema-valid, so it reaches the SAD reader...
+  auto document = read_xml_profile(file);
+  INFO((document ? std::string() : document.error().to_string()));
+  REQUIRE(document.has_value());
+
+  // ...which returns an error, not a model with the bad path left out.
+  auto sad = read_sad(*document);
+  const Error &error = error_of(sad);
+  REQUIRE(error.diagnostics().size() == 1);
+  const Diagnostic &d = error.diagnostics().front();
+  INFO("diagnostic: " << to_string(d));
+  CHECK(d.rule == "dangling-ref");
+  CHECK(d.where.file == file.string());
+  CHECK(d.where.line == 49); // the <componentinstantiationref refid="ghost_1"/> itself
+  CHECK_THAT(d.message,
+             Contains("latency path \"to_nowhere\" names componentinstantiation \"ghost_1\""));
+
+  auto descriptor = read_descriptor(file);
+  CHECK_FALSE(descriptor.has_value());
+}
+
+TEST_CASE("independent errors in one file are all reported", "[malformed][partial]") {
+  SECTION("reference errors") {
+    const fs::path file = fixture("partial/several_errors.sad.xml");
+    auto result = read_descriptor(file);
+    const Error &error = error_of(result);
+    REQUIRE(error.diagnostics().size() == 3);
+    check(error.diagnostics()[0], "dangling-ref", file.string(), 11, 46, {"\"nothing_spd\""});
+    check(error.diagnostics()[1], "duplicate-id", file.string(), 16, 44, {"\"comp_1\""});
+    check(error.diagnostics()[2], "dangling-ref", file.string(), 20, 49, {"\"ghost_1\""});
+  }
+  SECTION("schema errors") {
+    const fs::path file = fixture("partial/several_schema_errors.sad.xml");
+    auto result = read_descriptor(file);
+    const Error &error = error_of(result);
+    REQUIRE(error.diagnostics().size() == 3);
+    check(error.diagnostics()[0], "schema", file.string(), 11, 57, {"'colour'"});
+    check(error.diagnostics()[1], "schema", file.string(), 12, 62, {"'first'"});
+    check(error.diagnostics()[2], "schema", file.string(), 13, 32, {"'soon'"});
+  }
+}
+
+TEST_CASE("a UTF-16 file is refused before any DTD in it is read", "[malformed][entities]") {
+  TempDir dir;
+  const fs::path file = dir.path() / "utf16.sad.xml";
+  const std::string ascii = "<?xml version=\"1.0\" encoding=\"UTF-16\"?>\n"
+                            "<!DOCTYPE softwareassembly [<!ENTITY a \"aaaaaaaaaa\">]>\n"
+                            "<softwareassembly id=\"x\">&a;&a;</softwareassembly>\n";
+  std::string utf16 = "\xFF\xFE"; // little-endian BOM, then each character and a zero byte
+  for (char c : ascii) {
+    utf16 += c;
+    utf16 += '\0';
+  }
+  write_file(file, utf16);
+  auto result = read_descriptor(file);
+  check(error_of(result).diagnostics().front(), "encoding", file.string(), 1, 1,
+        {"not UTF-8", "profiles must be UTF-8 text"});
+}

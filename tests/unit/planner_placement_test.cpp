@@ -1,0 +1,235 @@
+// Unit tests of the placement planner (allocator/planner.hpp), continued from planner_test.cpp:
+// where components go relative to each other and to devices (host collocation, devicerequires
+// and deployerrequires, explicit assignment, usesdevice), every expected value worked out by
+// hand in a comment next to it.
+#include "allocator/planner.hpp"
+#include "planner_fixture.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <limits>
+#include <map>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+using namespace rsca;
+using namespace rsca::allocator;
+using namespace rsca::test;
+using std::chrono::milliseconds;
+
+// 5
+// ------------------------------------------------------------------------------------------------
+TEST_CASE("planner: host collocation keeps a group on one node", "[planner]") {
+  const auto state = domain({gpp("n1:GPP", "n1"), gpp("n2:GPP", "n2")});
+  const auto spread = with(Strategy::Spread);
+
+  SECTION("a group lands on one node although spreading would separate it") {
+    auto pkg = softpkg("comp", {ImplSpec("cpp").utilization(0.3)});
+    PlanRequest request = request_of({component("a", pkg), component("b", pkg)});
+    // Without the group: a on n1 (equal load, first id), b on n2 (0 % < 30 %).
+    const Plan apart = require_plan(make_plan(state, request, spread));
+    CHECK(device_of(apart, "a") == "n1:GPP");
+    CHECK(device_of(apart, "b") == "n2:GPP");
+    // With it: b follows a to n1 (30 + 30 = 60 % fits).
+    request.components[0].collocation = request.components[1].collocation = "g";
+    const Plan together = require_plan(make_plan(state, request, spread));
+    CHECK(device_of(together, "a") == "n1:GPP");
+    CHECK(device_of(together, "b") == "n1:GPP");
+  }
+
+  SECTION("a group that fits on no single node is rejected although its members fit apart") {
+    auto pkg = softpkg("comp", {ImplSpec("cpp").utilization(0.6)});
+    PlanRequest request = request_of({component("a", pkg), component("b", pkg)});
+    CHECK(make_plan(state, request).has_value()); // 60 % on each node
+    request.components[0].collocation = request.components[1].collocation = "g";
+    // 60 + 60 = 120 % > 100 % on either node.
+    const auto rejections = require_rejection(make_plan(state, request));
+    CHECK_THAT(to_string(rejections), Catch::Contains("hostcollocation g is on node"));
+  }
+
+  SECTION("collocation is per node: a node's two GPPs can share a group") {
+    const auto two = domain({gpp("n1:GPP_1", "n1"), gpp("n1:GPP_2", "n1"), gpp("n2:GPP", "n2")});
+    auto pkg = softpkg("comp", {ImplSpec("cpp").utilization(0.6)});
+    PlanRequest request =
+        request_of({component("a", pkg), component("b", pkg), component("free", pkg)});
+    request.components[0].collocation = request.components[1].collocation = "g";
+    const Plan plan = require_plan(make_plan(two, request));
+    // a and b need 60 % each: one per GPP of n1; "free" is not in the group and takes n2.
+    CHECK(placement_of(plan, "a").node == "n1");
+    CHECK(placement_of(plan, "b").node == "n1");
+    CHECK(device_of(plan, "a") != device_of(plan, "b"));
+    CHECK(device_of(plan, "free") == "n2:GPP");
+  }
+}
+
+// 6
+// ------------------------------------------------------------------------------------------------
+TEST_CASE("planner: devicerequires and deployerrequires", "[planner]") {
+  // n2:GPP offers (deployerrequires) safety=asil-b; n1:GPP offers nothing. Equal load, so pack
+  // would take n1:GPP first for anything.
+  Device offering = gpp("n2:GPP", "n2");
+  offering.deployer_requires["safety"] = "asil-b";
+  const auto state = domain({gpp("n1:GPP", "n1"), offering});
+  auto pkg = softpkg("comp", {ImplSpec("cpp")});
+
+  SECTION("a component that requires goes only to the device that offers") {
+    ComponentRequest c = component("c", pkg);
+    c.device_requires.push_back(ref("safety", "asil-b"));
+    const Plan plan = require_plan(make_plan(state, request_of({c})));
+    CHECK(device_of(plan, "c") == "n2:GPP");
+
+    const auto rejections =
+        require_rejection(make_plan(domain({gpp("n1:GPP", "n1")}), request_of({c})));
+    CHECK(rejections[0].reasons ==
+          std::vector<std::string>{"n1:GPP (cpp): devicerequires safety=asil-b, the device's "
+                                   "deployerrequires do not offer it"});
+
+    c.device_requires[0] = ref("safety", "asil-d"); // offered nowhere
+    CHECK_FALSE(make_plan(state, request_of({c})).has_value());
+  }
+
+  SECTION("a device that offers refuses a component that does not require it") {
+    const Plan plan = require_plan(make_plan(state, request_of({component("c", pkg)})));
+    CHECK(device_of(plan, "c") == "n1:GPP");
+
+    const auto rejections =
+        require_rejection(make_plan(domain({offering}), request_of({component("c", pkg)})));
+    CHECK(rejections[0].reasons ==
+          std::vector<std::string>{"n2:GPP (cpp): deployerrequires safety=asil-b: the device takes "
+                                   "only components that require it"});
+  }
+}
+
+// 7
+// ------------------------------------------------------------------------------------------------
+TEST_CASE("planner: explicit assignment", "[planner]") {
+  const auto state = domain({gpp("n1:GPP", "n1"), gpp("n2:GPP", "n2", 100, 1024, "QNX")});
+  auto pkg = softpkg("comp", {ImplSpec("cpp")});
+  ComponentRequest c = component("c", pkg);
+
+  SECTION("honoured over the strategy's preference") {
+    c.device = "n2:GPP"; // pack would take n1:GPP (equal load, first id)
+    const Plan plan = require_plan(make_plan(state, request_of({c})));
+    CHECK(device_of(plan, "c") == "n2:GPP");
+  }
+
+  SECTION("an unknown device is rejected") {
+    c.device = "n9:GPP";
+    const auto rejections = require_rejection(make_plan(state, request_of({c})));
+    REQUIRE(rejections.size() == 1);
+    CHECK(rejections[0].instance == "c");
+    CHECK(rejections[0].reasons ==
+          std::vector<std::string>{"the assigned device n9:GPP is not in the domain"});
+  }
+
+  SECTION("an assigned device that cannot run it is rejected, though another could") {
+    auto linux_only = softpkg("comp", {ImplSpec("cpp").os("Linux")});
+    ComponentRequest l = component("c", linux_only);
+    l.device = "n2:GPP";
+    const auto rejections = require_rejection(make_plan(state, request_of({l})));
+    CHECK(rejections[0].reasons ==
+          std::vector<std::string>{"n2:GPP (cpp): os_name is QNX, implementation cpp needs Linux"});
+  }
+}
+
+// 8
+// ------------------------------------------------------------------------------------------------
+TEST_CASE("planner: usesdevice places on the used device's node and allocates it", "[planner]") {
+  // n2 has a camera with one channel; n1 has none.
+  const Device camera = peripheral(
+      "n2:camera", "n2", {{"model", "model", "imx219", profile::Action::Eq}}, {{"channels", 1.0}});
+  const auto state = domain({gpp("n1:GPP", "n1"), gpp("n2:GPP", "n2"), camera});
+  const auto cam = uses_device("cam", {ref("model", "imx219"), ref("channels", "1")});
+  auto pkg = softpkg("comp", {ImplSpec("cpp").uses(cam)});
+
+  SECTION("placed on the GPP of the camera's node, the channel reserved") {
+    const Plan plan = require_plan(make_plan(state, request_of({component("c", pkg)})));
+    const Placement &p = placement_of(plan, "c");
+    CHECK(p.device == "n2:GPP"); // n1 has no device with model imx219
+    REQUIRE(p.used_devices.size() == 1);
+    CHECK(p.used_devices[0].uses_id == "cam");
+    CHECK(p.used_devices[0].device == "n2:camera");
+    CHECK(p.used_devices[0].demand == std::map<std::string, double>{{"channels", 1.0}});
+    DomainState committed = state;
+    commit(committed, plan);
+    CHECK(allocated(committed, "n2:camera", "channels") == 1);
+    // The channel is taken: the same component again does not fit.
+    CHECK_FALSE(make_plan(committed, request_of({component("c", pkg)})).has_value());
+  }
+
+  SECTION("a second component needing the single channel is rejected") {
+    const auto rejections = require_rejection(
+        make_plan(state, request_of({component("c1", pkg), component("c2", pkg)})));
+    CHECK(rejections[0].instance == "c2");
+    CHECK_THAT(to_string(rejections),
+               Catch::Contains("usesdevice cam: no device in the domain fits"));
+  }
+
+  SECTION("a device on a node without a GPP is used across the network") {
+    const Device sensor = peripheral("robot:sensor", "robot",
+                                     {{"model", "model", "imx219", profile::Action::Eq}}, {});
+    const auto remote = domain({gpp("n1:GPP", "n1"), sensor});
+    const Plan plan = require_plan(make_plan(
+        remote,
+        request_of({component("c", softpkg("comp", {ImplSpec("cpp").uses(uses_device(
+                                                       "cam", {ref("model", "imx219")}))}))})));
+    const Placement &p = placement_of(plan, "c");
+    CHECK(p.device == "n1:GPP");
+    REQUIRE(p.used_devices.size() == 1);
+    CHECK(p.used_devices[0].device == "robot:sensor");
+  }
+
+  SECTION("two usesdevice of one implementation cannot both take the single channel") {
+    // 1 + 1 = 2 channels wanted of a camera that has 1: accepting would over-commit it.
+    auto twice = softpkg("stereo", {ImplSpec("cpp")
+                                        .uses(uses_device("left", {ref("channels", "1")}))
+                                        .uses(uses_device("right", {ref("channels", "1")}))});
+    const auto result = make_plan(state, request_of({component("s", twice)}));
+    if (result) {
+      DomainState committed = state;
+      commit(committed, *result);
+      INFO("camera channels allocated: " << allocated(committed, "n2:camera", "channels"));
+      CHECK(allocated(committed, "n2:camera", "channels") <= 1.0);
+    }
+    CHECK_FALSE(result.has_value());
+  }
+
+  SECTION("the application's own usesdevice is reserved in application_devices") {
+    auto plain = softpkg("plain", {ImplSpec("cpp")});
+    PlanRequest request = request_of({component("c", plain)});
+    request.uses_devices.push_back(cam);
+    const Plan plan = require_plan(make_plan(state, request));
+    REQUIRE(plan.application_devices.size() == 1);
+    CHECK(plan.application_devices[0].device == "n2:camera");
+    CHECK(plan.application_devices[0].demand == std::map<std::string, double>{{"channels", 1.0}});
+  }
+
+  SECTION("a failed application usesdevice does not leak what an earlier one reserved") {
+    // n1: GPP + radio (band s, 1 slot); n2: GPP + radio (band x, 1 slot) + the camera.
+    // Component c uses any radio slot on its node. The application uses the camera channel
+    // ("cam") and a band-s radio slot ("uplink", only n1:radio has band s).
+    // The one plan: c on n2:GPP with n2:radio; cam -> n2:camera, uplink -> n1:radio.
+    // The search first tries c on n1:GPP (pack, equal load, first id), which takes n1:radio's
+    // slot: cam is then reserved, uplink fails. Backtracking to n2:GPP must find the camera free.
+    const Device radio1 = peripheral("n1:radio", "n1", {{"band", "band", "s", profile::Action::Eq}},
+                                     {{"slots", 1.0}});
+    const Device radio2 = peripheral("n2:radio", "n2", {{"band", "band", "x", profile::Action::Eq}},
+                                     {{"slots", 1.0}});
+    const auto radios = domain({gpp("n1:GPP", "n1"), radio1, gpp("n2:GPP", "n2"), radio2, camera});
+    auto linked =
+        softpkg("linked", {ImplSpec("cpp").uses(uses_device("link", {ref("slots", "1")}))});
+    PlanRequest request = request_of({component("c", linked)});
+    request.uses_devices = {cam, uses_device("uplink", {ref("band", "s"), ref("slots", "1")})};
+    // The plan exists: pinned to n2:GPP (so the search never tries n1), it is found.
+    PlanRequest pinned = request;
+    pinned.components[0].device = "n2:GPP";
+    CHECK(make_plan(radios, pinned).has_value());
+    const Plan plan = require_plan(make_plan(radios, request));
+    CHECK(device_of(plan, "c") == "n2:GPP");
+    REQUIRE(plan.application_devices.size() == 2);
+    CHECK(plan.application_devices[0].device == "n2:camera");
+    CHECK(plan.application_devices[1].device == "n1:radio");
+  }
+}
