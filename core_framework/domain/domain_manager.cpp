@@ -33,17 +33,6 @@ Json steps_json(const std::vector<LaunchStep> &steps) {
   return out;
 }
 
-// A field that may be absent; of the wrong type it is a BadRequest.
-template <typename T>
-CallResult<std::optional<T>> optional_field(const Json &body, const char *key) {
-  if (!body.contains(key))
-    return std::optional<T>();
-  auto value = required<T>(body, key);
-  if (!value)
-    return tl::unexpected(value.error());
-  return std::optional<T>(std::move(*value));
-}
-
 CallResult<InstallRequest> install_request_of(const Json &body) {
   auto sad = required<std::string>(body, "sad");
   auto files = required<std::vector<Json>>(body, "files");
@@ -77,65 +66,6 @@ placement_options(const Json &body) {
                                              excerpt(**strategy_name)));
   }
   return std::pair{assign->value_or(std::map<std::string, std::string>{}), strategy};
-}
-
-// Where configure/query go: the named component, or else the assembly controller (SCA).
-CallResult<const ComponentInstance *> target_of(const Application &app,
-                                                const std::string &component) {
-  for (const auto &c : app.components) {
-    if (!(component.empty() ? c.assembly_controller : c.id == component))
-      continue;
-    if (c.state == "exited")
-      return control::call_error(
-          Status::Failed, fmt::format("component {} of application {} has exited", c.id, app.name));
-    return &c;
-  }
-  return control::call_error(
-      Status::NotFound,
-      fmt::format("application {} has no component {}", app.name,
-                  component.empty() ? "(assembly controller)" : excerpt(component)));
-}
-
-// Property values given as text (from the CLI), typed against the component's PRF.
-CallResult<Json> typed_values(const Application &app, const ComponentInstance &component,
-                              const Json &values) {
-  const profile::ComponentPlacement *placement = nullptr;
-  app.profile->sad->find_instantiation(component.id, &placement);
-  const auto *pkg = placement != nullptr ? app.profile->softpkg_of(*placement) : nullptr;
-  Json typed = Json::object();
-  for (const auto &[id, text] : values.items()) {
-    const auto *definition = pkg != nullptr ? pkg->find_property(id) : nullptr;
-    if (definition == nullptr)
-      return control::call_error(Status::NotFound, fmt::format("component {} has no property {}",
-                                                               component.id, excerpt(id)));
-    const std::string value = text.is_string() ? text.get<std::string>() : text.dump();
-    profile::PropertyRef ref = profile::SimpleRef{id, value, {}};
-    if (std::holds_alternative<profile::SimpleSequenceProperty>(*definition)) {
-      profile::SimpleSequenceRef seq{id, {}, {}};
-      std::stringstream items(value);
-      for (std::string item; std::getline(items, item, ',');)
-        seq.values.push_back(item);
-      ref = seq;
-    }
-    auto bound = profile::bind_property(*definition, ref);
-    if (!bound)
-      return control::call_error(Status::BadRequest, bound.error().diagnostics().front().message);
-    typed[id] = profile::to_json(*bound);
-  }
-  return typed;
-}
-
-// Values given as text, for a device (whose PRF the domain does not hold): booleans and numbers
-// as such, the rest as text.
-Json json_values(const Json &values) {
-  Json out = Json::object();
-  for (const auto &[id, v] : values.items()) {
-    const std::string text = v.is_string() ? v.get<std::string>() : v.dump();
-    const Json parsed = Json::parse(text, nullptr, false);
-    out[id] =
-        !parsed.is_discarded() && (parsed.is_boolean() || parsed.is_number()) ? parsed : Json(text);
-  }
-  return out;
 }
 
 // The domain answered, so a peer that did not (a component) is a failure of the operation, not
@@ -386,71 +316,6 @@ CallResult<Json> DomainManager::Impl::start_or_stop(const Json &body, bool start
   return now ? to_json(*now) : Json{{"name", *name}};
 }
 
-CallResult<Json> DomainManager::Impl::configure(const Json &body) {
-  if (body.contains("device")) {
-    auto address = device_address(required<std::string>(body, "device").value_or(""));
-    if (!address)
-      return tl::unexpected(address.error());
-    return configure_at(*address, json_values(body.value("values", Json::object())));
-  }
-  auto name = required<std::string>(body, "app");
-  auto component = optional_field<std::string>(body, "component");
-  if (!name || !component)
-    return tl::unexpected(name ? component.error() : name.error());
-  auto app = applications.snapshot(*name);
-  if (!app)
-    return control::call_error(Status::NotFound,
-                               fmt::format("no application {} is running", excerpt(*name)));
-  auto target = target_of(*app, component->value_or(""));
-  if (!target)
-    return tl::unexpected(target.error());
-  Json properties = body.value("properties", Json::object());
-  if (body.contains("values")) {
-    auto typed = typed_values(*app, **target, body.at("values"));
-    if (!typed)
-      return tl::unexpected(typed.error());
-    properties.update(*typed);
-  }
-  return configure_at((*target)->address, std::move(properties));
-}
-
-CallResult<Json> DomainManager::Impl::configure_at(const std::string &address, Json properties) {
-  return control::call<protocol::component::Configure>(*endpoint, address, {std::move(properties)},
-                                                       options.call_timeout)
-      .map([](const auto &reply) { return protocol::encode(reply); });
-}
-
-CallResult<Json> DomainManager::Impl::query_at(const std::string &address,
-                                               std::vector<std::string> ids) {
-  return control::call<protocol::component::Query>(*endpoint, address, {std::move(ids)},
-                                                   options.call_timeout)
-      .map([](const auto &reply) { return protocol::encode(reply); });
-}
-
-CallResult<Json> DomainManager::Impl::query(const Json &body) {
-  auto ids = optional_field<std::vector<std::string>>(body, "ids");
-  if (!ids)
-    return tl::unexpected(ids.error());
-  if (body.contains("device")) {
-    auto address = device_address(required<std::string>(body, "device").value_or(""));
-    if (!address)
-      return tl::unexpected(address.error());
-    return query_at(*address, ids->value_or(std::vector<std::string>{}));
-  }
-  auto name = required<std::string>(body, "app");
-  auto component = optional_field<std::string>(body, "component");
-  if (!name || !component)
-    return tl::unexpected(name ? component.error() : name.error());
-  auto app = applications.snapshot(*name);
-  if (!app)
-    return control::call_error(Status::NotFound,
-                               fmt::format("no application {} is running", excerpt(*name)));
-  auto target = target_of(*app, component->value_or(""));
-  if (!target)
-    return tl::unexpected(target.error());
-  return query_at((*target)->address, ids->value_or(std::vector<std::string>{}));
-}
-
 CallResult<Json> DomainManager::Impl::list_applications() {
   Json list = Json::array();
   for (const auto &app : applications.snapshots())
@@ -494,49 +359,6 @@ CallResult<Json> DomainManager::Impl::plan_application(const Json &body) {
                 {"rejections", allocator::to_json(plan.error())},
                 {"strategy", strategy}};
   return Json{{"admitted", true}, {"plan", allocator::to_json(*plan)}, {"strategy", strategy}};
-}
-
-CallResult<protocol::Empty>
-DomainManager::Impl::component_exited(const protocol::domain::ComponentExitedReport &r) {
-  // Every component the process served: one, or those of a component host.
-  const std::string why = r.status.empty() ? std::string("exited") : r.status;
-  for (const auto &address : r.addresses) {
-    components.exited(address, why); // a launch waiting for it fails at once
-    endpoint->abandon(address, why);
-  }
-  mark_exited(
-      [&r](const ComponentInstance &c) {
-        return std::find(r.addresses.begin(), r.addresses.end(), c.address) != r.addresses.end();
-      },
-      why);
-  return protocol::Empty{};
-}
-
-void DomainManager::Impl::mark_exited(const std::function<bool(const ComponentInstance &)> &which,
-                                      const std::string &why) {
-  applications.update_all([&](Application &app) {
-    for (auto &c : app.components) {
-      if (c.pid == 0 || c.state == "exited" || !which(c))
-        continue;
-      components.exited(c.address, why);
-      c.state = "exited";
-      spdlog::warn("component {} of application {} exited unexpectedly: {}; the application is "
-                   "degraded",
-                   c.id, app.name, why);
-      events->publish(
-          "component.exited",
-          {{"application", app.name}, {"component", c.id}, {"node", c.node}, {"why", why}});
-    }
-  });
-}
-
-// A component saw its writer miss a connection's deadline or lose liveliness.
-CallResult<protocol::Empty>
-DomainManager::Impl::connection_problem(const protocol::domain::ConnectionProblemReport &r) {
-  spdlog::warn("connection {} of application {} ({}): {} ({} times)", excerpt(r.connection),
-               excerpt(r.application), excerpt(r.component), excerpt(r.problem), r.count);
-  events->publish("connection.problem", protocol::encode(r));
-  return protocol::Empty{};
 }
 
 void DomainManager::Impl::serve() {

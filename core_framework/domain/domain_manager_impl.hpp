@@ -128,4 +128,15 @@ control::CallResult<T> required(const control::Json &body, const char *key) {
   }
 }
 
+// A field that may be absent; of the wrong type it is a BadRequest.
+template <typename T>
+control::CallResult<std::optional<T>> optional_field(const control::Json &body, const char *key) {
+  if (!body.contains(key))
+    return std::optional<T>();
+  auto value = required<T>(body, key);
+  if (!value)
+    return tl::unexpected(value.error());
+  return std::optional<T>(std::move(*value));
+}
+
 } // namespace rsca::domain
