@@ -158,11 +158,14 @@ void Host::close() {
   if (endpoint_) {
     endpoint_->withdraw(address_);
     endpoint_->stop_serving(address_); // waits for running handlers
-    endpoint_.reset();
   }
   stop_service();
   if (loop_)
     loop_->stop();
+  // Only once the receive thread has stopped: it reports connection problems through the
+  // endpoint (ThreadSanitizer saw it read endpoint_ while close cleared it, then call through
+  // null: a consumer crashed as it exited).
+  endpoint_.reset();
   component_.reset(); // its ports detach from the stopped loop
   loop_.reset();
   participant_.reset();

@@ -263,6 +263,11 @@ Expected<std::unique_ptr<Endpoint>> Endpoint::open(std::shared_ptr<dds::Particip
 }
 
 Endpoint::~Endpoint() {
+  // The handlers under way first: they may still make calls, which need the sender and the
+  // receiver. Stopped before them, a handler's call went to a sender already gone, or waited
+  // for a reply nobody would take (ThreadSanitizer found the domain's handlers still running
+  // while its daemon stopped).
+  stop_serving();
   impl_->stopping = true;
   impl_->wake();
   impl_->receiver.join();
@@ -295,6 +300,14 @@ void Endpoint::start_serving() {
   dds_set_status_mask(impl_->request_reader.get(), DDS_DATA_AVAILABLE_STATUS);
   impl_->serving = true;
   impl_->wake(); // takes what was held
+}
+
+void Endpoint::stop_serving() {
+  dds_set_status_mask(impl_->request_reader.get(), 0);
+  impl_->serving = false;
+  // A request the receiver took just before is posted to the stopped pool and never runs: its
+  // caller times out, as if this endpoint had gone a moment earlier.
+  impl_->handler_pool->stop();
 }
 
 void Endpoint::stop_serving(const std::string &address) {

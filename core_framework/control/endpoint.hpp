@@ -100,6 +100,10 @@ public:
   void start_serving();
   // Drops the handlers of `address` and returns once none of them is running any more.
   void stop_serving(const std::string &address);
+  // Takes no more requests and returns once the handlers under way have returned; calls still
+  // work. The destructor does it first. An owner whose handlers reach the endpoint through a
+  // pointer calls it before clearing the pointer.
+  void stop_serving();
 
   // A call fails at its deadline (Timeout), at once when nobody serves `target` by then
   // (Unavailable), or as soon as its addressee leaves DDS after it was sent (Unavailable,

@@ -18,7 +18,9 @@ public:
     for (std::size_t i = 0; i < threads; ++i)
       threads_.emplace_back([this] { run(); });
   }
-  ~WorkerPool() {
+  ~WorkerPool() { stop(); }
+  // Runs what is queued, then ends the threads; a task posted afterwards never runs. Idempotent.
+  void stop() {
     {
       std::lock_guard lock(mutex_);
       stopping_ = true;
@@ -26,6 +28,7 @@ public:
     wake_.notify_all();
     for (auto &t : threads_)
       t.join();
+    threads_.clear();
   }
   void post(std::function<void()> task) {
     {

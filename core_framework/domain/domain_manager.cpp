@@ -411,6 +411,9 @@ DomainManager::DomainManager(std::unique_ptr<Impl> impl) : impl_(std::move(impl)
 DomainManager::~DomainManager() {
   // Releasing applications is the operator's decision; the domain only stops serving.
   impl_->runtime_connections->stop(); // its thread calls through the endpoint
+  // The handlers reach the endpoint through impl_->endpoint, which reset() clears before the
+  // endpoint's destructor waits for them (ThreadSanitizer saw connection.list read it meanwhile).
+  impl_->endpoint->stop_serving();
   impl_->endpoint.reset();
 }
 
