@@ -79,15 +79,14 @@ Json json_values(const Json &values) {
   return out;
 }
 
-} // namespace
+// The running application a configure or query names ("app") and its component that the
+// request goes to ("component", else the assembly controller): copies.
+struct Target {
+  Application app;
+  ComponentInstance component;
+};
 
-CallResult<Json> DomainManager::Impl::configure(const Json &body) {
-  if (body.contains("device")) {
-    auto address = device_address(required<std::string>(body, "device").value_or(""));
-    if (!address)
-      return tl::unexpected(address.error());
-    return configure_at(*address, json_values(body.value("values", Json::object())));
-  }
+CallResult<Target> target_in(ApplicationRegistry &applications, const Json &body) {
   auto name = required<std::string>(body, "app");
   auto component = optional_field<std::string>(body, "component");
   if (!name || !component)
@@ -99,14 +98,29 @@ CallResult<Json> DomainManager::Impl::configure(const Json &body) {
   auto target = target_of(*app, component->value_or(""));
   if (!target)
     return tl::unexpected(target.error());
+  return Target{*app, **target};
+}
+
+} // namespace
+
+CallResult<Json> DomainManager::Impl::configure(const Json &body) {
+  if (body.contains("device")) {
+    auto address = device_address(required<std::string>(body, "device").value_or(""));
+    if (!address)
+      return tl::unexpected(address.error());
+    return configure_at(*address, json_values(body.value("values", Json::object())));
+  }
+  auto target = target_in(applications, body);
+  if (!target)
+    return tl::unexpected(target.error());
   Json properties = body.value("properties", Json::object());
   if (body.contains("values")) {
-    auto typed = typed_values(*app, **target, body.at("values"));
+    auto typed = typed_values(target->app, target->component, body.at("values"));
     if (!typed)
       return tl::unexpected(typed.error());
     properties.update(*typed);
   }
-  return configure_at((*target)->address, std::move(properties));
+  return configure_at(target->component.address, std::move(properties));
 }
 
 CallResult<Json> DomainManager::Impl::configure_at(const std::string &address, Json properties) {
@@ -132,18 +146,10 @@ CallResult<Json> DomainManager::Impl::query(const Json &body) {
       return tl::unexpected(address.error());
     return query_at(*address, ids->value_or(std::vector<std::string>{}));
   }
-  auto name = required<std::string>(body, "app");
-  auto component = optional_field<std::string>(body, "component");
-  if (!name || !component)
-    return tl::unexpected(name ? component.error() : name.error());
-  auto app = applications.snapshot(*name);
-  if (!app)
-    return control::call_error(Status::NotFound,
-                               fmt::format("no application {} is running", excerpt(*name)));
-  auto target = target_of(*app, component->value_or(""));
+  auto target = target_in(applications, body);
   if (!target)
     return tl::unexpected(target.error());
-  return query_at((*target)->address, ids->value_or(std::vector<std::string>{}));
+  return query_at(target->component.address, ids->value_or(std::vector<std::string>{}));
 }
 
 CallResult<protocol::Empty>
