@@ -37,7 +37,6 @@ public:
   CallResult<std::shared_ptr<Application>> run();
 
 private:
-  // Wiring problems found while loading (unknown ports, mismatched port types) stop a launch.
   // Wiring problems found while loading (unknown ports, mismatched port types) and event-channel
   // members that could never match the channel's others stop a launch before anything runs.
   CallResult<void> check();
