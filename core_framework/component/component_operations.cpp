@@ -18,11 +18,6 @@ namespace op = protocol::component;
 
 namespace {
 
-std::string first_message(const Error &error) {
-  return error.diagnostics().empty() ? std::string("unknown error")
-                                     : error.diagnostics().front().message;
-}
-
 // Names that must not be empty: a connection and a port are always named.
 CallResult<void>
 check_named(std::initializer_list<std::pair<const char *, const std::string *>> names) {
@@ -149,7 +144,7 @@ CallResult<protocol::Empty> Host::op_connect(const op::ConnectRequest &r, const 
                                            port::to_string(port->type()), r.repid));
   auto qos = dds::qos_from_json(r.qos.value_or(Json::object()));
   if (!qos)
-    return control::call_error(Status::BadRequest, first_message(qos.error()));
+    return control::call_error(Status::BadRequest, qos.error());
   const std::string filter_text = r.filter.value_or("");
   std::optional<ContentFilter> filter;
   if (!filter_text.empty()) {
@@ -169,7 +164,7 @@ CallResult<protocol::Empty> Host::op_connect(const op::ConnectRequest &r, const 
   if (auto ok = port->connect(participant_->get(), loop_.get(), r.connection, topic, qos->get(),
                               std::move(filter), local);
       !ok)
-    return control::call_error(Status::Failed, first_message(ok.error()));
+    return control::call_error(Status::Failed, ok.error());
   watch_connections();
   log().info("port {}: connection {} on {}topic \"{}\"{}", r.port, r.connection,
              local ? "in-host " : "", topic,

@@ -187,7 +187,7 @@ void Endpoint::Impl::serve(RequestContext context, Json body) {
       body.is_discarded() ? call_error(Status::BadRequest, "the request body is not valid JSON")
       : context.operation == kBatch ? run_batch(context, body)
                                     : dispatch(context, body);
-  const std::string reply_body = result ? result->dump() : std::string();
+  const std::string reply_body = result ? result->dump() : protocol::error_body(result.error());
   const std::string error = result ? std::string() : result.error().message;
   rsca_ctl_Reply reply{};
   reply.id = const_cast<char *>(context.id.c_str());
@@ -218,11 +218,12 @@ void Endpoint::Impl::take_replies() {
       const auto *r = static_cast<const rsca_ctl_Reply *>(samples[i]);
       if (r->status != static_cast<std::int32_t>(Status::Ok)) {
         // A status this version does not know is a failure all the same, said as it came.
-        complete(str(r->id),
-                 protocol::is_known(r->status)
-                     ? call_error(static_cast<Status>(r->status), str(r->error))
-                     : call_error(Status::Failed,
-                                  fmt::format("status {}: {}", r->status, str(r->error))));
+        auto error = protocol::is_known(r->status)
+                         ? call_error(static_cast<Status>(r->status), str(r->error))
+                         : call_error(Status::Failed,
+                                      fmt::format("status {}: {}", r->status, str(r->error)));
+        error.value().details = protocol::details_of_text(str(r->body));
+        complete(str(r->id), std::move(error));
         continue;
       }
       Json body = parse_body(r->body);

@@ -66,8 +66,11 @@ inline constexpr const char *kBatch = "endpoint.batch";
 inline Json reply_json(const CallResult<Json> &result) {
   if (result)
     return Json{{"status", 0}, {"body", *result}};
-  return Json{{"status", static_cast<std::int32_t>(result.error().status)},
-              {"error", result.error().message}};
+  Json reply{{"status", static_cast<std::int32_t>(result.error().status)},
+             {"error", result.error().message}};
+  if (!result.error().details.empty())
+    reply["details"] = result.error().details;
+  return reply;
 }
 
 inline CallResult<Json> result_of(const Json &reply) {
@@ -75,9 +78,11 @@ inline CallResult<Json> result_of(const Json &reply) {
   if (status == static_cast<std::int32_t>(Status::Ok))
     return reply.value("body", Json::object());
   const auto error = reply.value("error", std::string("no reason given"));
-  if (!protocol::is_known(status))
-    return call_error(Status::Failed, fmt::format("status {}: {}", status, error));
-  return call_error(static_cast<Status>(status), error);
+  auto failed = protocol::is_known(status)
+                    ? call_error(static_cast<Status>(status), error)
+                    : call_error(Status::Failed, fmt::format("status {}: {}", status, error));
+  failed.value().details = protocol::details_of(reply);
+  return failed;
 }
 
 // Runs a handler. A request is untrusted: a handler that reads a field of the wrong type (JSON's

@@ -18,6 +18,26 @@ std::string_view to_string(ApplicationState state) {
   return "unknown";
 }
 
+std::string_view to_string(ComponentState state) {
+  switch (state) {
+  case ComponentState::Allocated:
+    return "allocated";
+  case ComponentState::Executed:
+    return "executed";
+  case ComponentState::Registered:
+    return "registered";
+  case ComponentState::Running:
+    return "running";
+  case ComponentState::Stopped:
+    return "stopped";
+  case ComponentState::Exited:
+    return "exited";
+  case ComponentState::Released:
+    return "released";
+  }
+  return "unknown";
+}
+
 ComponentInstance *Application::find_component(std::string_view id) {
   for (auto &c : components)
     if (c.id == id)
@@ -35,7 +55,7 @@ const ComponentInstance *Application::find_component(std::string_view id) const 
 std::vector<std::string> exited_components(const Application &app) {
   std::vector<std::string> ids;
   for (const auto &c : app.components)
-    if (c.state == "exited")
+    if (c.state == ComponentState::Exited)
       ids.push_back(c.id);
   return ids;
 }
@@ -54,7 +74,7 @@ nlohmann::json to_json(const Application &app) {
                          {"implementation", c.implementation},
                          {"address", c.address},
                          {"pid", c.pid},
-                         {"state", c.state},
+                         {"state", to_string(c.state)},
                          {"assembly_controller", c.assembly_controller}};
     for (const auto &p : app.plan.placements)
       if (p.instance == c.id && p.schedule)

@@ -16,6 +16,19 @@ namespace rsca::domain {
 enum class ApplicationState : std::uint8_t { Created, Running, Stopped, Failed };
 std::string_view to_string(ApplicationState state);
 
+// A component's life as the domain sees it, in the order a launch and a release pass through.
+// Exited is final while the application runs: a component that exited is never called again.
+enum class ComponentState : std::uint8_t {
+  Allocated,  // placed, its device's capacity reserved
+  Executed,   // its process started
+  Registered, // it announced itself and was configured and connected
+  Running,
+  Stopped,
+  Exited, // its process ended without being asked to
+  Released
+};
+std::string_view to_string(ComponentState state);
+
 struct ComponentInstance {
   std::string id; // componentinstantiation id
   std::string usage_name;
@@ -26,7 +39,7 @@ struct ComponentInstance {
   std::string host;    // the address of the component host that serves it, if it is hosted
   std::string spd;     // the SPD it runs from
   long pid = 0;
-  std::string state; // "executed", "registered", "running", "stopped", "exited"
+  ComponentState state = ComponentState::Allocated;
   std::uint32_t start_order = 0;
   bool assembly_controller = false;
 };

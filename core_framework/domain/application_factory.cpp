@@ -7,6 +7,7 @@
 #include <spdlog/spdlog.h>
 
 #include "domain/launch.hpp"
+#include "domain/wiring.hpp"
 #include "protocol/component_ops.hpp"
 
 namespace rsca::domain {
@@ -21,11 +22,11 @@ CallResult<std::shared_ptr<Application>> ApplicationFactory::create(const Launch
 namespace {
 
 bool exited(const ComponentInstance &c) {
-  return c.state == "exited";
+  return c.state == ComponentState::Exited;
 }
 
 // Marks the components `ids` names as `state`, except those that exited meanwhile.
-void mark(Application &app, const std::vector<std::string> &ids, const char *state) {
+void mark(Application &app, const std::vector<std::string> &ids, ComponentState state) {
   for (const auto &id : ids)
     if (auto *c = app.find_component(id); c != nullptr && !exited(*c))
       c->state = state;
@@ -58,7 +59,7 @@ CallResult<void> ApplicationFactory::start(const Application &app, const ApplyCh
     }
     if (auto ok = call_all(*services_.endpoint, calls, services_.call_timeout); !ok)
       return ok;
-    apply([&ids](Application &a) { mark(a, ids, "running"); });
+    apply([&ids](Application &a) { mark(a, ids, ComponentState::Running); });
   }
   apply([](Application &a) { a.state = ApplicationState::Running; });
   return {};
@@ -79,7 +80,7 @@ CallResult<void> ApplicationFactory::stop(const Application &app, const ApplyCha
     if (replies[i])
       stopped.push_back(ids[i]);
   apply([&stopped](Application &a) {
-    mark(a, stopped, "stopped");
+    mark(a, stopped, ComponentState::Stopped);
     a.state = ApplicationState::Stopped;
   });
   return first_failure(calls, replies);
@@ -87,19 +88,19 @@ CallResult<void> ApplicationFactory::stop(const Application &app, const ApplyCha
 
 // Devices outlive the application: their ends of its connections go first.
 std::size_t ApplicationFactory::disconnect_devices(const Application &app) {
-  std::vector<Call> calls;
+  std::vector<WireEnd> ends;
   for (const auto &ci : app.connections)
     for (const auto *end : {&ci.uses, &ci.provides})
       if (!end->device.empty())
-        calls.push_back(
-            call_of<protocol::component::Disconnect>(end->address, {end_key(ci, *end), end->port},
-                                                     fmt::format("{} ({})", ci.id, end->name())));
-  const auto replies = call_each_of(*services_.endpoint, calls, services_.call_timeout);
-  for (std::size_t i = 0; i < replies.size(); ++i)
-    if (!replies[i])
-      spdlog::warn("application {}: disconnecting device end of {} failed: {}", app.name,
-                   calls[i].what, replies[i].error().message);
-  return calls.size();
+        ends.push_back({.address = end->address,
+                        .port = end->port,
+                        .connection = end_key(ci, *end),
+                        .host = {},
+                        .peers = 1,
+                        .what = fmt::format("{} ({})", ci.id, end->name())});
+  for (const auto &failed : Wiring(*services_.endpoint, services_.call_timeout).disconnect(ends))
+    spdlog::warn("application {}: a device end was not disconnected: {}", app.name, failed);
+  return ends.size();
 }
 
 CallResult<std::vector<std::string>> ApplicationFactory::release(Application &app) {
@@ -141,7 +142,7 @@ CallResult<std::vector<std::string>> ApplicationFactory::release_processes(Appli
     services_.endpoint->forget(c.address);
     if (!c.host.empty())
       services_.endpoint->forget(c.host);
-    c.state = "released";
+    c.state = ComponentState::Released;
     c.pid = 0;
   }
   // A component whose node is gone cannot be terminated by it, and is gone with it.

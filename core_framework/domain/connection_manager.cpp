@@ -3,10 +3,11 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "common/content_filter.hpp"
 #include "common/names.hpp"
 #include "control/operation.hpp"
 #include "dds/port_qos.hpp"
-#include "protocol/component_ops.hpp"
+#include "domain/wiring.hpp"
 #include "protocol/topics.hpp"
 
 namespace rsca::domain {
@@ -33,8 +34,9 @@ namespace {
 // every runtime connection (made, retried and restored), because the request is untrusted.
 CallResult<void> check_end(const PortRef &end, const char *which) {
   auto refused = [which](const Error &error) {
-    return control::call_error(Status::BadRequest,
-                               fmt::format("{} end: {}", which, error.diagnostics()[0].message));
+    auto refusal = control::call_error(Status::BadRequest, error);
+    refusal.value().message = fmt::format("{} end: {}", which, refusal.value().message);
+    return refusal;
   };
   Expected<void> ok;
   if (end.kind == PortRef::Kind::Device) {
@@ -64,7 +66,7 @@ CallResult<void> check_request(const PortRef &uses, const PortRef &provides,
                                const std::string &id) {
   if (!id.empty())
     if (auto ok = check_name("the connection id", id); !ok)
-      return control::call_error(Status::BadRequest, ok.error().diagnostics()[0].message);
+      return control::call_error(Status::BadRequest, ok.error());
   return check_end(uses, "uses").and_then([&] { return check_end(provides, "provides"); });
 }
 
@@ -86,6 +88,14 @@ void ConnectionManager::stop() {
     retrier_.join();
 }
 
+namespace {
+
+WireEnd wire_end(const RuntimeConnection &c, const ResolvedEnd &end, const PortRef &ref) {
+  return {end.address, end.port, c.id, end.host, 1, fmt::format("{} ({})", c.id, ref.to_string())};
+}
+
+} // namespace
+
 CallResult<void> ConnectionManager::wire(RuntimeConnection &c) {
   auto uses = resolve_(c.uses, profile::PortDirection::Uses);
   auto provides = resolve_(c.provides, profile::PortDirection::Provides);
@@ -102,55 +112,59 @@ CallResult<void> ConnectionManager::wire(RuntimeConnection &c) {
     return {};
   }
   c.repid = uses->repid;
-  auto request = [&](const ResolvedEnd &end, const char *direction) {
-    protocol::component::ConnectRequest r;
-    r.connection = c.id;
-    r.port = end.port;
-    r.direction = direction;
-    r.topic = c.topic;
-    r.repid = c.repid;
-    r.qos = c.qos;
-    return r;
-  };
-  using Connect = protocol::component::Connect;
-  // The reader first, so that the first samples written find it.
-  auto provided = control::call<Connect>(*endpoint_, provides->address,
-                                         request(*provides, "provides"), timeout_);
-  auto used =
-      provided ? control::call<Connect>(*endpoint_, uses->address, request(*uses, "uses"), timeout_)
-               : provided;
-  if (!provided || !used) {
-    if (provided)
-      unwire_end(c, *provides);
-    const auto &error = !provided ? provided.error() : used.error();
-    return control::call_error(error.status, fmt::format("connection {}: {}", c.id, error.message));
+  Wire w{wire_end(c, *uses, c.uses),
+         wire_end(c, *provides, c.provides),
+         c.topic,
+         "",
+         c.repid,
+         c.qos,
+         c.filter};
+  std::vector<WireEnd> made;
+  if (auto wired = Wiring(*endpoint_, timeout_).connect({w}, made); !wired) {
+    // What was made is undone: a connection is made whole or not at all.
+    for (const auto &failed : Wiring(*endpoint_, timeout_).disconnect(made))
+      spdlog::warn("runtime connection {}: undoing an end failed: {}", c.id, failed);
+    return control::call_error(wired.error().status,
+                               fmt::format("connection {}: {}", c.id, wired.error().message));
   }
   c.uses_end = std::move(*uses);
   c.provides_end = std::move(*provides);
   c.waiting_for.clear();
-  spdlog::info("runtime connection {}: {} -> {} on topic {}", c.id, c.uses.to_string(),
-               c.provides.to_string(), c.topic);
+  spdlog::info("runtime connection {}: {} -> {} on topic {}{}", c.id, c.uses.to_string(),
+               c.provides.to_string(), c.topic, w.in_one_host() ? " (in its component host)" : "");
   return {};
 }
 
-void ConnectionManager::unwire_end(const RuntimeConnection &c, const ResolvedEnd &end) {
-  if (auto ok = control::call<protocol::component::Disconnect>(*endpoint_, end.address,
-                                                               {c.id, end.port}, timeout_);
-      !ok)
-    spdlog::warn("runtime connection {}: disconnecting {} failed: {}", c.id, end.address,
-                 ok.error().message);
+void ConnectionManager::unwire(const RuntimeConnection &c,
+                               const std::vector<const ResolvedEnd *> &ends) {
+  std::vector<WireEnd> wire_ends;
+  for (const auto *end : ends)
+    wire_ends.push_back({end->address, end->port, c.id, end->host, 1, end->address});
+  for (const auto &failed : Wiring(*endpoint_, timeout_).disconnect(wire_ends))
+    spdlog::warn("runtime connection {}: an end was not disconnected: {}", c.id, failed);
 }
 
-CallResult<RuntimeConnection> ConnectionManager::connect(const PortRef &uses,
-                                                         const PortRef &provides, std::string id,
-                                                         const Json &qos_json) {
-  if (auto ok = check_request(uses, provides, id); !ok)
+CallResult<RuntimeConnection> ConnectionManager::connect(Request request) {
+  if (auto ok = check_request(request.uses, request.provides, request.id); !ok)
     return tl::unexpected(ok.error());
-  auto qos = dds::connection_qos_from_json(qos_json);
+  auto qos = dds::connection_qos_from_json(request.qos);
   if (!qos)
     return control::call_error(Status::BadRequest, qos.error().to_string());
+  // A filter that does not parse would fail only when both ends are there: refused now.
+  if (!request.filter.empty())
+    if (auto filter = ContentFilter::parse(request.filter); !filter)
+      return control::call_error(Status::BadRequest, fmt::format("filter: {}", filter.error()));
   std::lock_guard wiring(wiring_);
-  RuntimeConnection c{std::move(id), uses, provides, "", "", dds::qos_to_json(*qos), "", {}, {}};
+  RuntimeConnection c{std::move(request.id),
+                      request.uses,
+                      request.provides,
+                      "",
+                      "",
+                      dds::qos_to_json(*qos),
+                      std::move(request.filter),
+                      "",
+                      {},
+                      {}};
   {
     std::lock_guard lock(mutex_);
     if (c.id.empty())
@@ -164,8 +178,8 @@ CallResult<RuntimeConnection> ConnectionManager::connect(const PortRef &uses,
   if (auto ok = wire(c); !ok)
     return tl::unexpected(ok.error());
   if (!c.connected())
-    spdlog::info("runtime connection {}: {} -> {} pending: {}", c.id, uses.to_string(),
-                 provides.to_string(), c.waiting_for);
+    spdlog::info("runtime connection {}: {} -> {} pending: {}", c.id, c.uses.to_string(),
+                 c.provides.to_string(), c.waiting_for);
   std::lock_guard lock(mutex_);
   connections_[c.id] = c;
   return c;
@@ -182,10 +196,8 @@ CallResult<void> ConnectionManager::disconnect(const std::string &id) {
     c = std::move(it->second);
     connections_.erase(it);
   }
-  if (c.connected()) {
-    unwire_end(c, c.uses_end);
-    unwire_end(c, c.provides_end);
-  }
+  if (c.connected())
+    unwire(c, {&c.uses_end, &c.provides_end});
   spdlog::info("runtime connection {} removed", id);
   return {};
 }
@@ -203,10 +215,12 @@ void ConnectionManager::owner_gone(const std::function<bool(const PortRef &)> &g
     }
   }
   for (const auto &c : affected) {
+    std::vector<const ResolvedEnd *> remaining;
     if (!gone(c.uses))
-      unwire_end(c, c.uses_end);
+      remaining.push_back(&c.uses_end);
     if (!gone(c.provides))
-      unwire_end(c, c.provides_end);
+      remaining.push_back(&c.provides_end);
+    unwire(c, remaining);
     spdlog::info("runtime connection {} pending again: an end is gone", c.id);
   }
 }
@@ -282,6 +296,8 @@ nlohmann::json to_json(const RuntimeConnection &c) {
            {"repid", c.repid},
            {"qos", c.qos},
            {"state", c.connected() ? "connected" : "pending"}};
+  if (!c.filter.empty())
+    out["filter"] = c.filter;
   if (!c.connected())
     out["waiting_for"] = c.waiting_for;
   return out;

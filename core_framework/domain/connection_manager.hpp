@@ -43,6 +43,7 @@ struct ResolvedEnd {
   std::string address;
   std::string port; // the owner's port (an external port's is the component's)
   std::string repid;
+  std::string host; // the component host that serves the owner, when it is hosted
 };
 
 struct RuntimeConnection {
@@ -52,6 +53,7 @@ struct RuntimeConnection {
   std::string topic;
   std::string repid;
   nlohmann::json qos;
+  std::string filter;      // the provides end's content filter (common/content_filter.hpp)
   std::string waiting_for; // empty when connected; else what it waits for
   ResolvedEnd uses_end, provides_end;
   bool connected() const { return waiting_for.empty(); }
@@ -74,10 +76,20 @@ public:
   ConnectionManager(const ConnectionManager &) = delete;
   ConnectionManager &operator=(const ConnectionManager &) = delete;
 
-  // Connects uses → provides with `qos` (SAD <qos> names, defaults filled in); `id` may be empty.
-  // The result is pending (waiting_for says for what) when an end is not there yet.
-  control::CallResult<RuntimeConnection> connect(const PortRef &uses, const PortRef &provides,
-                                                 std::string id, const nlohmann::json &qos);
+  // What a runtime connection is asked to be: `id` may be empty; `qos` has SAD <qos> names
+  // (defaults are filled in); `filter`, a content filter for the provides end, may be empty.
+  struct Request {
+    PortRef uses;
+    PortRef provides;
+    std::string id;
+    nlohmann::json qos = nlohmann::json::object();
+    std::string filter;
+  };
+
+  // Connects uses → provides, as the wiring service makes a SAD's connections (the reader
+  // first, then a wait until both ends match; in one component host without DDS). The result
+  // is pending (waiting_for says for what) when an end is not there yet.
+  control::CallResult<RuntimeConnection> connect(Request request);
   control::CallResult<void> disconnect(const std::string &id);
   // Something appeared (an application launched, a node registered): pending connections are
   // tried again, on the manager's own thread.
@@ -93,7 +105,8 @@ public:
 private:
   // Makes both ends, or leaves the connection pending. Called with wiring_ held.
   control::CallResult<void> wire(RuntimeConnection &c);
-  void unwire_end(const RuntimeConnection &c, const ResolvedEnd &end);
+  // Disconnects the ends given (best effort: a failure is logged).
+  void unwire(const RuntimeConnection &c, const std::vector<const ResolvedEnd *> &ends);
   void retry_pending();
   void retry_loop();
 

@@ -26,7 +26,7 @@ CallResult<const ComponentInstance *> target_of(const Application &app,
   for (const auto &c : app.components) {
     if (!(component.empty() ? c.assembly_controller : c.id == component))
       continue;
-    if (c.state == "exited")
+    if (c.state == ComponentState::Exited)
       return control::call_error(
           Status::Failed, fmt::format("component {} of application {} has exited", c.id, app.name));
     return &c;
@@ -60,7 +60,7 @@ CallResult<Json> typed_values(const Application &app, const ComponentInstance &c
     }
     auto bound = profile::bind_property(*definition, ref);
     if (!bound)
-      return control::call_error(Status::BadRequest, bound.error().diagnostics().front().message);
+      return control::call_error(Status::BadRequest, bound.error());
     typed[id] = profile::to_json(*bound);
   }
   return typed;
@@ -172,10 +172,10 @@ void DomainManager::Impl::mark_exited(const std::function<bool(const ComponentIn
                                       const std::string &why) {
   applications.update_all([&](Application &app) {
     for (auto &c : app.components) {
-      if (c.pid == 0 || c.state == "exited" || !which(c))
+      if (c.pid == 0 || c.state == ComponentState::Exited || !which(c))
         continue;
       components.exited(c.address, why);
-      c.state = "exited";
+      c.state = ComponentState::Exited;
       spdlog::warn("component {} of application {} exited unexpectedly: {}; the application is "
                    "degraded",
                    c.id, app.name, why);

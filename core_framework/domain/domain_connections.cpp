@@ -104,7 +104,7 @@ CallResult<PortRef> port_ref(const Json &body, const char *key) {
 // not exited (one that exited cannot answer) and the devices its connections reach.
 void status_addresses(const Application &app, std::set<std::string> &addresses) {
   for (const auto &c : app.components)
-    if (c.state != "exited")
+    if (c.state != ComponentState::Exited)
       addresses.insert(c.address);
   for (const auto &c : app.connections)
     for (const auto *end : {&c.uses, &c.provides})
@@ -258,7 +258,7 @@ DomainManager::Impl::resolve_component_end(const PortRef &ref, profile::PortDire
   if (definition == nullptr)
     return control::call_error(Status::NotFound, fmt::format("{} is not a {} port", ref.to_string(),
                                                              profile::to_string(direction)));
-  return ResolvedEnd{instance->address, port, definition->repid};
+  return ResolvedEnd{instance->address, port, definition->repid, instance->host};
 }
 
 CallResult<ResolvedEnd> DomainManager::Impl::resolve_device_end(const PortRef &ref,
@@ -274,7 +274,7 @@ CallResult<ResolvedEnd> DomainManager::Impl::resolve_device_end(const PortRef &r
                                fmt::format("node {} has no device {}", node, ref.owner));
   for (const auto &p : device->ports)
     if (p.name == ref.port && p.direction == wanted)
-      return ResolvedEnd{device->address, ref.port, p.repid};
+      return ResolvedEnd{device->address, ref.port, p.repid, ""};
   return control::call_error(Status::NotFound,
                              fmt::format("{} is not a {} port", ref.to_string(), wanted));
 }
@@ -372,8 +372,9 @@ CallResult<RuntimeConnection> DomainManager::Impl::make_connection(const Json &b
   auto provides = port_ref(body, "provides");
   if (!provides)
     return tl::unexpected(provides.error());
-  return runtime_connections->connect(*uses, *provides, body.value("id", ""),
-                                      body.value("qos", Json::object()));
+  return runtime_connections->connect({*uses, *provides, body.value("id", ""),
+                                       body.value("qos", Json::object()),
+                                       body.value("filter", "")});
 }
 
 // A runtime connection lasts until `rsca disconnect`, also over a restart of the domain daemon:
@@ -385,11 +386,13 @@ CallResult<Json> DomainManager::Impl::create_connection(const Json &body) {
   if (!made)
     return tl::unexpected(made.error());
   // The request as given (the QoS asked for, not today's defaults), with the id it got.
-  const Json request{{"format", 1},
-                     {"id", made->id},
-                     {"uses", body.at("uses")},
-                     {"provides", body.at("provides")},
-                     {"qos", body.value("qos", Json::object())}};
+  Json request{{"format", 1},
+               {"id", made->id},
+               {"uses", body.at("uses")},
+               {"provides", body.at("provides")},
+               {"qos", body.value("qos", Json::object())}};
+  if (!made->filter.empty())
+    request["filter"] = made->filter;
   Json reply = to_json(*made);
   reply["persisted"] = true;
   if (auto kept = store->put_connection({made->id, request.dump()}); !kept) {

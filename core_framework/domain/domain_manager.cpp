@@ -164,7 +164,7 @@ CallResult<Json> DomainManager::Impl::create_application(const Json &body) {
                                                        .message);
   if (*wanted)
     if (auto named = check_name("the application", **wanted); !named)
-      return control::call_error(Status::BadRequest, named.error().diagnostics().front().message);
+      return control::call_error(Status::BadRequest, named.error());
   LaunchRequest request;
   {
     std::lock_guard lock(installs);

@@ -94,7 +94,7 @@ CallResult<void> write_files(const fs::path &dir, const std::vector<InstallFile>
 // A name a client sent, checked: BadRequest when it is not a name.
 CallResult<void> checked_name(const std::string &name) {
   if (auto named = check_name("the application", name); !named)
-    return control::call_error(Status::BadRequest, named.error().diagnostics().front().message);
+    return control::call_error(Status::BadRequest, named.error());
   return {};
 }
 

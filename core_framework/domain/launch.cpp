@@ -219,7 +219,7 @@ CallResult<void> ApplicationFactory::Launch::execute() {
       continue;
     for (auto i : started_by[k]) {
       app_->components[i].pid = started.back()->pid;
-      app_->components[i].state = "executed";
+      app_->components[i].state = ComponentState::Executed;
     }
   }
   if (auto ok = first_failure(calls, started); !ok)
@@ -237,7 +237,7 @@ CallResult<void> ApplicationFactory::Launch::await_registration() {
   if (!ok)
     return ok;
   for (auto &c : app_->components)
-    c.state = "registered";
+    c.state = ComponentState::Registered;
   return {};
 }
 
@@ -385,7 +385,7 @@ void ApplicationFactory::Launch::build_components() {
     c.spd = request_.profile->softpkg_of(*placement)->spd_path.string();
     c.start_order = ci->start_order.value_or(UINT32_MAX);
     c.assembly_controller = sad.assembly_controller == ci->id;
-    c.state = "allocated";
+    c.state = ComponentState::Allocated;
     app_->components.push_back(std::move(c));
   }
 }

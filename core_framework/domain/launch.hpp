@@ -12,6 +12,7 @@
 #include "domain/application_factory.hpp"
 #include "domain/factory_calls.hpp"
 #include "domain/saga.hpp"
+#include "domain/wiring.hpp"
 #include "protocol/exec_params.hpp"
 
 namespace rsca::domain {
@@ -65,6 +66,11 @@ private:
 
   CallResult<void> connect();
 
+  // A SAD connection with its ends resolved.
+  CallResult<ConnectionInstance> connection_of(const profile::Connection &c, std::size_t index);
+
+  Wire wire_of(const ConnectionInstance &ci) const;
+
   // One end of a SAD connection: a port of one of this application's components, or of the
   // device that loaded or is used by one of them (checked against what its node announced);
   // nothing for an event channel.
@@ -77,11 +83,6 @@ private:
   CallResult<ConnectionEnd> device_end(ConnectionInstance &ci, const std::string &device,
                                        const std::string &port, profile::PortDirection direction);
 
-  // Waits until every connection made has matched its peers in this application (a channel
-  // member: this application's members on the other side), so that nothing a component writes
-  // once started is lost to discovery still under way.
-  CallResult<void> await_matched();
-
   // This application's subscribers (or publishers) on a channel's topic.
   int members_on(const std::string &topic, bool subscribers) const;
 
@@ -91,15 +92,6 @@ private:
 
   template <control::Operation Op, typename Request>
   CallResult<void> call_each(Request request);
-
-  Call connect_call(const ConnectionInstance &ci, const ConnectionEnd &end, const char *direction);
-
-  // A uses port's connection to a component's supported interface: it calls the component's
-  // control address.
-  Call interface_call(const ConnectionInstance &ci);
-
-  // Both ends are components of one component host: the connection bypasses DDS.
-  bool in_one_host(const ConnectionInstance &ci) const;
 
   std::string repid_of(const profile::Connection &c) const;
 

@@ -1,17 +1,16 @@
 // The connect step of a launch: each SAD connection's ends resolved (a component's port, a
-// device's, an event channel), the readers connected first, then the writers, then a wait until
-// every connection has matched its peers.
+// device's, an event channel), then made by the wiring service (domain/wiring.hpp).
 #include <algorithm>
 #include <filesystem>
 #include <map>
 
 #include <fmt/format.h>
-#include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
 #include "common/elapsed.hpp"
 #include "dds/port_qos.hpp"
 #include "domain/launch.hpp"
+#include "domain/wiring.hpp"
 #include "profile/property_binding.hpp"
 #include "profile/property_json.hpp"
 #include "protocol/component_ops.hpp"
@@ -23,42 +22,11 @@ using namespace detail;
 
 CallResult<void> ApplicationFactory::Launch::connect() {
   const auto &sad = *request_.profile->sad;
-  std::vector<Call> provides_side, uses_side;
   for (std::size_t i = 0; i < sad.connections.size(); ++i) {
-    const auto &c = sad.connections[i];
-    ConnectionInstance ci;
-    ci.id = connection_id(c, i);
-    ci.qos = dds::qos_to_json(c.qos.value_or(profile::ConnectionQos{}));
-    ci.topic = c.publishes_to_channel() || c.subscribes_to_channel()
-                   ? s_.channels->topic_of(channel_name(c))
-                   : protocol::connection_topic(s_.domain_name, app_->name, launch_, ci.id);
-    ci.filter = c.filter.value_or("");
-    ci.repid = repid_of(c);
-    auto uses = resolve_end(ci, c.uses.target, c.uses.port, profile::PortDirection::Uses);
-    if (!uses)
-      return tl::unexpected(uses.error());
-    ci.uses = std::move(*uses);
-    if (c.provides.kind == profile::ProvidesEnd::Kind::SupportedInterface) {
-      // The component itself, at its control address: no topic, nothing to make on its side.
-      ci.topic.clear();
-      ci.provides = {c.provides.target.refid, "", "",
-                     component_of(c.provides.target.refid)->address};
-      uses_side.push_back(interface_call(ci));
-      app_->connections.push_back(std::move(ci));
-      continue;
-    }
-    if (c.provides.kind == profile::ProvidesEnd::Kind::Port) {
-      auto provides =
-          resolve_end(ci, c.provides.target, c.provides.port, profile::PortDirection::Provides);
-      if (!provides)
-        return tl::unexpected(provides.error());
-      ci.provides = std::move(*provides);
-    }
-    if (!ci.uses.empty())
-      uses_side.push_back(connect_call(ci, ci.uses, "uses"));
-    if (!ci.provides.empty())
-      provides_side.push_back(connect_call(ci, ci.provides, "provides"));
-    app_->connections.push_back(std::move(ci));
+    auto ci = connection_of(sad.connections[i], i);
+    if (!ci)
+      return tl::unexpected(ci.error());
+    app_->connections.push_back(std::move(*ci));
   }
   // Devices outlive the application: their ends of its connections are undone on their own (the
   // components' ends go with their processes).
@@ -67,21 +35,77 @@ CallResult<void> ApplicationFactory::Launch::connect() {
     return ends == 0 ? std::string()
                      : fmt::format("{} device end{} disconnected", ends, ends == 1 ? "" : "s");
   });
-  // Readers first, so the first samples written find them.
-  auto began = Clock::now();
-  if (auto ok = call_all(*s_.endpoint, provides_side, s_.call_timeout); !ok)
-    return ok;
-  const double readers_ms = ms_since(began);
-  began = Clock::now();
-  if (auto ok = call_all(*s_.endpoint, uses_side, s_.call_timeout); !ok)
-    return ok;
-  const double writers_ms = ms_since(began);
-  began = Clock::now();
-  if (auto ok = await_matched(); !ok)
-    return ok;
+  std::vector<Wire> wires;
+  wires.reserve(app_->connections.size());
+  for (const auto &ci : app_->connections)
+    wires.push_back(wire_of(ci));
+  std::vector<WireEnd> made;
+  auto times = Wiring(*s_.endpoint, s_.call_timeout).connect(wires, made);
+  if (!times)
+    return tl::unexpected(times.error());
   detail_ = fmt::format("{} connections (readers {:.0f} ms, writers {:.0f} ms, matched {:.0f} ms)",
-                        app_->connections.size(), readers_ms, writers_ms, ms_since(began));
+                        app_->connections.size(), times->readers_ms, times->writers_ms,
+                        times->matched_ms);
   return {};
+}
+
+CallResult<ConnectionInstance>
+ApplicationFactory::Launch::connection_of(const profile::Connection &c, std::size_t index) {
+  ConnectionInstance ci;
+  ci.id = connection_id(c, index);
+  ci.qos = dds::qos_to_json(c.qos.value_or(profile::ConnectionQos{}));
+  ci.topic = c.publishes_to_channel() || c.subscribes_to_channel()
+                 ? s_.channels->topic_of(channel_name(c))
+                 : protocol::connection_topic(s_.domain_name, app_->name, launch_, ci.id);
+  ci.filter = c.filter.value_or("");
+  ci.repid = repid_of(c);
+  auto uses = resolve_end(ci, c.uses.target, c.uses.port, profile::PortDirection::Uses);
+  if (!uses)
+    return tl::unexpected(uses.error());
+  ci.uses = std::move(*uses);
+  if (c.provides.kind == profile::ProvidesEnd::Kind::SupportedInterface) {
+    // The component itself, at its control address: no topic, nothing to make on its side.
+    ci.topic.clear();
+    ci.provides = {c.provides.target.refid, "", "", component_of(c.provides.target.refid)->address};
+    return ci;
+  }
+  if (c.provides.kind == profile::ProvidesEnd::Kind::Port) {
+    auto provides =
+        resolve_end(ci, c.provides.target, c.provides.port, profile::PortDirection::Provides);
+    if (!provides)
+      return tl::unexpected(provides.error());
+    ci.provides = std::move(*provides);
+  }
+  return ci;
+}
+
+// A SAD connection as the wiring service makes it. An event channel's member waits for this
+// application's members on the other side of the channel.
+Wire ApplicationFactory::Launch::wire_of(const ConnectionInstance &ci) const {
+  Wire w;
+  w.topic = ci.topic;
+  w.repid = ci.repid;
+  w.qos = ci.qos;
+  w.filter = ci.filter;
+  auto end_of = [&](const ConnectionEnd &end, int peers, std::string what) {
+    const auto *component = end.component.empty() ? nullptr : component_of(end.component);
+    return WireEnd{end.address, end.port,       end_key(ci, end), component ? component->host : "",
+                   peers,       std::move(what)};
+  };
+  if (ci.is_interface()) {
+    w.interface_target = ci.provides.address;
+    w.uses =
+        end_of(ci.uses, 0, fmt::format("{} ({} -> {})", ci.id, ci.uses.name(), ci.provides.name()));
+    return w;
+  }
+  const bool channel = ci.uses.empty() || ci.provides.empty();
+  if (!ci.uses.empty())
+    w.uses = end_of(ci.uses, channel ? members_on(ci.topic, /*subscribers=*/true) : 1,
+                    fmt::format("{} ({})", ci.id, ci.uses.name()));
+  if (!ci.provides.empty())
+    w.provides = end_of(ci.provides, channel ? members_on(ci.topic, /*subscribers=*/false) : 1,
+                        fmt::format("{} ({})", ci.id, ci.provides.name()));
+  return w;
 }
 
 CallResult<ConnectionEnd>
@@ -140,87 +164,12 @@ CallResult<ConnectionEnd> ApplicationFactory::Launch::device_end(ConnectionInsta
   return ConnectionEnd{"", port, device, ports->address};
 }
 
-CallResult<void> ApplicationFactory::Launch::await_matched() {
-  std::map<std::string, protocol::component::AwaitMatchedRequest> awaited; // by address
-  auto await = [&](const ConnectionInstance &ci, const ConnectionEnd &end, int peers) {
-    if (end.empty() || peers == 0)
-      return;
-    auto &request = awaited[end.address];
-    request.timeout_ms = s_.call_timeout.count();
-    request.connections.push_back({end.port, end_key(ci, end), peers, 0});
-  };
-  for (const auto &ci : app_->connections) {
-    if (ci.is_interface())
-      continue; // a control address: nothing to discover
-    const bool channel = ci.uses.empty() || ci.provides.empty();
-    await(ci, ci.uses, channel ? members_on(ci.topic, /*subscribers=*/true) : 1);
-    await(ci, ci.provides, channel ? members_on(ci.topic, /*subscribers=*/false) : 1);
-  }
-  std::vector<Call> calls;
-  for (auto &[address, request] : awaited)
-    calls.push_back(call_of<protocol::component::AwaitMatched>(address, request, address));
-  auto replies = call_each_of(*s_.endpoint, calls, 2 * s_.call_timeout);
-  if (auto ok = first_failure(calls, replies); !ok)
-    return ok;
-  std::vector<std::string> unmatched;
-  for (auto &raw : replies) {
-    auto reply = control::reply_of<protocol::component::AwaitMatched>(std::move(raw));
-    if (!reply)
-      return tl::unexpected(reply.error());
-    for (const auto &c : reply->connections)
-      if (c.matched < c.peers)
-        unmatched.push_back(fmt::format("{} on port {}: {} of {} peers matched", c.connection,
-                                        c.port, c.matched, c.peers));
-  }
-  if (!unmatched.empty())
-    return control::call_error(Status::Unavailable,
-                               fmt::format("connections not matched after {} ms: {}",
-                                           s_.call_timeout.count(), fmt::join(unmatched, "; ")));
-  return {};
-}
-
 int ApplicationFactory::Launch::members_on(const std::string &topic, bool subscribers) const {
   int n = 0;
   for (const auto &ci : app_->connections)
     if (ci.topic == topic && !(subscribers ? ci.provides : ci.uses).empty())
       ++n;
   return n;
-}
-
-Call ApplicationFactory::Launch::connect_call(const ConnectionInstance &ci,
-                                              const ConnectionEnd &end, const char *direction) {
-  protocol::component::ConnectRequest request;
-  request.connection = end_key(ci, end);
-  request.port = end.port;
-  request.direction = direction;
-  request.topic = ci.topic;
-  request.repid = ci.repid;
-  request.qos = ci.qos;
-  request.filter = std::string_view(direction) == "provides" ? ci.filter : "";
-  request.local = in_one_host(ci);
-  return call_of<protocol::component::Connect>(end.address, request,
-                                               fmt::format("{} ({})", ci.id, end.name()));
-}
-
-Call ApplicationFactory::Launch::interface_call(const ConnectionInstance &ci) {
-  protocol::component::ConnectRequest request;
-  request.connection = end_key(ci, ci.uses);
-  request.port = ci.uses.port;
-  request.direction = "uses";
-  request.repid = ci.repid;
-  request.target = ci.provides.address;
-  return call_of<protocol::component::Connect>(
-      ci.uses.address, request,
-      fmt::format("{} ({} -> {})", ci.id, ci.uses.name(), ci.provides.name()));
-}
-
-bool ApplicationFactory::Launch::in_one_host(const ConnectionInstance &ci) const {
-  if (ci.uses.component.empty() || ci.provides.component.empty())
-    return false;
-  const auto *uses = component_of(ci.uses.component);
-  const auto *provides = component_of(ci.provides.component);
-  return uses != nullptr && provides != nullptr && !uses->host.empty() &&
-         uses->host == provides->host;
 }
 
 std::string ApplicationFactory::Launch::repid_of(const profile::Connection &c) const {

@@ -1,5 +1,8 @@
 #include "protocol/status.hpp"
 
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
 namespace rsca::protocol {
 
 std::string_view to_string(Status status) {
@@ -25,6 +28,51 @@ std::string_view to_string(Status status) {
 bool is_known(std::int32_t status) {
   return status >= static_cast<std::int32_t>(Status::Ok) &&
          status <= static_cast<std::int32_t>(Status::Rejected);
+}
+
+namespace {
+
+std::string detail_of(const Diagnostic &d) {
+  if (d.where.file.empty())
+    return fmt::format("{}: {}", d.rule, d.message);
+  return to_string(d);
+}
+
+} // namespace
+
+tl::unexpected<CallError> call_error(Status status, const Error &findings) {
+  const auto &all = findings.diagnostics();
+  if (all.empty())
+    return call_error(status, "failed, with no finding given");
+  CallError error{status, all.front().message};
+  if (all.size() > 1)
+    error.message += fmt::format(" (and {} more)", all.size() - 1);
+  for (const auto &d : all)
+    error.details.push_back(detail_of(d));
+  return tl::unexpected(std::move(error));
+}
+
+std::string error_body(const CallError &error) {
+  if (error.details.empty())
+    return {};
+  return nlohmann::json{{"details", error.details}}.dump();
+}
+
+std::vector<std::string> details_of_text(std::string_view body) {
+  if (body.empty())
+    return {};
+  return details_of(nlohmann::json::parse(body, nullptr, /*allow_exceptions=*/false));
+}
+
+// Bounded: the reply is untrusted.
+std::vector<std::string> details_of(const nlohmann::json &json) {
+  if (!json.is_object() || !json.contains("details") || !json.at("details").is_array())
+    return {};
+  std::vector<std::string> details;
+  for (const auto &d : json.at("details"))
+    if (d.is_string() && details.size() < 1000)
+      details.push_back(d.get<std::string>());
+  return details;
 }
 
 } // namespace rsca::protocol

@@ -7,8 +7,12 @@
 #include <cstdint>
 #include <string>
 #include <string_view>
+#include <vector>
 
+#include <nlohmann/json_fwd.hpp>
 #include <tl/expected.hpp>
+
+#include "common/diagnostic.hpp"
 
 namespace rsca::protocol {
 
@@ -31,6 +35,9 @@ struct CallError {
   // The addressee was there when the request was sent and may have acted on it: an Unavailable
   // call whose addressee left DDS before it replied, as opposed to one nobody ever served.
   bool maybe_received = false;
+  // Every finding behind the message, when there are several to tell (a profile's, a value's):
+  // each "file:line:column: rule: message", or "rule: message" where it has no place.
+  std::vector<std::string> details{};
 };
 
 template <typename T>
@@ -39,5 +46,15 @@ using CallResult = tl::expected<T, CallError>;
 inline tl::unexpected<CallError> call_error(Status status, std::string message) {
   return tl::unexpected(CallError{status, std::move(message)});
 }
+
+// A request that fails on findings (common/diagnostic.hpp: a name, a value, a profile): the
+// message is the first one's, and `details` keeps them all, so that no conversion drops one.
+tl::unexpected<CallError> call_error(Status status, const Error &findings);
+
+// The details of an error reply, as its body carries them ({"details": [...]}), and back; a body
+// without them gives none.
+std::string error_body(const CallError &error);
+std::vector<std::string> details_of(const nlohmann::json &body);
+std::vector<std::string> details_of_text(std::string_view body);
 
 } // namespace rsca::protocol

@@ -103,7 +103,49 @@ TEST_CASE("shared-library components run in one component host: launched, carryi
   REQUIRE(q.has_value());
   CHECK(q->at("properties").at("rate_hz").get<double>() == 200.0);
 
+  // A runtime connection between the two takes the same in-host path, and filters as a SAD
+  // connection does: no sample is the end of a stream, so every one is filtered out.
+  const Json ends{{"uses",
+                   {{"application", "ProducerConsumerHosted"},
+                    {"component", "Producer_1"},
+                    {"port", "samples_out"}}},
+                  {"provides",
+                   {{"application", "ProducerConsumerHosted"},
+                    {"component", "Consumer_1"},
+                    {"port", "samples_in"}}}};
+  Json request = ends;
+  request["id"] = "filtered";
+  request["filter"] = "end_of_stream";
+  auto made = domain.call("connection.create", request);
+  REQUIRE(made.has_value());
+  CHECK(made->at("state") == "connected");
+  CHECK(made->at("filter") == "end_of_stream");
+  auto runtime_state = [&domain] {
+    auto list = domain.call("connection.list", Json{{"app", "ProducerConsumerHosted"}});
+    REQUIRE(list.has_value());
+    for (const auto &c : list->at("connections"))
+      if (c.at("id") == "filtered")
+        return c;
+    FAIL("the runtime connection is not listed");
+    return Json();
+  };
+  CHECK(TestDomain::wait_for(
+      [&] { return runtime_state().at("provides_state").value("filtered", 0) > 5; }));
+  const Json state = runtime_state();
+  CHECK(state.at("uses_state").value("in_host", false));
+  CHECK(state.at("provides_state").value("in_host", false));
+  // Every sample that arrived was filtered (one may be between the two counts).
+  const auto arrived = state.at("provides_state").value("samples", 0);
+  CHECK(arrived - state.at("provides_state").value("filtered", 0) <= 1);
+  // A filter that does not parse is refused before anything is made or kept.
+  request["id"] = "unparsable";
+  request["filter"] = "range <";
+  auto refused = domain.call("connection.create", request);
+  REQUIRE_FALSE(refused.has_value());
+  CHECK_THAT(refused.error().message, Catch::StartsWith("filter: "));
+
   REQUIRE(domain.call("app.release", Json{{"app", "ProducerConsumerHosted"}}).has_value());
+  REQUIRE(domain.call("connection.destroy", Json{{"id", "filtered"}}).has_value());
   domain.require_clean({pids.at("Producer_1")});
 }
 

@@ -8,6 +8,7 @@
 using rsca::control::Status;
 using rsca::domain::Application;
 using rsca::domain::ApplicationRegistry;
+using rsca::domain::ComponentState;
 
 namespace {
 
@@ -17,7 +18,7 @@ std::shared_ptr<Application> application(const std::string &name, const std::str
   app->installed = installed;
   rsca::domain::ComponentInstance c;
   c.id = "Producer_1";
-  c.state = "running";
+  c.state = ComponentState::Running;
   c.pid = 42;
   app->components.push_back(c);
   return app;
@@ -69,9 +70,10 @@ TEST_CASE("state changes go through update and readers get copies",
   registry.commit(application("A", "X"));
   auto before = registry.snapshot("A");
   REQUIRE(before.has_value());
-  CHECK(registry.update("A", [](Application &a) { a.components[0].state = "exited"; }));
-  CHECK(before->components[0].state == "running"); // a copy: unchanged
-  CHECK(registry.snapshot("A")->components[0].state == "exited");
+  CHECK(
+      registry.update("A", [](Application &a) { a.components[0].state = ComponentState::Exited; }));
+  CHECK(before->components[0].state == ComponentState::Running); // a copy: unchanged
+  CHECK(registry.snapshot("A")->components[0].state == ComponentState::Exited);
   CHECK(rsca::domain::state_of(*registry.snapshot("A")) == "degraded");
   CHECK(rsca::domain::exited_components(*registry.snapshot("A")) ==
         std::vector<std::string>{"Producer_1"});

@@ -134,6 +134,41 @@ TEST_CASE("errors travel back with their status", "[control]") {
   CHECK(reply.error().status == Status::Rejected);
   CHECK(reply.error().message == "not enough memory on gpp@node2");
 
+  CHECK(reply.error().details.empty());
+
+  // Findings travel whole: the first says what failed, every one is in the details, also
+  // through a batch (call_all to an alias of the server).
+  Error findings(Diagnostic{{"a.prf.xml", 3, 7}, "range", "rate_hz is -1, below 0"});
+  findings.add(Diagnostic{{}, "name", "the port \"a/b\" is not a name"});
+  server->on("findings",
+             [&](const Json &, const control::RequestContext &) -> control::CallResult<Json> {
+               return control::call_error(Status::BadRequest, findings);
+             });
+  const std::vector<std::string> details{"a.prf.xml:3:7: range: rate_hz is -1, below 0",
+                                         "name: the port \"a/b\" is not a name"};
+  auto found = client->call_sync("test/server", "findings", Json::object(), 5s);
+  REQUIRE_FALSE(found.has_value());
+  CHECK(found.error().message == "rate_hz is -1, below 0 (and 1 more)");
+  CHECK(found.error().details == details);
+  control::EndpointOptions options;
+  options.aliases = {"test/host/a", "test/host/b"};
+  auto host = open(pp, "test/host", options);
+  for (const std::string alias : {"test/host/a", "test/host/b"})
+    host->on(alias, "findings",
+             [&](const Json &, const control::RequestContext &) -> control::CallResult<Json> {
+               return control::call_error(Status::BadRequest, findings);
+             });
+  client->route("test/host/a", "test/host");
+  client->route("test/host/b", "test/host");
+  auto batch = client->call_all(
+      {{"test/host/a", "findings", Json::object()}, {"test/host/b", "findings", Json::object()}},
+      5s);
+  REQUIRE(batch.size() == 2);
+  for (const auto &r : batch) {
+    REQUIRE_FALSE(r.has_value());
+    CHECK(r.error().details == details);
+  }
+
   auto unknown = client->call_sync("test/server", "nope", Json::object(), 5s);
   REQUIRE_FALSE(unknown.has_value());
   CHECK(unknown.error().status == Status::BadRequest);

@@ -77,9 +77,14 @@ int report_failure(const GlobalOptions &global, const std::string &what,
     message += fmt::format(" (is the domain \"{}\" up on DDS domain {}? see `rsca domain up`)",
                            global.domain, dds::DdsSettings::from_environment().domain_id);
   if (global.json) {
-    print_json({{"error", {{"status", control::to_string(error.status)}, {"message", message}}}});
+    control::Json reported{{"status", control::to_string(error.status)}, {"message", message}};
+    if (!error.details.empty())
+      reported["details"] = error.details;
+    print_json({{"error", std::move(reported)}});
   } else {
     fmt::print(stderr, "rsca {}: {}\n", what, message);
+    for (const auto &detail : error.details)
+      fmt::print(stderr, "  {}\n", detail);
   }
   return exit_code_of(error.status);
 }
