@@ -56,6 +56,13 @@ const Json &component(const Json &app, const std::string &id) {
   throw std::logic_error("unreachable");
 }
 
+void refused_as_bad_request(const rsca::control::CallResult<Json> &reply,
+                            const std::string &saying) {
+  REQUIRE_FALSE(reply.has_value());
+  CHECK(reply.error().status == Status::BadRequest);
+  CHECK_THAT(reply.error().message, Catch::Contains(saying));
+}
+
 } // namespace
 
 TEST_CASE("an application name that is a path never makes the domain act outside its repository",
@@ -138,6 +145,27 @@ TEST_CASE("uninstall while a launch of the application is under way is refused; 
   REQUIRE(installed.has_value());
   CHECK(installed->at("applications").empty());
   domain.require_clean({});
+}
+
+TEST_CASE("a request with a field the domain does not know is refused, naming the field, before "
+          "anything is done",
+          "[integration][hostile]") {
+  TestDomain domain;
+  domain.install("Healthy");
+  // A client's typo ("stratgy"): taken without it, the launch would run on the default strategy.
+  refused_as_bad_request(
+      domain.call("app.create", Json{{"application", "Healthy"}, {"stratgy", "spread"}}),
+      "app.create: unknown field \"stratgy\"");
+  auto apps = domain.call("app.list");
+  REQUIRE(apps.has_value());
+  CHECK(apps->at("applications").empty());
+  CHECK(domain.running_pids().empty());
+
+  refused_as_bad_request(
+      domain.call("app.show", Json{{"app", "Healthy"}, {"component", "Producer_1"}}),
+      "app.show: unknown field \"component\"");
+  refused_as_bad_request(domain.call("app.query", Json{{"app", "Healthy"}, {"ids", "received"}}),
+                         "app.query: field \"ids\": expected an array, found string");
 }
 
 TEST_CASE("a restarted domain daemon never collides with what a killed one left running, and "
