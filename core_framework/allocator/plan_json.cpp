@@ -91,4 +91,15 @@ json to_json(const DomainState &state) {
   return out;
 }
 
+protocol::application::PlanReply
+plan_reply(const tl::expected<Plan, std::vector<Rejection>> &outcome, Strategy strategy) {
+  protocol::application::PlanReply reply{outcome.has_value(), std::string(to_string(strategy)),
+                                         std::nullopt, std::nullopt};
+  if (outcome)
+    reply.plan = to_json(*outcome);
+  else
+    reply.rejections = to_json(outcome.error());
+  return reply;
+}
+
 } // namespace rsca::allocator

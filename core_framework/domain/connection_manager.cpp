@@ -288,19 +288,4 @@ std::vector<RuntimeConnection> ConnectionManager::list() const {
   return out;
 }
 
-nlohmann::json to_json(const RuntimeConnection &c) {
-  Json out{{"id", c.id},
-           {"uses", c.uses.to_string()},
-           {"provides", c.provides.to_string()},
-           {"topic", c.topic},
-           {"repid", c.repid},
-           {"qos", c.qos},
-           {"state", c.connected() ? "connected" : "pending"}};
-  if (!c.filter.empty())
-    out["filter"] = c.filter;
-  if (!c.connected())
-    out["waiting_for"] = c.waiting_for;
-  return out;
-}
-
 } // namespace rsca::domain

@@ -126,6 +126,4 @@ private:
   std::thread retrier_;
 };
 
-nlohmann::json to_json(const RuntimeConnection &connection);
-
 } // namespace rsca::domain

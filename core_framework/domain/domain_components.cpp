@@ -37,14 +37,16 @@ CallResult<const ComponentInstance *> target_of(const Application &app,
                   component.empty() ? "(assembly controller)" : excerpt(component)));
 }
 
+using TextValues = std::map<std::string, Json>;
+
 // Property values given as text (from the CLI), typed against the component's PRF.
 CallResult<Json> typed_values(const Application &app, const ComponentInstance &component,
-                              const Json &values) {
+                              const TextValues &values) {
   const profile::ComponentPlacement *placement = nullptr;
   app.profile->sad->find_instantiation(component.id, &placement);
   const auto *pkg = placement != nullptr ? app.profile->softpkg_of(*placement) : nullptr;
   Json typed = Json::object();
-  for (const auto &[id, text] : values.items()) {
+  for (const auto &[id, text] : values) {
     const auto *definition = pkg != nullptr ? pkg->find_property(id) : nullptr;
     if (definition == nullptr)
       return control::call_error(Status::NotFound, fmt::format("component {} has no property {}",
@@ -68,9 +70,9 @@ CallResult<Json> typed_values(const Application &app, const ComponentInstance &c
 
 // Values given as text, for a device (whose PRF the domain does not hold): booleans and numbers
 // as such, the rest as text.
-Json json_values(const Json &values) {
+Json json_values(const TextValues &values) {
   Json out = Json::object();
-  for (const auto &[id, v] : values.items()) {
+  for (const auto &[id, v] : values) {
     const std::string text = v.is_string() ? v.get<std::string>() : v.dump();
     const Json parsed = Json::parse(text, nullptr, false);
     out[id] =
@@ -86,16 +88,15 @@ struct Target {
   ComponentInstance component;
 };
 
-CallResult<Target> target_in(ApplicationRegistry &applications, const Json &body) {
-  auto name = required<std::string>(body, "app");
-  auto component = optional_field<std::string>(body, "component");
-  if (!name || !component)
-    return tl::unexpected(name ? component.error() : name.error());
-  auto app = applications.snapshot(*name);
+CallResult<Target> target_in(ApplicationRegistry &applications, const app_ops::Target &request) {
+  if (!request.app)
+    return control::call_error(Status::BadRequest, "the request names no \"app\" (or \"device\")");
+  const std::string &name = *request.app;
+  auto app = applications.snapshot(name);
   if (!app)
     return control::call_error(Status::NotFound,
-                               fmt::format("no application {} is running", excerpt(*name)));
-  auto target = target_of(*app, component->value_or(""));
+                               fmt::format("no application {} is running", excerpt(name)));
+  auto target = target_of(*app, request.component.value_or(""));
   if (!target)
     return tl::unexpected(target.error());
   return Target{*app, **target};
@@ -103,19 +104,20 @@ CallResult<Target> target_in(ApplicationRegistry &applications, const Json &body
 
 } // namespace
 
-CallResult<Json> DomainManager::Impl::configure(const Json &body) {
-  if (body.contains("device")) {
-    auto address = device_address(required<std::string>(body, "device").value_or(""));
+CallResult<protocol::Empty> DomainManager::Impl::configure(const app_ops::ConfigureRequest &r) {
+  const TextValues none;
+  if (r.device) {
+    auto address = device_address(*r.device);
     if (!address)
       return tl::unexpected(address.error());
-    return configure_at(*address, json_values(body.value("values", Json::object())));
+    return configure_at(*address, json_values(r.values.value_or(none)));
   }
-  auto target = target_in(applications, body);
+  auto target = target_in(applications, r);
   if (!target)
     return tl::unexpected(target.error());
-  Json properties = body.value("properties", Json::object());
-  if (body.contains("values")) {
-    auto typed = typed_values(target->app, target->component, body.at("values"));
+  Json properties(r.properties.value_or(none));
+  if (r.values) {
+    auto typed = typed_values(target->app, target->component, *r.values);
     if (!typed)
       return tl::unexpected(typed.error());
     properties.update(*typed);
@@ -123,33 +125,30 @@ CallResult<Json> DomainManager::Impl::configure(const Json &body) {
   return configure_at(target->component.address, std::move(properties));
 }
 
-CallResult<Json> DomainManager::Impl::configure_at(const std::string &address, Json properties) {
+CallResult<protocol::Empty> DomainManager::Impl::configure_at(const std::string &address,
+                                                              Json properties) {
   return control::call<protocol::component::Configure>(*endpoint, address, {std::move(properties)},
-                                                       options.call_timeout)
-      .map([](const auto &reply) { return protocol::encode(reply); });
+                                                       options.call_timeout);
 }
 
-CallResult<Json> DomainManager::Impl::query_at(const std::string &address,
-                                               std::vector<std::string> ids) {
+CallResult<protocol::component::QueryReply>
+DomainManager::Impl::query_at(const std::string &address, std::vector<std::string> ids) {
   return control::call<protocol::component::Query>(*endpoint, address, {std::move(ids)},
-                                                   options.call_timeout)
-      .map([](const auto &reply) { return protocol::encode(reply); });
+                                                   options.call_timeout);
 }
 
-CallResult<Json> DomainManager::Impl::query(const Json &body) {
-  auto ids = optional_field<std::vector<std::string>>(body, "ids");
-  if (!ids)
-    return tl::unexpected(ids.error());
-  if (body.contains("device")) {
-    auto address = device_address(required<std::string>(body, "device").value_or(""));
+CallResult<protocol::component::QueryReply>
+DomainManager::Impl::query(const app_ops::QueryRequest &r) {
+  if (r.device) {
+    auto address = device_address(*r.device);
     if (!address)
       return tl::unexpected(address.error());
-    return query_at(*address, ids->value_or(std::vector<std::string>{}));
+    return query_at(*address, r.ids);
   }
-  auto target = target_in(applications, body);
+  auto target = target_in(applications, r);
   if (!target)
     return tl::unexpected(target.error());
-  return query_at(target->component.address, ids->value_or(std::vector<std::string>{}));
+  return query_at(target->component.address, r.ids);
 }
 
 CallResult<protocol::Empty>

@@ -45,21 +45,59 @@ Json end_state(const StatusOf &status_of, const std::string &address, const std:
   return nullptr;
 }
 
-Json connection_json(const Application &app, const ConnectionInstance &c,
-                     const StatusOf &status_of) {
+// An application's connection in connection.list, with its ends' live state.
+connection_ops::ListedConnection listed(const Application &app, const ConnectionInstance &c,
+                                        const StatusOf &status_of) {
   auto state = [&](const ConnectionEnd &e) {
     return end_state(status_of, e.address, e.port, end_key(c, e));
   };
-  return {{"application", app.name},
-          {"id", c.id},
-          {"uses", c.uses.name()},
-          {"provides", c.provides.name()},
-          {"topic", c.topic},
-          {"repid", c.repid},
-          {"qos", c.qos},
-          {"filter", c.filter},
-          {"uses_state", state(c.uses)},
-          {"provides_state", state(c.provides)}};
+  return {{c.id, c.uses.name(), c.provides.name(), c.topic, c.repid, c.qos},
+          app.name,
+          c.filter,
+          std::nullopt,
+          std::nullopt,
+          state(c.uses),
+          state(c.provides)};
+}
+
+connection_ops::ConnectionView view_of(const RuntimeConnection &c) {
+  return {c.id, c.uses.to_string(), c.provides.to_string(), c.topic, c.repid, c.qos};
+}
+
+connection_ops::ConnectionState state_of(const RuntimeConnection &c) {
+  return c.connected() ? connection_ops::ConnectionState::Connected
+                       : connection_ops::ConnectionState::Pending;
+}
+
+// A runtime connection's content filter, when it has one.
+std::optional<std::string> filter_of(const RuntimeConnection &c) {
+  return c.filter.empty() ? std::nullopt : std::optional(c.filter);
+}
+
+// What a pending connection waits for; nothing for a connected one.
+std::optional<std::string> waiting_for(const RuntimeConnection &c) {
+  return c.connected() ? std::nullopt : std::optional(c.waiting_for);
+}
+
+// A runtime connection in connection.list: its ends' live state only when it is connected.
+connection_ops::ListedConnection listed(const RuntimeConnection &c, const StatusOf &status_of) {
+  auto state = [&](const ResolvedEnd &end) {
+    return c.connected() ? end_state(status_of, end.address, end.port, c.id) : Json();
+  };
+  return {view_of(c),     "(runtime)",       filter_of(c),         state_of(c),
+          waiting_for(c), state(c.uses_end), state(c.provides_end)};
+}
+
+connection_ops::ChannelView view_of(const EventChannel &channel) {
+  connection_ops::ChannelView view{
+      channel.name, channel.topic, channel.repid, channel.operator_owned, 0, 0, {}};
+  for (const auto &m : channel.members) {
+    view.publishers += m.role == ChannelMember::Role::Publisher ? 1 : 0;
+    view.members.push_back({std::string(to_string(m.role)), m.application, m.connection,
+                            m.component, m.port, m.filter});
+  }
+  view.subscribers = channel.members.size() - view.publishers;
+  return view;
 }
 
 Json device_ids(const protocol::node::NodeAnnouncement &node) {
@@ -78,19 +116,15 @@ std::vector<allocator::Device> devices_of(const protocol::node::NodeAnnouncement
 
 // {"application", "component", "port"}, {"application", "port"} (an external port) or
 // {"device", "port"}.
-CallResult<PortRef> port_ref(const Json &body, const char *key) {
-  if (!body.contains(key) || !body.at(key).is_object())
-    return control::call_error(Status::BadRequest,
-                               fmt::format("the request has no \"{}\" port", key));
-  const Json &end = body.at(key);
+CallResult<PortRef> port_ref(const connection_ops::PortEnd &end, const char *key) {
   PortRef ref;
-  ref.port = end.value("port", "");
-  if (end.contains("device")) {
+  ref.port = end.port;
+  if (end.device) {
     ref.kind = PortRef::Kind::Device;
-    ref.owner = end.value("device", "");
+    ref.owner = *end.device;
   } else {
-    ref.owner = end.value("application", "");
-    ref.component = end.value("component", "");
+    ref.owner = end.application.value_or("");
+    ref.component = end.component.value_or("");
     ref.kind = ref.component.empty() ? PortRef::Kind::External : PortRef::Kind::Component;
   }
   if (ref.owner.empty() || ref.port.empty())
@@ -112,6 +146,20 @@ void status_addresses(const Application &app, std::set<std::string> &addresses) 
         addresses.insert(end->address);
 }
 
+// A runtime connection's request as the domain's store keeps it (with "format": 1).
+CallResult<connection_ops::CreateRequest> kept_request(const std::string &text) {
+  Json record = Json::parse(text, nullptr, /*allow_exceptions=*/false);
+  if (!record.is_object())
+    return control::call_error(Status::BadRequest, "not JSON");
+  if (record.value("format", 0) != 1)
+    return control::call_error(Status::BadRequest, "kept in another format");
+  record.erase("format");
+  auto request = protocol::decode<connection_ops::CreateRequest>(record);
+  if (!request)
+    return control::call_error(Status::BadRequest, request.error());
+  return std::move(*request);
+}
+
 } // namespace
 
 void DomainManager::Impl::on_announcement(const control::AnnouncementEvent &event) {
@@ -131,8 +179,9 @@ void DomainManager::Impl::on_announcement(const control::AnnouncementEvent &even
 void DomainManager::Impl::node_alive(const control::AnnouncementEvent &event) {
   auto announced = protocol::decode<protocol::node::NodeAnnouncement>(event.body);
   if (!announced) {
-    spdlog::warn("node at {}: its announcement is not taken: {}", excerpt(event.address),
-                 announced.error());
+    const std::string why = excerpt(announced.error(), 300);
+    if (nodes.refused(event.address, why))
+      spdlog::warn("node at {}: its announcement is not taken: {}", excerpt(event.address), why);
     return;
   }
   const std::string node = announced->node;
@@ -194,14 +243,12 @@ void DomainManager::Impl::component_announced(const control::AnnouncementEvent &
                                         {"pid", event.body.value("pid", 0)}});
 }
 
-Json DomainManager::Impl::unknown_components() {
+std::vector<app_ops::UnknownComponent> DomainManager::Impl::unknown_components() {
   std::lock_guard lock(unknown_mutex);
-  Json list = Json::array();
+  std::vector<app_ops::UnknownComponent> list;
   for (const auto &[address, u] : unknown)
-    list.push_back({{"address", address},
-                    {"application", u.announcement.value("application", "")},
-                    {"component", u.announcement.value("id", "")},
-                    {"pid", u.announcement.value("pid", 0)}});
+    list.push_back({address, u.announcement.value("application", ""),
+                    u.announcement.value("id", ""), u.announcement.value("pid", 0)});
   return list;
 }
 
@@ -279,52 +326,46 @@ CallResult<ResolvedEnd> DomainManager::Impl::resolve_device_end(const PortRef &r
                              fmt::format("{} is not a {} port", ref.to_string(), wanted));
 }
 
-CallResult<Json> DomainManager::Impl::list_nodes() {
-  Json list = Json::array();
+CallResult<domain_ops::NodesReply> DomainManager::Impl::list_nodes() {
+  domain_ops::NodesReply reply;
   for (const auto &node : nodes.snapshot())
-    list.push_back({{"name", node.announcement.node},
-                    {"address", node.address},
-                    {"pid", node.announcement.pid},
-                    {"devices", node.announcement.devices.size()}});
-  return Json{{"nodes", list}};
+    reply.nodes.push_back({node.announcement.node, node.address, node.announcement.pid,
+                           node.announcement.devices.size()});
+  for (const auto &r : nodes.refused_nodes())
+    reply.refused.push_back({excerpt(r.address), r.why});
+  return reply;
 }
 
-CallResult<Json> DomainManager::Impl::list_devices() {
-  return Json{{"devices", allocator::to_json(allocator.snapshot())}};
+CallResult<domain_ops::DevicesReply> DomainManager::Impl::list_devices() {
+  return domain_ops::DevicesReply{allocator::to_json(allocator.snapshot())};
 }
 
-CallResult<Json> DomainManager::Impl::list_channels() {
-  Json list = Json::array();
+CallResult<connection_ops::ChannelsReply> DomainManager::Impl::list_channels() {
+  connection_ops::ChannelsReply reply;
   for (const auto &c : channels->list())
-    list.push_back(to_json(c));
-  return Json{{"channels", list}};
+    reply.channels.push_back(view_of(c));
+  return reply;
 }
 
-CallResult<Json> DomainManager::Impl::create_channel(const Json &body) {
-  auto name = required<std::string>(body, "name");
-  if (!name)
-    return tl::unexpected(name.error());
-  auto channel = channels->create(*name);
-  if (!channel)
-    return tl::unexpected(channel.error());
-  return to_json(*channel);
+CallResult<connection_ops::ChannelView>
+DomainManager::Impl::create_channel(const domain_ops::Named &request) {
+  return channels->create(request.name).map([](const EventChannel &c) { return view_of(c); });
 }
 
-CallResult<Json> DomainManager::Impl::destroy_channel(const Json &body) {
-  auto name = required<std::string>(body, "name");
-  if (!name)
-    return tl::unexpected(name.error());
-  if (auto ok = channels->destroy(*name); !ok)
+CallResult<domain_ops::Named>
+DomainManager::Impl::destroy_channel(const domain_ops::Named &request) {
+  if (auto ok = channels->destroy(request.name); !ok)
     return tl::unexpected(ok.error());
-  return Json{{"name", *name}};
+  return request;
 }
 
 // Every connection of the running applications (or of one), with its live state as its
 // components report it: matched or not, samples through it. The domain answers with what it
 // knows: one status call to every live owner at once, bounded below the CLI's own wait; an end
 // whose owner exited or does not answer shows no state.
-CallResult<Json> DomainManager::Impl::list_connections(const Json &body) {
-  const std::string only = body.value("app", "");
+CallResult<connection_ops::ListReply>
+DomainManager::Impl::list_connections(const connection_ops::ListRequest &request) {
+  const std::string &only = request.app;
   std::vector<Application> apps = applications.snapshots();
   std::erase_if(apps, [&](const Application &a) { return !only.empty() && a.name != only; });
   if (!only.empty() && apps.empty())
@@ -348,57 +389,47 @@ CallResult<Json> DomainManager::Impl::list_connections(const Json &body) {
   for (std::size_t i = 0; i < calls.size(); ++i)
     if (auto status = control::reply_of<protocol::component::Status>(statuses[i]))
       status_of[calls[i].target] = std::move(*status);
-  Json list = Json::array();
+  connection_ops::ListReply reply;
   for (const auto &app : apps)
     for (const auto &c : app.connections)
-      list.push_back(connection_json(app, c, status_of));
-  for (const auto &c : runtime) {
-    Json entry = to_json(c);
-    entry["application"] = "(runtime)";
-    entry["uses_state"] =
-        c.connected() ? end_state(status_of, c.uses_end.address, c.uses_end.port, c.id) : nullptr;
-    entry["provides_state"] =
-        c.connected() ? end_state(status_of, c.provides_end.address, c.provides_end.port, c.id)
-                      : nullptr;
-    list.push_back(std::move(entry));
-  }
-  return Json{{"connections", list}};
+      reply.connections.push_back(listed(app, c, status_of));
+  for (const auto &c : runtime)
+    reply.connections.push_back(listed(c, status_of));
+  return reply;
 }
 
-CallResult<RuntimeConnection> DomainManager::Impl::make_connection(const Json &body) {
-  auto uses = port_ref(body, "uses");
+CallResult<RuntimeConnection>
+DomainManager::Impl::make_connection(const connection_ops::CreateRequest &request) {
+  auto uses = port_ref(request.uses, "uses");
   if (!uses)
     return tl::unexpected(uses.error());
-  auto provides = port_ref(body, "provides");
+  auto provides = port_ref(request.provides, "provides");
   if (!provides)
     return tl::unexpected(provides.error());
-  return runtime_connections->connect({*uses, *provides, body.value("id", ""),
-                                       body.value("qos", Json::object()),
-                                       body.value("filter", "")});
+  return runtime_connections->connect(
+      {*uses, *provides, request.id.value_or(""), request.qos, request.filter.value_or("")});
 }
 
 // A runtime connection lasts until `rsca disconnect`, also over a restart of the domain daemon:
 // it is kept in the domain's store as its request.
-CallResult<Json> DomainManager::Impl::create_connection(const Json &body) {
+CallResult<connection_ops::CreateReply>
+DomainManager::Impl::create_connection(const connection_ops::CreateRequest &request) {
   // Made and kept as one step, so that a disconnect of the same id cannot come in between.
   std::lock_guard kept_lock(kept_connections);
-  auto made = make_connection(body);
+  auto made = make_connection(request);
   if (!made)
     return tl::unexpected(made.error());
   // The request as given (the QoS asked for, not today's defaults), with the id it got.
-  Json request{{"format", 1},
-               {"id", made->id},
-               {"uses", body.at("uses")},
-               {"provides", body.at("provides")},
-               {"qos", body.value("qos", Json::object())}};
-  if (!made->filter.empty())
-    request["filter"] = made->filter;
-  Json reply = to_json(*made);
-  reply["persisted"] = true;
-  if (auto kept = store->put_connection({made->id, request.dump()}); !kept) {
+  connection_ops::CreateRequest kept_as = request;
+  kept_as.id = made->id;
+  Json record = protocol::encode(kept_as);
+  record["format"] = 1;
+  connection_ops::CreateReply reply{view_of(*made), state_of(*made), waiting_for(*made), true,
+                                    filter_of(*made)};
+  if (auto kept = store->put_connection({made->id, record.dump()}); !kept) {
     spdlog::warn("runtime connection {} will not outlast a restart of the domain daemon: {}",
                  made->id, kept.error().to_string());
-    reply["persisted"] = false;
+    reply.persisted = false;
   }
   return reply;
 }
@@ -411,11 +442,8 @@ void DomainManager::Impl::restore_connections() {
     return;
   }
   for (const auto &r : *records) {
-    const Json request = Json::parse(r.request, nullptr, /*allow_exceptions=*/false);
-    auto made = !request.is_object() ? control::call_error(Status::BadRequest, "not JSON")
-                : request.value("format", 0) != 1
-                    ? control::call_error(Status::BadRequest, "kept in another format")
-                    : make_connection(request);
+    auto request = kept_request(r.request);
+    auto made = request ? make_connection(*request) : tl::unexpected(request.error());
     if (!made) {
       spdlog::warn("runtime connection {} not restored ({}); `rsca disconnect {}` forgets it", r.id,
                    made.error().message, r.id);
@@ -426,20 +454,19 @@ void DomainManager::Impl::restore_connections() {
   }
 }
 
-CallResult<Json> DomainManager::Impl::destroy_connection(const Json &body) {
-  auto id = required<std::string>(body, "id");
-  if (!id)
-    return tl::unexpected(id.error());
+CallResult<connection_ops::ConnectionId>
+DomainManager::Impl::destroy_connection(const connection_ops::ConnectionId &request) {
+  const std::string &id = request.id;
   std::lock_guard kept_lock(kept_connections);
   // Forgotten also when not made now: a kept request that no longer restores is removed so.
-  auto forgotten = store->remove_connection(*id);
+  auto forgotten = store->remove_connection(id);
   if (!forgotten)
     spdlog::warn("runtime connection {}: it may come back after a restart of the domain daemon: "
                  "{}",
-                 *id, forgotten.error().to_string());
-  if (auto ok = runtime_connections->disconnect(*id); !ok)
+                 id, forgotten.error().to_string());
+  if (auto ok = runtime_connections->disconnect(id); !ok)
     return tl::unexpected(ok.error());
-  return Json{{"id", *id}};
+  return request;
 }
 
 } // namespace rsca::domain

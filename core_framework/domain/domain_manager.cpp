@@ -4,7 +4,9 @@
 #include "domain/domain_manager.hpp"
 
 #include <algorithm>
+#include <functional>
 #include <sstream>
+#include <type_traits>
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -26,55 +28,53 @@ namespace fs = std::filesystem;
 using control::Json;
 using control::Status;
 
-Json steps_json(const std::vector<LaunchStep> &steps) {
-  Json out = Json::array();
+std::vector<app_ops::StepView> steps_of(const std::vector<LaunchStep> &steps) {
+  std::vector<app_ops::StepView> out;
   for (const auto &s : steps)
-    out.push_back({{"step", s.step}, {"detail", s.detail}, {"ms", s.milliseconds}});
+    out.push_back({s.step, s.detail, s.milliseconds});
   return out;
 }
 
-CallResult<InstallRequest> install_request_of(const Json &body) {
-  auto sad = required<std::string>(body, "sad");
-  auto files = required<std::vector<Json>>(body, "files");
-  auto name = optional_field<std::string>(body, "name");
-  if (!sad || !files || !name)
-    return tl::unexpected(!sad ? sad.error() : !files ? files.error() : name.error());
-  InstallRequest request{*sad, {}, *name};
-  for (const auto &f : *files) {
-    auto path = required<std::string>(f, "path");
-    auto content = required<std::string>(f, "content");
-    if (!path || !content)
-      return tl::unexpected(path ? content.error() : path.error());
-    request.files.push_back({std::move(*path), std::move(*content)});
-  }
+InstallRequest install_request_of(const domain_ops::InstallRequest &wire) {
+  InstallRequest request{wire.sad, {}, wire.name};
+  for (const auto &f : wire.files)
+    request.files.push_back({f.path, f.content});
   return request;
 }
 
-// The assignments and strategy a launch or plan request gives.
-CallResult<std::pair<std::map<std::string, std::string>, std::optional<allocator::Strategy>>>
-placement_options(const Json &body) {
-  auto assign = optional_field<std::map<std::string, std::string>>(body, "assign");
-  auto strategy_name = optional_field<std::string>(body, "strategy");
-  if (!assign || !strategy_name)
-    return tl::unexpected(assign ? strategy_name.error() : assign.error());
-  std::optional<allocator::Strategy> strategy;
-  if (*strategy_name) {
-    strategy = allocator::parse_strategy(**strategy_name);
-    if (!strategy)
-      return control::call_error(Status::BadRequest,
-                                 fmt::format("unknown placement strategy \"{}\": pack or spread",
-                                             excerpt(**strategy_name)));
-  }
-  return std::pair{assign->value_or(std::map<std::string, std::string>{}), strategy};
+// The strategy a launch or plan request names, if any.
+CallResult<std::optional<allocator::Strategy>> strategy_of(const std::optional<std::string> &name) {
+  if (!name)
+    return std::nullopt;
+  auto strategy = allocator::parse_strategy(*name);
+  if (!strategy)
+    return control::call_error(
+        Status::BadRequest,
+        fmt::format("unknown placement strategy \"{}\": pack or spread", excerpt(*name)));
+  return strategy;
 }
 
 // The domain answered, so a peer that did not (a component) is a failure of the operation, not
 // an unreachable domain: the CLI tells the two apart by status.
-CallResult<Json> as_domain_reply(CallResult<Json> result) {
+template <typename Reply>
+CallResult<Reply> as_domain_reply(CallResult<Reply> result) {
   if (!result &&
       (result.error().status == Status::Unavailable || result.error().status == Status::Timeout))
     result.error().status = Status::Failed;
   return result;
+}
+
+// A running application as replies show it: its components and connections as application.cpp
+// makes them (to_json), the rest typed.
+app_ops::ApplicationView view_of(const Application &app) {
+  Json parts = to_json(app);
+  return {app.name,
+          app.installed,
+          app.sad,
+          state_of(app),
+          exited_components(app),
+          std::move(parts["components"]),
+          std::move(parts["connections"])};
 }
 
 } // namespace
@@ -106,83 +106,72 @@ ApplicationFactory::ApplyChange DomainManager::Impl::apply_to(const std::string 
   };
 }
 
-CallResult<Json> DomainManager::Impl::install(const Json &body) {
-  auto request = install_request_of(body);
-  if (!request)
-    return tl::unexpected(request.error());
-  auto installed = repository->install(*request);
+CallResult<domain_ops::InstallReply>
+DomainManager::Impl::install(const domain_ops::InstallRequest &request) {
+  auto installed = repository->install(install_request_of(request));
   if (!installed)
     return tl::unexpected(installed.error());
-  spdlog::info("installed application {} ({} files)", installed->name, request->files.size());
-  Json warnings = Json::array();
+  spdlog::info("installed application {} ({} files)", installed->name, request.files.size());
+  domain_ops::InstallReply reply{installed->name, {}};
   for (const auto &w : installed->profile->warnings)
-    warnings.push_back(to_string(w));
-  return Json{{"name", installed->name}, {"warnings", warnings}};
+    reply.warnings.push_back(to_string(w));
+  return reply;
 }
 
-CallResult<Json> DomainManager::Impl::uninstall(const Json &body) {
-  auto name = required<std::string>(body, "name");
-  if (!name)
-    return tl::unexpected(name.error());
+CallResult<domain_ops::Named> DomainManager::Impl::uninstall(const domain_ops::Named &request) {
+  const std::string &name = request.name;
   std::lock_guard lock(installs);
   // Its launch would run from files that are gone, and come back after a restart of the domain.
-  if (applications.launching(*name))
+  if (applications.launching(name))
     return control::call_error(
         Status::Rejected,
-        fmt::format("a launch of {} is under way: uninstall it once the launch has ended", *name));
-  if (auto removed = repository->uninstall(*name); !removed)
+        fmt::format("a launch of {} is under way: uninstall it once the launch has ended", name));
+  if (auto removed = repository->uninstall(name); !removed)
     return tl::unexpected(removed.error());
-  for (const auto &running : applications.running_from(*name))
-    spdlog::info("{} stays running after uninstalling {}", running, *name);
-  spdlog::info("uninstalled application {}", *name);
-  return Json{{"name", *name}};
+  for (const auto &running : applications.running_from(name))
+    spdlog::info("{} stays running after uninstalling {}", running, name);
+  spdlog::info("uninstalled application {}", name);
+  return request;
 }
 
-CallResult<Json> DomainManager::Impl::list_installed() {
-  Json list = Json::array();
+CallResult<domain_ops::InstalledReply> DomainManager::Impl::list_installed() {
+  domain_ops::InstalledReply reply;
   for (const auto &app : repository->list()) {
     std::size_t count = 0;
     for (const auto &p : app.profile->sad->placements)
       count += p.instantiations.size();
-    list.push_back({{"name", app.name}, {"sad", app.sad.string()}, {"components", count}});
+    reply.applications.push_back({app.name, app.sad.string(), count});
   }
-  return Json{{"applications", list}};
+  return reply;
 }
 
-CallResult<Json> DomainManager::Impl::create_application(const Json &body) {
-  auto installed_name = required<std::string>(body, "application");
-  auto wanted = optional_field<std::string>(body, "name");
-  auto launch_id = optional_field<std::string>(body, "launch_id");
-  auto start = optional_field<bool>(body, "start");
-  auto placement = placement_options(body);
-  if (!installed_name || !wanted || !launch_id || !start || !placement)
-    return control::call_error(Status::BadRequest, (!installed_name ? installed_name.error()
-                                                    : !wanted       ? wanted.error()
-                                                    : !launch_id    ? launch_id.error()
-                                                    : !start        ? start.error()
-                                                                    : placement.error())
-                                                       .message);
-  if (*wanted)
-    if (auto named = check_name("the application", **wanted); !named)
+CallResult<app_ops::CreateReply>
+DomainManager::Impl::create_application(const app_ops::CreateRequest &wire) {
+  if (wire.name)
+    if (auto named = check_name("the application", *wire.name); !named)
       return control::call_error(Status::BadRequest, named.error());
+  auto strategy = strategy_of(wire.strategy);
+  if (!strategy)
+    return tl::unexpected(strategy.error());
   LaunchRequest request;
   {
     std::lock_guard lock(installs);
-    auto installed = repository->find(*installed_name);
+    auto installed = repository->find(wire.application);
     if (!installed)
       return control::call_error(Status::NotFound, fmt::format("no application {} is installed",
-                                                               excerpt(*installed_name)));
-    auto name = applications.reserve(wanted->value_or(*installed_name), wanted->has_value(),
-                                     *installed_name);
+                                                               excerpt(wire.application)));
+    auto name = applications.reserve(wire.name.value_or(wire.application), wire.name.has_value(),
+                                     wire.application);
     if (!name)
       return tl::unexpected(name.error());
     request.name = *name;
-    request.installed = *installed_name;
+    request.installed = wire.application;
     request.profile = installed->profile;
   }
-  request.start = start->value_or(true);
-  std::tie(request.assignments, request.strategy) = *placement;
-  const std::string id = launch_id->value_or(request.name);
+  request.start = wire.start;
+  request.assignments = wire.assign;
+  request.strategy = *strategy;
+  const std::string id = wire.launch_id.value_or(request.name);
   const auto began = std::chrono::steady_clock::now();
   std::vector<LaunchStep> steps;
   auto app = launch(request, id, steps);
@@ -198,10 +187,9 @@ CallResult<Json> DomainManager::Impl::create_application(const Json &body) {
   events->publish("application.created", {{"application", request.name},
                                           {"installed", request.installed},
                                           {"components", (*app)->components.size()}});
-  Json reply = to_json(**app);
+  app_ops::CreateReply reply{view_of(**app), {steps_of(steps), ms_since(began)}};
   applications.commit(*app);
   runtime_connections->endpoints_changed(); // connections waiting for it
-  reply["launch"] = {{"steps", steps_json(steps)}, {"ms", ms_since(began)}};
   return reply;
 }
 
@@ -236,174 +224,155 @@ DomainManager::Impl::launch(LaunchRequest &request, const std::string &launch_id
       fmt::format("launch of {} cancelled after its last step; released", request.name));
 }
 
-CallResult<Json> DomainManager::Impl::progress(const Json &body) {
-  auto id = required<std::string>(body, "launch_id");
-  if (!id)
-    return tl::unexpected(id.error());
-  auto progress = launches.progress(*id);
+CallResult<app_ops::ProgressReply> DomainManager::Impl::progress(const app_ops::LaunchId &request) {
+  auto progress = launches.progress(request.launch_id);
   if (!progress)
-    return control::call_error(Status::NotFound, fmt::format("no launch {}", excerpt(*id)));
-  return Json{{"steps", steps_json(progress->steps)}, {"done", progress->done}};
+    return control::call_error(Status::NotFound,
+                               fmt::format("no launch {}", excerpt(request.launch_id)));
+  return app_ops::ProgressReply{steps_of(progress->steps), progress->done};
 }
 
 // A caller that stops waiting for its launch (the CLI's own deadline) cancels it, so that no
 // application it gave up on appears later: the launch rolls back at its next step, or at once
 // when it is waiting for registrations. A cancel that overtook its create is kept: that launch
 // never begins.
-CallResult<Json> DomainManager::Impl::cancel_launch(const Json &body) {
-  auto id = required<std::string>(body, "launch_id");
-  if (!id)
-    return tl::unexpected(id.error());
-  const auto outcome = launches.cancel(*id);
+CallResult<app_ops::CancelReply>
+DomainManager::Impl::cancel_launch(const app_ops::LaunchId &request) {
+  const std::string &id = request.launch_id;
+  const auto outcome = launches.cancel(id);
   if (!outcome.cancelled)
-    return Json{{"cancelled", false}, {"done", true}};
+    return app_ops::CancelReply{false, true, std::nullopt};
   if (!outcome.begun) {
-    spdlog::info("launch {} cancelled by its caller before it began", *id);
-    return Json{{"cancelled", true}, {"done", false}, {"begun", false}};
+    spdlog::info("launch {} cancelled by its caller before it began", id);
+    return app_ops::CancelReply{true, false, false};
   }
-  spdlog::info("launch {} cancelled by its caller", *id);
+  spdlog::info("launch {} cancelled by its caller", id);
   components.interrupt();
-  return Json{{"cancelled", true}, {"done", false}, {"begun", true}};
+  return app_ops::CancelReply{true, false, true};
 }
 
-CallResult<Json> DomainManager::Impl::release(const Json &body) {
-  auto name = required<std::string>(body, "app");
-  if (!name)
-    return tl::unexpected(name.error());
-  auto found = applications.find(*name);
+CallResult<app_ops::ReleaseReply> DomainManager::Impl::release(const app_ops::AppRequest &request) {
+  const std::string &name = request.app;
+  auto found = applications.find(name);
   if (!found)
     return tl::unexpected(found.error());
   std::lock_guard lifecycle(*found->lifecycle); // a start or stop under way ends first
-  auto removed = applications.remove(*name);
+  auto removed = applications.remove(name);
   if (!removed)
     return control::call_error(Status::NotFound, fmt::format("application {} was released "
                                                              "meanwhile",
-                                                             *name));
+                                                             name));
   // Its runtime connections wait for it again; their other ends are disconnected. Only now that
   // it can no longer be found: a retry of pending connections in between would wire them to it.
   runtime_connections->owner_gone([&name](const PortRef &ref) {
-    return ref.kind != PortRef::Kind::Device && ref.owner == *name;
+    return ref.kind != PortRef::Kind::Device && ref.owner == name;
   });
   auto unconfirmed = factory().release(*removed->app);
-  spdlog::info("application {} released", *name);
-  events->publish("application.released", {{"application", *name}});
+  spdlog::info("application {} released", name);
+  events->publish("application.released", {{"application", name}});
   if (!unconfirmed)
     return control::call_error(
         unconfirmed.error().status,
-        fmt::format("released {} with problems: {}", *name, unconfirmed.error().message));
-  return Json{{"name", *name}, {"unconfirmed", *unconfirmed}};
+        fmt::format("released {} with problems: {}", name, unconfirmed.error().message));
+  return app_ops::ReleaseReply{name, std::move(*unconfirmed)};
 }
 
 // Start and stop of one application are serialized (its lifecycle lock) and work from a copy;
 // its state changes only through the registry.
-CallResult<Json> DomainManager::Impl::start_or_stop(const Json &body, bool start) {
-  auto name = required<std::string>(body, "app");
-  if (!name)
-    return tl::unexpected(name.error());
-  auto found = applications.find(*name);
+CallResult<app_ops::ApplicationView>
+DomainManager::Impl::start_or_stop(const app_ops::AppRequest &request, bool start) {
+  const std::string &name = request.app;
+  auto found = applications.find(name);
   if (!found)
     return tl::unexpected(found.error());
   std::lock_guard lifecycle(*found->lifecycle);
-  auto app = applications.snapshot(*name);
+  auto app = applications.snapshot(name);
   if (!app)
     return control::call_error(Status::NotFound,
-                               fmt::format("application {} was released meanwhile", *name));
-  auto done =
-      start ? factory().start(*app, apply_to(*name)) : factory().stop(*app, apply_to(*name));
+                               fmt::format("application {} was released meanwhile", name));
+  auto done = start ? factory().start(*app, apply_to(name)) : factory().stop(*app, apply_to(name));
   if (!done)
     return tl::unexpected(done.error());
-  auto now = applications.snapshot(*name);
-  return now ? to_json(*now) : Json{{"name", *name}};
+  // A release waits for the lifecycle lock held here: the application is still there.
+  auto now = applications.snapshot(name);
+  return view_of(now ? *now : *app);
 }
 
-CallResult<Json> DomainManager::Impl::list_applications() {
-  Json list = Json::array();
+CallResult<app_ops::ListReply> DomainManager::Impl::list_applications() {
+  app_ops::ListReply reply;
   for (const auto &app : applications.snapshots())
-    list.push_back({{"name", app.name},
-                    {"installed", app.installed},
-                    {"state", state_of(app)},
-                    {"exited", exited_components(app)},
-                    {"components", app.components.size()}});
-  return Json{{"applications", list}, {"unknown", unknown_components()}};
+    reply.applications.push_back(
+        {app.name, app.installed, state_of(app), exited_components(app), app.components.size()});
+  reply.unknown = unknown_components();
+  return reply;
 }
 
-CallResult<Json> DomainManager::Impl::show_application(const Json &body) {
-  auto name = required<std::string>(body, "app");
-  if (!name)
-    return tl::unexpected(name.error());
-  auto app = applications.snapshot(*name);
+CallResult<app_ops::ApplicationView>
+DomainManager::Impl::show_application(const app_ops::AppRequest &request) {
+  auto app = applications.snapshot(request.app);
   if (!app)
     return control::call_error(Status::NotFound,
-                               fmt::format("no application {} is running", excerpt(*name)));
-  return to_json(*app);
+                               fmt::format("no application {} is running", excerpt(request.app)));
+  return view_of(*app);
 }
 
 // Admission and placement of an installed application on the domain as it is, reserving nothing.
-CallResult<Json> DomainManager::Impl::plan_application(const Json &body) {
-  auto name = required<std::string>(body, "application");
-  if (!name)
-    return tl::unexpected(name.error());
-  auto placement = placement_options(body);
-  if (!placement)
-    return tl::unexpected(placement.error());
-  auto installed = repository->find(*name);
+CallResult<app_ops::PlanReply>
+DomainManager::Impl::plan_application(const app_ops::PlanRequest &request) {
+  auto strategy = strategy_of(request.strategy);
+  if (!strategy)
+    return tl::unexpected(strategy.error());
+  auto installed = repository->find(request.application);
   if (!installed)
-    return control::call_error(Status::NotFound,
-                               fmt::format("no application {} is installed", excerpt(*name)));
-  const allocator::PlanOptions plan_options{placement->second.value_or(options.strategy)};
-  auto plan = allocator.plan(allocator::plan_request_of(*installed->profile, placement->first),
-                             plan_options);
-  const std::string strategy(to_string(plan_options.strategy));
-  if (!plan)
-    return Json{{"admitted", false},
-                {"rejections", allocator::to_json(plan.error())},
-                {"strategy", strategy}};
-  return Json{{"admitted", true}, {"plan", allocator::to_json(*plan)}, {"strategy", strategy}};
+    return control::call_error(Status::NotFound, fmt::format("no application {} is installed",
+                                                             excerpt(request.application)));
+  const allocator::PlanOptions plan_options{strategy->value_or(options.strategy)};
+  auto plan =
+      allocator.plan(allocator::plan_request_of(*installed->profile, request.assign), plan_options);
+  return allocator::plan_reply(plan, plan_options.strategy);
+}
+
+template <control::Operation Op, typename Handler>
+void DomainManager::Impl::serve_op(Handler handler) {
+  using Request = typename Op::Request;
+  control::serve<Op>(*endpoint, [this, handler]([[maybe_unused]] const Request &request,
+                                                const control::RequestContext &) {
+    if constexpr (std::is_invocable_v<Handler, Impl *, const Request &>)
+      return as_domain_reply(std::invoke(handler, this, request));
+    else
+      return as_domain_reply(std::invoke(handler, this));
+  });
 }
 
 void DomainManager::Impl::serve() {
-  // Every handler's reply passes as_domain_reply; a field of the wrong type is a BadRequest
-  // (required, optional_field) or, where read with a default, caught by the endpoint.
-  auto bind = [this](const char *op, auto method) {
-    endpoint->on(op, [this, method](const Json &body, const control::RequestContext &) {
-      return as_domain_reply((this->*method)(body));
-    });
-  };
-  auto bind0 = [this](const char *op, auto method) {
-    endpoint->on(op, [this, method](const Json &, const control::RequestContext &) {
-      return as_domain_reply((this->*method)());
-    });
-  };
-  bind("domain.install", &Impl::install);
-  bind("domain.uninstall", &Impl::uninstall);
-  bind0("domain.installed", &Impl::list_installed);
-  bind0("domain.nodes", &Impl::list_nodes);
-  bind0("domain.devices", &Impl::list_devices);
-  control::serve<protocol::domain::ComponentExited>(
+  serve_op<domain_ops::Install>(&Impl::install);
+  serve_op<domain_ops::Uninstall>(&Impl::uninstall);
+  serve_op<domain_ops::Installed>(&Impl::list_installed);
+  serve_op<domain_ops::Nodes>(&Impl::list_nodes);
+  serve_op<domain_ops::Devices>(&Impl::list_devices);
+  control::serve<domain_ops::ComponentExited>(
       *endpoint, [this](const auto &report, const auto &) { return component_exited(report); });
-  control::serve<protocol::domain::ConnectionProblem>(
+  control::serve<domain_ops::ConnectionProblem>(
       *endpoint, [this](const auto &report, const auto &) { return connection_problem(report); });
-  bind("app.create", &Impl::create_application);
-  bind("app.plan", &Impl::plan_application);
-  bind0("channel.list", &Impl::list_channels);
-  bind("channel.create", &Impl::create_channel);
-  bind("channel.destroy", &Impl::destroy_channel);
-  bind("connection.list", &Impl::list_connections);
-  bind("connection.create", &Impl::create_connection);
-  bind("connection.destroy", &Impl::destroy_connection);
-  bind("app.progress", &Impl::progress);
-  bind("app.cancel", &Impl::cancel_launch);
-  bind("app.release", &Impl::release);
-  bind("app.configure", &Impl::configure);
-  bind("app.query", &Impl::query);
-  bind0("app.list", &Impl::list_applications);
-  bind("app.show", &Impl::show_application);
-  endpoint->on("app.start", [this](const Json &body, const control::RequestContext &) {
-    return as_domain_reply(start_or_stop(body, true));
-  });
-  endpoint->on("app.stop", [this](const Json &body, const control::RequestContext &) {
-    return as_domain_reply(start_or_stop(body, false));
-  });
+  serve_op<app_ops::Create>(&Impl::create_application);
+  serve_op<app_ops::Plan>(&Impl::plan_application);
+  serve_op<app_ops::Progress>(&Impl::progress);
+  serve_op<app_ops::Cancel>(&Impl::cancel_launch);
+  serve_op<app_ops::Release>(&Impl::release);
+  serve_op<app_ops::Start>(
+      [](Impl *impl, const app_ops::AppRequest &r) { return impl->start_or_stop(r, true); });
+  serve_op<app_ops::Stop>(
+      [](Impl *impl, const app_ops::AppRequest &r) { return impl->start_or_stop(r, false); });
+  serve_op<app_ops::Configure>(&Impl::configure);
+  serve_op<app_ops::Query>(&Impl::query);
+  serve_op<app_ops::List>(&Impl::list_applications);
+  serve_op<app_ops::Show>(&Impl::show_application);
+  serve_op<connection_ops::ListChannels>(&Impl::list_channels);
+  serve_op<connection_ops::CreateChannel>(&Impl::create_channel);
+  serve_op<connection_ops::DestroyChannel>(&Impl::destroy_channel);
+  serve_op<connection_ops::List>(&Impl::list_connections);
+  serve_op<connection_ops::Create>(&Impl::create_connection);
+  serve_op<connection_ops::Destroy>(&Impl::destroy_connection);
 }
 
 DomainManager::DomainManager(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}

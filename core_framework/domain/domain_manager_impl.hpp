@@ -13,21 +13,26 @@
 #include <optional>
 #include <set>
 #include <string>
-
-#include <fmt/format.h>
+#include <vector>
 
 #include "control/domain_events.hpp"
+#include "control/operation.hpp"
 #include "domain/application_registry.hpp"
 #include "domain/connection_manager.hpp"
 #include "domain/domain_manager.hpp"
 #include "domain/installed_repository.hpp"
 #include "domain/launch_tracker.hpp"
 #include "domain/node_directory.hpp"
+#include "protocol/application_ops.hpp"
+#include "protocol/connection_ops.hpp"
 #include "protocol/domain_ops.hpp"
 
 namespace rsca::domain {
 
 using control::CallResult;
+namespace app_ops = protocol::application;
+namespace connection_ops = protocol::connection;
+namespace domain_ops = protocol::domain;
 
 // A component process found running that no application of this domain daemon launched: left by
 // a domain daemon that was killed, or by another domain on the same DDS domain and tag.
@@ -66,23 +71,25 @@ struct DomainManager::Impl {
   ApplicationFactory::ApplyChange apply_to(const std::string &name);
 
   // Installs and applications (domain_manager.cpp).
-  CallResult<control::Json> install(const control::Json &body);
-  CallResult<control::Json> uninstall(const control::Json &body);
-  CallResult<control::Json> list_installed();
-  CallResult<control::Json> create_application(const control::Json &body);
+  CallResult<domain_ops::InstallReply> install(const domain_ops::InstallRequest &request);
+  CallResult<domain_ops::Named> uninstall(const domain_ops::Named &request);
+  CallResult<domain_ops::InstalledReply> list_installed();
+  CallResult<app_ops::CreateReply> create_application(const app_ops::CreateRequest &request);
   CallResult<std::shared_ptr<Application>>
   launch(LaunchRequest &request, const std::string &launch_id, std::vector<LaunchStep> &steps);
-  CallResult<control::Json> progress(const control::Json &body);
-  CallResult<control::Json> cancel_launch(const control::Json &body);
-  CallResult<control::Json> release(const control::Json &body);
-  CallResult<control::Json> start_or_stop(const control::Json &body, bool start);
-  CallResult<control::Json> configure(const control::Json &body);
-  CallResult<control::Json> query(const control::Json &body);
-  CallResult<control::Json> configure_at(const std::string &address, control::Json properties);
-  CallResult<control::Json> query_at(const std::string &address, std::vector<std::string> ids);
-  CallResult<control::Json> list_applications();
-  CallResult<control::Json> show_application(const control::Json &body);
-  CallResult<control::Json> plan_application(const control::Json &body);
+  CallResult<app_ops::ProgressReply> progress(const app_ops::LaunchId &request);
+  CallResult<app_ops::CancelReply> cancel_launch(const app_ops::LaunchId &request);
+  CallResult<app_ops::ReleaseReply> release(const app_ops::AppRequest &request);
+  CallResult<app_ops::ApplicationView> start_or_stop(const app_ops::AppRequest &request,
+                                                     bool start);
+  CallResult<protocol::Empty> configure(const app_ops::ConfigureRequest &request);
+  CallResult<protocol::component::QueryReply> query(const app_ops::QueryRequest &request);
+  CallResult<protocol::Empty> configure_at(const std::string &address, control::Json properties);
+  CallResult<protocol::component::QueryReply> query_at(const std::string &address,
+                                                       std::vector<std::string> ids);
+  CallResult<app_ops::ListReply> list_applications();
+  CallResult<app_ops::ApplicationView> show_application(const app_ops::AppRequest &request);
+  CallResult<app_ops::PlanReply> plan_application(const app_ops::PlanRequest &request);
   CallResult<protocol::Empty> component_exited(const protocol::domain::ComponentExitedReport &r);
   CallResult<protocol::Empty>
   connection_problem(const protocol::domain::ConnectionProblemReport &r);
@@ -90,6 +97,10 @@ struct DomainManager::Impl {
   void mark_exited(const std::function<bool(const ComponentInstance &)> &which,
                    const std::string &why);
   void serve();
+  // Serves `Op` with `handler` (a method of the request, or of nothing); every reply passes
+  // as_domain_reply.
+  template <control::Operation Op, typename Handler>
+  void serve_op(Handler handler);
 
   // Nodes, devices, connections and channels (domain_connections.cpp).
   void on_announcement(const control::AnnouncementEvent &event);
@@ -101,42 +112,20 @@ struct DomainManager::Impl {
   CallResult<ResolvedEnd> resolve_component_end(const PortRef &ref,
                                                 profile::PortDirection direction);
   CallResult<ResolvedEnd> resolve_device_end(const PortRef &ref, profile::PortDirection direction);
-  CallResult<control::Json> list_nodes();
-  CallResult<control::Json> list_devices();
-  CallResult<control::Json> list_channels();
-  CallResult<control::Json> create_channel(const control::Json &body);
-  CallResult<control::Json> destroy_channel(const control::Json &body);
-  CallResult<control::Json> list_connections(const control::Json &body);
-  CallResult<control::Json> create_connection(const control::Json &body);
-  CallResult<control::Json> destroy_connection(const control::Json &body);
-  CallResult<RuntimeConnection> make_connection(const control::Json &body);
+  CallResult<domain_ops::NodesReply> list_nodes();
+  CallResult<domain_ops::DevicesReply> list_devices();
+  CallResult<connection_ops::ChannelsReply> list_channels();
+  CallResult<connection_ops::ChannelView> create_channel(const domain_ops::Named &request);
+  CallResult<domain_ops::Named> destroy_channel(const domain_ops::Named &request);
+  CallResult<connection_ops::ListReply>
+  list_connections(const connection_ops::ListRequest &request);
+  CallResult<connection_ops::CreateReply>
+  create_connection(const connection_ops::CreateRequest &request);
+  CallResult<connection_ops::ConnectionId>
+  destroy_connection(const connection_ops::ConnectionId &request);
+  CallResult<RuntimeConnection> make_connection(const connection_ops::CreateRequest &request);
   void restore_connections();
-  control::Json unknown_components();
+  std::vector<app_ops::UnknownComponent> unknown_components();
 };
-
-// A required field of a request, typed; a clear BadRequest when it is missing or of another type.
-template <typename T>
-control::CallResult<T> required(const control::Json &body, const char *key) {
-  if (!body.contains(key))
-    return control::call_error(control::Status::BadRequest,
-                               fmt::format("the request has no \"{}\"", key));
-  try {
-    return body.at(key).get<T>();
-  } catch (const control::Json::exception &) {
-    return control::call_error(control::Status::BadRequest,
-                               fmt::format("\"{}\" has the wrong type", key));
-  }
-}
-
-// A field that may be absent; of the wrong type it is a BadRequest.
-template <typename T>
-control::CallResult<std::optional<T>> optional_field(const control::Json &body, const char *key) {
-  if (!body.contains(key))
-    return std::optional<T>();
-  auto value = required<T>(body, key);
-  if (!value)
-    return tl::unexpected(value.error());
-  return std::optional<T>(std::move(*value));
-}
 
 } // namespace rsca::domain

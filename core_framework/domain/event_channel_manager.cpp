@@ -135,22 +135,4 @@ std::optional<EventChannel> EventChannelManager::find(const std::string &name) c
   return std::nullopt;
 }
 
-nlohmann::json to_json(const EventChannel &channel) {
-  nlohmann::json members = nlohmann::json::array();
-  std::size_t publishers = 0;
-  for (const auto &m : channel.members) {
-    publishers += m.role == Role::Publisher ? 1 : 0;
-    members.push_back({{"role", to_string(m.role)},
-                       {"application", m.application},
-                       {"connection", m.connection},
-                       {"component", m.component},
-                       {"port", m.port},
-                       {"filter", m.filter}});
-  }
-  return {{"name", channel.name},     {"topic", channel.topic},
-          {"repid", channel.repid},   {"operator", channel.operator_owned},
-          {"publishers", publishers}, {"subscribers", channel.members.size() - publishers},
-          {"members", members}};
-}
-
 } // namespace rsca::domain

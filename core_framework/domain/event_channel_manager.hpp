@@ -72,6 +72,4 @@ private:
   std::vector<EventChannel> channels_; // in order of creation
 };
 
-nlohmann::json to_json(const EventChannel &channel);
-
 } // namespace rsca::domain

@@ -7,14 +7,36 @@ namespace rsca::domain {
 bool NodeDirectory::alive(const std::string &address,
                           protocol::node::NodeAnnouncement announcement) {
   std::lock_guard lock(mutex_);
+  refused_.erase(address); // it announced again, within the contract this time
   const std::string name = announcement.node;
   const bool known = nodes_.count(name) != 0;
   nodes_[name] = Node{address, std::move(announcement)};
   return !known;
 }
 
+bool NodeDirectory::refused(const std::string &address, std::string why) {
+  std::lock_guard lock(mutex_);
+  auto it = refused_.find(address);
+  if (it != refused_.end()) {
+    it->second = std::move(why);
+    return false;
+  }
+  if (refused_.size() < kMaxRefused)
+    refused_.emplace(address, std::move(why));
+  return true;
+}
+
+std::vector<NodeDirectory::Refused> NodeDirectory::refused_nodes() const {
+  std::lock_guard lock(mutex_);
+  std::vector<Refused> out;
+  for (const auto &[address, why] : refused_)
+    out.push_back({address, why});
+  return out;
+}
+
 std::optional<NodeDirectory::Node> NodeDirectory::gone(const std::string &address) {
   std::lock_guard lock(mutex_);
+  refused_.erase(address);
   auto it = std::find_if(nodes_.begin(), nodes_.end(),
                          [&](const auto &n) { return n.second.address == address; });
   if (it == nodes_.end())

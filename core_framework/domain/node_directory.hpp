@@ -20,8 +20,19 @@ public:
     protocol::node::NodeAnnouncement announcement; // announcement.node is its name
   };
 
+  // An endpoint that announced itself as a node with an announcement that does not fit the
+  // contract (another version of rsca, or not rsca at all): listed, never used.
+  struct Refused {
+    std::string address;
+    std::string why;
+  };
+  // At most this many are kept: the announcements come from the network.
+  static constexpr std::size_t kMaxRefused = 64;
+
   // Records what the node at `address` announced; true when the node is new.
   bool alive(const std::string &address, protocol::node::NodeAnnouncement announcement);
+  // Records that the node at `address` was refused, and why; false when it was already.
+  bool refused(const std::string &address, std::string why);
   // The node at `address` left: its record, now dropped; nothing for an address no node has.
   std::optional<Node> gone(const std::string &address);
 
@@ -30,12 +41,14 @@ public:
   // The device of that id ("NODE:LABEL").
   std::optional<protocol::node::DeviceRecord> device(const std::string &id) const;
   std::vector<Node> snapshot() const;
+  std::vector<Refused> refused_nodes() const;
 
 private:
   const protocol::node::DeviceRecord *find_device(const std::string &id) const;
 
   mutable std::mutex mutex_;
-  std::map<std::string, Node> nodes_; // by name
+  std::map<std::string, Node> nodes_;          // by name
+  std::map<std::string, std::string> refused_; // why, by address
 };
 
 } // namespace rsca::domain

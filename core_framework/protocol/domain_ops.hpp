@@ -1,8 +1,11 @@
-// The domain.* reports: what nodes and components tell the domain daemon without waiting for
-// its reply.
+// The domain.* operations: the reports nodes and components send the domain daemon without
+// waiting for its reply, and what the CLI asks of the domain as a whole (installs, nodes,
+// devices). Applications are in application_ops.hpp, connections and channels in
+// connection_ops.hpp.
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -55,6 +58,125 @@ struct ConnectionProblem {
   static constexpr std::string_view name = "domain.connection_problem";
   using Request = ConnectionProblemReport;
   using Reply = Empty;
+};
+
+// A request or reply that names one thing: an installed application, an event channel.
+struct Named {
+  std::string name;
+  static constexpr auto fields() { return std::tuple{required("name", &Named::name)}; }
+};
+
+// One file of an application, carried from the CLI (which may run on another host) with its
+// content.
+struct InstallFile {
+  std::string path; // relative to the SDR root the profiles came from
+  std::string content;
+  static constexpr auto fields() {
+    return std::tuple{required("path", &InstallFile::path),
+                      required("content", &InstallFile::content)};
+  }
+};
+
+struct InstallRequest {
+  std::string sad; // the SAD's path among the files
+  std::vector<InstallFile> files;
+  std::optional<std::string> name; // absent: the SAD's name
+  static constexpr auto fields() {
+    return std::tuple{required("sad", &InstallRequest::sad),
+                      required("files", &InstallRequest::files),
+                      optional("name", &InstallRequest::name)};
+  }
+};
+
+struct InstallReply {
+  std::string name;
+  std::vector<std::string> warnings; // what the profiles' checks found, as text
+  static constexpr auto fields() {
+    return std::tuple{required("name", &InstallReply::name),
+                      required("warnings", &InstallReply::warnings)};
+  }
+};
+
+struct InstalledApplication {
+  std::string name;
+  std::string sad;
+  std::uint64_t components = 0;
+  static constexpr auto fields() {
+    using R = InstalledApplication;
+    return std::tuple{required("name", &R::name), required("sad", &R::sad),
+                      required("components", &R::components)};
+  }
+};
+
+struct InstalledReply {
+  std::vector<InstalledApplication> applications;
+  static constexpr auto fields() {
+    return std::tuple{required("applications", &InstalledReply::applications)};
+  }
+};
+
+struct NodeSummary {
+  std::string name;
+  std::string address;
+  std::int64_t pid = 0;
+  std::uint64_t devices = 0;
+  static constexpr auto fields() {
+    using R = NodeSummary;
+    return std::tuple{required("name", &R::name), required("address", &R::address),
+                      required("pid", &R::pid), required("devices", &R::devices)};
+  }
+};
+
+// An endpoint that announced itself as a node in a form this domain does not take.
+struct RefusedNode {
+  std::string address;
+  std::string why;
+  static constexpr auto fields() {
+    return std::tuple{required("address", &RefusedNode::address),
+                      required("why", &RefusedNode::why)};
+  }
+};
+
+struct NodesReply {
+  std::vector<NodeSummary> nodes;
+  std::vector<RefusedNode> refused;
+  static constexpr auto fields() {
+    return std::tuple{required("nodes", &NodesReply::nodes),
+                      optional("refused", &NodesReply::refused)};
+  }
+};
+
+// Every device's capacities (total, allocated, free) and tasks per CPU, as
+// allocator/plan_json.hpp makes them: the allocator's view, free-form here.
+struct DevicesReply {
+  Json devices = Json::array();
+  static constexpr auto fields() { return std::tuple{required("devices", &DevicesReply::devices)}; }
+};
+
+struct Install {
+  static constexpr std::string_view name = "domain.install";
+  using Request = InstallRequest;
+  using Reply = InstallReply;
+};
+struct Uninstall {
+  static constexpr std::string_view name = "domain.uninstall";
+  using Request = Named;
+  using Reply = Named;
+};
+struct Installed {
+  static constexpr std::string_view name = "domain.installed";
+  using Request = Empty;
+  using Reply = InstalledReply;
+};
+struct Nodes {
+  static constexpr std::string_view name = "domain.nodes";
+  using Request = Empty;
+  using Reply = NodesReply;
+};
+struct Devices {
+  static constexpr std::string_view name = "domain.devices";
+  using Request = Empty;
+  using Reply = DevicesReply;
 };
 
 } // namespace rsca::protocol::domain

@@ -56,6 +56,13 @@ const Json &component(const Json &app, const std::string &id) {
   throw std::logic_error("unreachable");
 }
 
+void refused_as_bad_request(const rsca::control::CallResult<Json> &reply,
+                            const std::string &saying) {
+  REQUIRE_FALSE(reply.has_value());
+  CHECK(reply.error().status == Status::BadRequest);
+  CHECK_THAT(reply.error().message, Catch::Contains(saying));
+}
+
 } // namespace
 
 TEST_CASE("an application name that is a path never makes the domain act outside its repository",
@@ -138,6 +145,27 @@ TEST_CASE("uninstall while a launch of the application is under way is refused; 
   REQUIRE(installed.has_value());
   CHECK(installed->at("applications").empty());
   domain.require_clean({});
+}
+
+TEST_CASE("a request with a field the domain does not know is refused, naming the field, before "
+          "anything is done",
+          "[integration][hostile]") {
+  TestDomain domain;
+  domain.install("Healthy");
+  // A client's typo ("stratgy"): taken without it, the launch would run on the default strategy.
+  refused_as_bad_request(
+      domain.call("app.create", Json{{"application", "Healthy"}, {"stratgy", "spread"}}),
+      "app.create: unknown field \"stratgy\"");
+  auto apps = domain.call("app.list");
+  REQUIRE(apps.has_value());
+  CHECK(apps->at("applications").empty());
+  CHECK(domain.running_pids().empty());
+
+  refused_as_bad_request(
+      domain.call("app.show", Json{{"app", "Healthy"}, {"component", "Producer_1"}}),
+      "app.show: unknown field \"component\"");
+  refused_as_bad_request(domain.call("app.query", Json{{"app", "Healthy"}, {"ids", "received"}}),
+                         "app.query: field \"ids\": expected an array, found string");
 }
 
 TEST_CASE("a restarted domain daemon never collides with what a killed one left running, and "
@@ -274,4 +302,39 @@ TEST_CASE("a launch whose domain daemon dies says so within a lease, not after i
     return nodes && nodes->at("nodes").size() == 2;
   }));
   domain.require_clean(orphans);
+}
+
+TEST_CASE("a node announcement that does not fit the contract is refused and listed, never used",
+          "[integration][hostile]") {
+  TestDomain domain;
+  auto nodes = [&domain] {
+    auto listed = domain.call("domain.nodes");
+    REQUIRE(listed.has_value());
+    return *listed;
+  };
+  const auto before = nodes().at("nodes").size();
+  // Another endpoint on the domain's DDS domain claims to be a node, with its devices a string.
+  auto rogue = rsca::control::Endpoint::open(rsca::test::participant(), "rsca/node/rogue");
+  REQUIRE(rogue.has_value());
+  REQUIRE((*rogue)
+              ->announce("node",
+                         Json{{"node", "rogue"}, {"pid", 1}, {"host", "h"}, {"devices", "lots"}})
+              .has_value());
+  REQUIRE(TestDomain::wait_for([&] { return !nodes().value("refused", Json::array()).empty(); }));
+  const Json listed = nodes();
+  CHECK(listed.at("nodes").size() == before);
+  const Json &refused = listed.at("refused").at(0);
+  CHECK(refused.at("address") == "rsca/node/rogue");
+  CHECK_THAT(refused.at("why").get<std::string>(), Catch::Contains("field \"devices\""));
+  auto devices = domain.call("domain.devices");
+  REQUIRE(devices.has_value());
+  for (const auto &d : devices->at("devices"))
+    CHECK(d.at("node") != "rogue");
+  auto [rc, out] = domain.cli({"ls", "nodes"});
+  CHECK(rc == 0);
+  CHECK_THAT(out, Catch::Contains("refused: the endpoint at rsca/node/rogue"));
+
+  // Once it is gone, it is no longer listed.
+  rogue->reset();
+  CHECK(TestDomain::wait_for([&] { return nodes().value("refused", Json::array()).empty(); }));
 }

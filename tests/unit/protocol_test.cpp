@@ -4,7 +4,9 @@
 
 #include "control/operation.hpp"
 #include "protocol/addresses.hpp"
+#include "protocol/application_ops.hpp"
 #include "protocol/component_ops.hpp"
+#include "protocol/connection_ops.hpp"
 #include "protocol/domain_ops.hpp"
 #include "protocol/exec_params.hpp"
 #include "protocol/node_ops.hpp"
@@ -137,6 +139,214 @@ TEST_CASE("protocol: a reply that does not fit its contract fails the call", "[p
       control::call_error(control::Status::NotFound, "no such device"));
   REQUIRE_FALSE(failed.has_value());
   CHECK(failed.error().status == control::Status::NotFound);
+}
+
+TEST_CASE("protocol: a launch request reads as the CLI sends it, and says what it leaves out",
+          "[protocol]") {
+  using protocol::application::CreateRequest;
+  const Json sent{{"application", "PC"},
+                  {"start", false},
+                  {"assign", {{"Producer_1", "node1:GPP_1"}}},
+                  {"launch_id", "42-7"},
+                  {"strategy", "spread"}};
+  auto request = protocol::decode<CreateRequest>(sent);
+  REQUIRE(request.has_value());
+  CHECK(request->application == "PC"); // a field of the plan request it extends
+  CHECK(request->assign.at("Producer_1") == "node1:GPP_1");
+  CHECK(request->strategy == std::optional<std::string>("spread"));
+  CHECK(request->launch_id == std::optional<std::string>("42-7"));
+  CHECK_FALSE(request->start);
+  CHECK_FALSE(request->name.has_value());
+  CHECK(protocol::encode(*request) == sent);
+
+  auto least = protocol::decode<CreateRequest>(Json{{"application", "PC"}});
+  REQUIRE(least.has_value());
+  CHECK(least->start); // started unless asked not to
+  CHECK(least->assign.empty());
+  CHECK_FALSE(least->strategy.has_value());
+}
+
+TEST_CASE("protocol: a malformed application request names its field", "[protocol]") {
+  using protocol::decode;
+  namespace app = protocol::application;
+  const Json create{{"application", "PC"}, {"start", true}};
+  REQUIRE(decode<app::CreateRequest>(create).has_value());
+  Json typo = create;
+  typo["strat"] = "spread";
+  CHECK(decode<app::CreateRequest>(typo).error() == "unknown field \"strat\"");
+  Json start = create;
+  start["start"] = "yes";
+  CHECK(decode<app::CreateRequest>(start).error() ==
+        "field \"start\": expected true or false, found string");
+  Json assign = create;
+  assign["assign"] = {{"Producer_1", 3}};
+  CHECK(decode<app::CreateRequest>(assign).error() ==
+        "field \"assign[\"Producer_1\"]\": expected a string, found number");
+  CHECK(decode<app::CreateRequest>(Json{{"name", "x"}}).error() == "missing field \"application\"");
+  CHECK(decode<app::AppRequest>(Json{{"application", "PC"}}).error() == "missing field \"app\"");
+  CHECK(decode<app::QueryRequest>(Json{{"app", "PC"}, {"ids", "rate_hz"}}).error() ==
+        "field \"ids\": expected an array, found string");
+  CHECK(decode<app::ConfigureRequest>(Json{{"device", "n:D"}, {"values", {1, 2}}}).error() ==
+        "field \"values\": expected an object, found array");
+}
+
+TEST_CASE("protocol: configure and query requests name their target", "[protocol]") {
+  namespace app = protocol::application;
+  auto configure = protocol::decode<app::ConfigureRequest>(
+      Json{{"app", "RangeStop"}, {"component", ""}, {"values", {{"speed", "0.4"}, {"on", true}}}});
+  REQUIRE(configure.has_value());
+  CHECK(configure->app == std::optional<std::string>("RangeStop"));
+  CHECK(configure->component == std::optional<std::string>(""));
+  CHECK_FALSE(configure->device.has_value());
+  REQUIRE(configure->values.has_value());
+  CHECK(configure->values->at("speed") == "0.4");
+  CHECK(configure->values->at("on") == true); // not text: the domain takes its JSON
+  CHECK_FALSE(configure->properties.has_value());
+
+  auto query = protocol::decode<app::QueryRequest>(Json{{"device", "robot:IR_1"}});
+  REQUIRE(query.has_value());
+  CHECK(query->device == std::optional<std::string>("robot:IR_1"));
+  CHECK(query->ids.empty()); // every property
+}
+
+TEST_CASE("protocol: a launched application's reply round-trips with its launch", "[protocol]") {
+  protocol::application::CreateReply reply;
+  reply.name = "PC";
+  reply.installed = "ProducerConsumer";
+  reply.sad = "dom/waveforms/PC/PC.sad.xml";
+  reply.state = "degraded";
+  reply.exited = {"Producer_1"};
+  reply.components = Json::array({{{"id", "Producer_1"}, {"pid", 12}}});
+  reply.launch = {{{"check", "2 components", 0.5}, {"execute", "failed", 12.25}}, 13.0};
+  const Json encoded = protocol::encode(reply);
+  CHECK(encoded.at("launch").at("steps")[1].at("detail") == "failed");
+  CHECK(encoded.at("connections") == Json::array());
+  const auto back = round_trip(reply);
+  CHECK(back.name == "PC");
+  CHECK(back.exited == std::vector<std::string>{"Producer_1"});
+  CHECK(back.components[0].at("pid") == 12);
+  REQUIRE(back.launch.steps.size() == 2);
+  CHECK(back.launch.steps[1].ms == 12.25);
+  CHECK(back.launch.ms == 13.0);
+  Json no_launch = encoded;
+  no_launch.erase("launch");
+  CHECK(protocol::decode<protocol::application::CreateReply>(no_launch).error() ==
+        "missing field \"launch\"");
+}
+
+TEST_CASE("protocol: launch progress, cancel and plan replies keep what is absent absent",
+          "[protocol]") {
+  namespace app = protocol::application;
+  const Json finished{{"cancelled", false}, {"done", true}};
+  auto cancel = protocol::decode<app::CancelReply>(finished);
+  REQUIRE(cancel.has_value());
+  CHECK_FALSE(cancel->begun.has_value());
+  CHECK(protocol::encode(*cancel) == finished);
+  CHECK(round_trip(app::CancelReply{true, false, false}).begun == std::optional<bool>(false));
+
+  const Json rejected{{"admitted", false},
+                      {"strategy", "pack"},
+                      {"rejections", {{{"component", "Greedy_1"}, {"reasons", {"no room"}}}}}};
+  auto plan = protocol::decode<app::PlanReply>(rejected);
+  REQUIRE(plan.has_value());
+  CHECK_FALSE(plan->admitted);
+  CHECK_FALSE(plan->plan.has_value());
+  CHECK(plan->rejections->at(0).at("component") == "Greedy_1");
+  CHECK(protocol::encode(*plan) == rejected);
+
+  auto progress =
+      protocol::decode<app::ProgressReply>(Json{{"steps", {{{"step", "check"}}}}, {"done", false}});
+  REQUIRE_FALSE(progress.has_value());
+  CHECK(progress.error() == "field \"steps[0]\": missing field \"detail\"");
+}
+
+TEST_CASE("protocol: a connection request reads its ends, and refuses an end with no port",
+          "[protocol]") {
+  using protocol::connection::CreateRequest;
+  const Json sent{{"uses", {{"application", "pc"}, {"component", "Producer_1"}, {"port", "out"}}},
+                  {"provides", {{"device", "monitor:HostMonitor_1"}, {"port", "in"}}},
+                  {"qos", {{"depth", 4}}}};
+  auto request = protocol::decode<CreateRequest>(sent);
+  REQUIRE(request.has_value());
+  CHECK(request->uses.component == std::optional<std::string>("Producer_1"));
+  CHECK_FALSE(request->uses.device.has_value());
+  CHECK(request->provides.device == std::optional<std::string>("monitor:HostMonitor_1"));
+  CHECK(request->provides.port == "in");
+  CHECK_FALSE(request->id.has_value());
+  CHECK(request->qos.at("depth") == 4);
+  CHECK(protocol::encode(*request) == sent); // what the domain keeps to restore it
+
+  Json no_port = sent;
+  no_port["uses"].erase("port");
+  CHECK(protocol::decode<CreateRequest>(no_port).error() ==
+        "field \"uses\": missing field \"port\"");
+  Json extra = sent;
+  extra["provides"]["node"] = "monitor";
+  CHECK(protocol::decode<CreateRequest>(extra).error() ==
+        "field \"provides\": unknown field \"node\"");
+}
+
+TEST_CASE("protocol: a listed connection keeps a null end state null, and its state by name",
+          "[protocol]") {
+  using protocol::connection::ConnectionState;
+  using protocol::connection::ListedConnection;
+  ListedConnection pending;
+  pending.id = "runtime_1";
+  pending.uses = "pc/Producer_1.out";
+  pending.application = "(runtime)";
+  pending.state = ConnectionState::Pending;
+  pending.waiting_for = "application pc";
+  const Json encoded = protocol::encode(pending);
+  REQUIRE(encoded.contains("uses_state"));
+  CHECK(encoded.at("uses_state").is_null());
+  CHECK(encoded.at("state") == "pending");
+  CHECK_FALSE(encoded.contains("filter"));
+  const auto back = round_trip(pending);
+  CHECK(back.state == std::optional<ConnectionState>(ConnectionState::Pending));
+  CHECK(back.waiting_for == pending.waiting_for);
+  CHECK(back.provides_state.is_null());
+
+  Json unknown_state = encoded;
+  unknown_state["state"] = "matched";
+  CHECK(protocol::decode<ListedConnection>(unknown_state).error() ==
+        "field \"state\": \"matched\" is not one of the names allowed");
+}
+
+TEST_CASE("protocol: domain replies round-trip, and an install names its broken file",
+          "[protocol]") {
+  namespace dom = protocol::domain;
+  const auto nodes = round_trip(dom::NodesReply{{{"node1", "rsca/node/node1", 77, 3}}});
+  REQUIRE(nodes.nodes.size() == 1);
+  CHECK(nodes.nodes[0].pid == 77);
+  CHECK(nodes.nodes[0].devices == 3u);
+  const auto channel = round_trip(protocol::connection::ChannelView{
+      "ticks", "rsca_d_ch_ticks", "", true, 1, 0, {{"publisher", "a", "c", "T_1", "out", ""}}});
+  CHECK(channel.operator_owned);
+  CHECK(protocol::encode(channel).at("operator") == true);
+  CHECK(channel.members.at(0).component == "T_1");
+
+  const Json install{
+      {"sad", "dom/a.sad.xml"},
+      {"files", {{{"path", "dom/a.sad.xml"}, {"content", "<x/>"}}, {{"path", "b"}}}}};
+  CHECK(protocol::decode<dom::InstallRequest>(install).error() ==
+        "field \"files[1]\": missing field \"content\"");
+}
+
+TEST_CASE("protocol: the domain's typed handler refuses an application request with an unknown "
+          "field by name",
+          "[protocol]") {
+  int ran = 0;
+  auto handler = control::typed_handler<protocol::application::Show>(
+      [&ran](const protocol::application::AppRequest &, const control::RequestContext &)
+          -> control::CallResult<protocol::application::ApplicationView> {
+        ++ran;
+        return protocol::application::ApplicationView{};
+      });
+  auto bad = handler(Json{{"app", "PC"}, {"verbose", true}}, control::RequestContext{});
+  REQUIRE_FALSE(bad.has_value());
+  CHECK(bad.error().status == control::Status::BadRequest);
+  CHECK(bad.error().message == "app.show: unknown field \"verbose\"");
+  CHECK(ran == 0);
 }
 
 TEST_CASE("protocol: addresses are made in one scheme and read back", "[protocol]") {

@@ -18,11 +18,16 @@
 #include "domain_client.hpp"
 #include "exit_codes.hpp"
 #include "profile/profile_loader.hpp"
+#include "protocol/application_ops.hpp"
+#include "protocol/connection_ops.hpp"
+#include "protocol/domain_ops.hpp"
 
 namespace rsca::cli {
 namespace {
 
 namespace fs = std::filesystem;
+namespace app_ops = protocol::application;
+namespace connection_ops = protocol::connection;
 using control::Json;
 using namespace std::chrono_literals;
 
@@ -43,8 +48,8 @@ std::optional<fs::path> sdrroot_of(const fs::path &file, const GlobalOptions &gl
 
 // The install request for a SAD: the application's files, read here and carried to the domain,
 // so that the CLI may run on another host than the domain daemon.
-Expected<Json> install_request(const fs::path &sad, const GlobalOptions &global,
-                               const std::string &name) {
+Expected<protocol::domain::InstallRequest>
+install_request(const fs::path &sad, const GlobalOptions &global, const std::string &name) {
   auto root = sdrroot_of(sad, global);
   if (!root)
     return make_error(
@@ -54,13 +59,12 @@ Expected<Json> install_request(const fs::path &sad, const GlobalOptions &global,
   auto app = loader.load_application(sad);
   if (!app)
     return tl::unexpected(app.error());
-  Json list = Json::array();
+  protocol::domain::InstallRequest request{
+      app->sad_path.lexically_relative(*root).string(), {}, std::nullopt};
   for (const auto &f : app->files())
-    list.push_back(
-        {{"path", fs::path(f).lexically_relative(*root).string()}, {"content", read_text(f)}});
-  Json request{{"sad", app->sad_path.lexically_relative(*root).string()}, {"files", list}};
+    request.files.push_back({fs::path(f).lexically_relative(*root).string(), read_text(f)});
   if (!name.empty())
-    request["name"] = name;
+    request.name = name;
   return request;
 }
 
@@ -83,23 +87,22 @@ int install(const std::string &sad, const std::string &name, const GlobalOptions
     fmt::print(stderr, "rsca install: {}\n", client.error().to_string());
     return kFailed;
   }
-  auto reply =
-      client->call("domain.install", *request, std::chrono::milliseconds(global.timeout_ms) * 2);
+  auto reply = client->call<protocol::domain::Install>(
+      *request, std::chrono::milliseconds(global.timeout_ms) * 2);
   if (!reply)
     return report_failure(global, "install", reply.error());
   if (installed_name != nullptr)
-    *installed_name = reply->at("name").get<std::string>();
+    *installed_name = reply->name;
   if (global.json && installed_name == nullptr)
-    print_json(*reply);
+    print_json(protocol::encode(*reply));
   else if (!global.json)
-    fmt::print("installed {} ({} files)\n", reply->at("name").get<std::string>(),
-               (*request)["files"].size());
+    fmt::print("installed {} ({} files)\n", reply->name, request->files.size());
   return kOk;
 }
 
-std::optional<Json> assignments_json(const std::vector<std::string> &assignments,
-                                     const char *command) {
-  Json assign = Json::object();
+std::optional<std::map<std::string, std::string>>
+assignments_of(const std::vector<std::string> &assignments, const char *command) {
+  std::map<std::string, std::string> assign;
   for (const auto &a : assignments) {
     auto eq = a.find('=');
     if (eq == std::string::npos || eq == 0) {
@@ -143,15 +146,15 @@ private:
 
 // Prints the launch steps the domain completed since the last call (`shown` of them were).
 void print_progress(const DomainClient &client, const std::string &launch_id, std::size_t &shown) {
-  auto progress = client.call("app.progress", Json{{"launch_id", launch_id}}, 2s);
+  auto progress = client.call<app_ops::Progress>({launch_id}, 2s);
   if (!progress)
     return;
-  const auto &steps = progress->at("steps");
+  const auto &steps = progress->steps;
   for (; shown < steps.size(); ++shown) {
     const auto &s = steps[shown];
-    const bool failed = s.value("detail", "") == "failed";
-    fmt::print("  {} {:<10} {:>8.1f} ms  {}\n", failed ? "x" : "+", s.value("step", ""),
-               s.value("ms", 0.0), failed ? "" : s.value("detail", ""));
+    const bool failed = s.detail == "failed";
+    fmt::print("  {} {:<10} {:>8.1f} ms  {}\n", failed ? "x" : "+", s.step, s.ms,
+               failed ? "" : s.detail);
   }
 }
 
@@ -163,22 +166,23 @@ std::string cancel_launch(const DomainClient &client, const std::string &launch_
   // At least 2 s: a user who wants quick answers (a small --timeout-ms) still wants it cancelled.
   const auto timeout =
       std::max<std::chrono::milliseconds>(std::chrono::milliseconds(global.timeout_ms), 2s);
-  auto cancelled = client.call("app.cancel", Json{{"launch_id", launch_id}}, timeout);
+  auto cancelled = client.call<app_ops::Cancel>({launch_id}, timeout);
   if (!cancelled)
     return fmt::format("cancelling it failed ({}): it may still be under way (see `rsca ls apps`)",
                        cancelled.error().message);
-  if (!cancelled->value("cancelled", false))
+  if (!cancelled->cancelled)
     return "it finished meanwhile (see `rsca ls apps`)";
-  if (!cancelled->value("begun", true))
+  if (!cancelled->begun.value_or(true))
     return "the launch is cancelled before it began: the domain will not start it";
   return "the launch is cancelled: the domain rolls back what it did (see `rsca ls apps`)";
 }
 
 // Waits for the launch's reply, showing its steps on a terminal. On Ctrl-C it asks the domain
 // once to cancel the launch and goes on waiting: the reply then says what was rolled back.
-control::CallResult<Json> await_launch(const DomainClient &client, const std::string &launch_id,
-                                       std::future<control::CallResult<Json>> &launch,
-                                       bool show_progress, const GlobalOptions &global) {
+control::CallResult<app_ops::CreateReply>
+await_launch(const DomainClient &client, const std::string &launch_id,
+             std::future<control::CallResult<Json>> &launch, bool show_progress,
+             const GlobalOptions &global) {
   std::size_t shown = 0;
   bool cancelling = false;
   for (;;) {
@@ -186,7 +190,7 @@ control::CallResult<Json> await_launch(const DomainClient &client, const std::st
     if (show_progress)
       print_progress(client, launch_id, shown);
     if (finished)
-      return launch.get();
+      return control::reply_of<app_ops::Create>(launch.get());
     if (g_interrupted && !cancelling) {
       cancelling = true;
       const std::string outcome = cancel_launch(client, launch_id, global);
@@ -199,7 +203,7 @@ control::CallResult<Json> await_launch(const DomainClient &client, const std::st
 int launch(const std::string &what, const std::string &name, bool no_start,
            const std::vector<std::string> &assignments, const std::string &strategy,
            const GlobalOptions &global) {
-  auto assign = assignments_json(assignments, "launch");
+  auto assign = assignments_of(assignments, "launch");
   if (!assign)
     return kUsage;
   int rc = kOk;
@@ -213,21 +217,22 @@ int launch(const std::string &what, const std::string &name, bool no_start,
   }
   const std::string launch_id =
       fmt::format("{}-{}", getpid(), std::chrono::steady_clock::now().time_since_epoch().count());
-  Json request{{"application", application},
-               {"start", !no_start},
-               {"assign", *assign},
-               {"launch_id", launch_id}};
+  app_ops::CreateRequest request;
+  request.application = application;
+  request.start = !no_start;
+  request.assign = *assign;
+  request.launch_id = launch_id;
   if (!strategy.empty())
-    request["strategy"] = strategy;
+    request.strategy = strategy;
   if (!name.empty())
-    request["name"] = name;
+    request.name = name;
   const bool show_progress = !global.json && isatty(STDOUT_FILENO);
   if (show_progress)
     fmt::print("launching {}\n", application);
   const auto launch_timeout = std::chrono::milliseconds(global.timeout_ms) * 6;
   const auto sent = std::chrono::steady_clock::now();
   InterruptsNoted interrupts;
-  auto future = client->call_async("app.create", request, launch_timeout);
+  auto future = client->call_async<app_ops::Create>(request, launch_timeout);
   auto reply = await_launch(*client, launch_id, future, show_progress, global);
   // The CLI's own deadline, not the domain's reply that a step timed out: the domain took the
   // request (else the call fails as unavailable) but is not done with it.
@@ -250,69 +255,61 @@ int launch(const std::string &what, const std::string &name, bool no_start,
   if (!reply)
     return report_failure(global, "launch", reply.error());
   if (global.json) {
-    print_json(*reply);
+    print_json(protocol::encode(*reply));
     return kOk;
   }
-  fmt::print("{} {} ({} components)\n", no_start ? "created" : "launched",
-             reply->at("name").get<std::string>(), reply->at("components").size());
+  fmt::print("{} {} ({} components)\n", no_start ? "created" : "launched", reply->name,
+             reply->components.size());
   return kOk;
 }
 
-int simple_call(const char *what, const std::string &operation, Json body,
-                const GlobalOptions &global, const std::function<void(const Json &)> &print_text) {
-  auto client = DomainClient::connect(global);
-  if (!client) {
-    fmt::print(stderr, "rsca {}: {}\n", what, client.error().to_string());
-    return kFailed;
-  }
-  auto reply =
-      client->call(operation, std::move(body), std::chrono::milliseconds(global.timeout_ms) * 2);
-  if (!reply)
-    return report_failure(global, what, reply.error());
-  if (global.json)
-    print_json(*reply);
-  else
-    print_text(*reply);
-  return kOk;
+// A call of `Op` by a command that waits twice the timeout (the domain calls components in turn).
+template <control::Operation Op>
+int simple_call(const std::string &what, const typename Op::Request &request,
+                const GlobalOptions &global,
+                const std::function<void(const typename Op::Reply &)> &print_text) {
+  return call_and_print<Op>(global, what, request, std::chrono::milliseconds(global.timeout_ms) * 2,
+                            print_text);
 }
 
-// APP, APP/COMPONENT or NODE:DEVICE, with the request's other fields.
-Json target_json(const std::string &target, Json body) {
+// APP, APP/COMPONENT or NODE:DEVICE, into the request's target.
+void set_target(const std::string &target, app_ops::Target &request) {
   if (target.find(':') != std::string::npos) {
-    body["device"] = target;
-    return body;
+    request.device = target;
+    return;
   }
   const auto slash = target.find('/');
-  body["app"] = target.substr(0, slash);
-  body["component"] = slash == std::string::npos ? "" : target.substr(slash + 1);
-  return body;
+  request.app = target.substr(0, slash);
+  request.component = slash == std::string::npos ? "" : target.substr(slash + 1);
 }
 
-// APP/COMPONENT.PORT as {"application", "component", "port"}.
 // APP/COMPONENT.PORT (a component's port), NODE:DEVICE.PORT (a device's) or APP.PORT (an
 // application's external port).
-std::optional<Json> port_json(const std::string &text) {
+std::optional<connection_ops::PortEnd> port_end(const std::string &text) {
   const auto dot = text.rfind('.');
   if (dot == std::string::npos || dot == 0 || dot + 1 == text.size())
     return std::nullopt;
   const std::string owner = text.substr(0, dot), port = text.substr(dot + 1);
+  connection_ops::PortEnd end{std::nullopt, std::nullopt, std::nullopt, port};
   if (const auto slash = owner.find('/'); slash != std::string::npos) {
     if (slash == 0 || slash + 1 == owner.size())
       return std::nullopt;
-    return Json{{"application", owner.substr(0, slash)},
-                {"component", owner.substr(slash + 1)},
-                {"port", port}};
+    end.application = owner.substr(0, slash);
+    end.component = owner.substr(slash + 1);
+  } else if (owner.find(':') != std::string::npos) {
+    end.device = owner;
+  } else {
+    end.application = owner;
   }
-  if (owner.find(':') != std::string::npos)
-    return Json{{"device", owner}, {"port", port}};
-  return Json{{"application", owner}, {"port", port}};
+  return end;
 }
 
+using TextValues = std::map<std::string, std::string>;
+
 // QoS values given as text: numbers (depth, strength, ...) as numbers, the rest as text.
-Json typed_qos(const Json &values) {
+Json typed_qos(const TextValues &values) {
   Json out = Json::object();
-  for (const auto &[k, v] : values.items()) {
-    const std::string text = v.get<std::string>();
+  for (const auto &[k, text] : values) {
     const bool number = !text.empty() && text.find_first_not_of("0123456789") == std::string::npos;
     out[k] = number ? Json(std::stoll(text)) : Json(text);
   }
@@ -320,8 +317,8 @@ Json typed_qos(const Json &values) {
 }
 
 // prop=value arguments; values are sent as text and typed by the domain against the PRF.
-std::optional<Json> parse_assignments(const std::vector<std::string> &args) {
-  Json values = Json::object();
+std::optional<TextValues> parse_assignments(const std::vector<std::string> &args) {
+  TextValues values;
   for (const auto &a : args) {
     auto eq = a.find('=');
     if (eq == std::string::npos || eq == 0)
@@ -337,23 +334,66 @@ std::string scalar_text(const Json &v) {
 
 } // namespace
 
-int show_application(const std::string &name, const GlobalOptions &global) {
-  return simple_call("show", "app.show", Json{{"app", name}}, global, [](const Json &app) {
-    const Json exited = app.value("exited", Json::array());
-    fmt::print("application {} ({}) {}{}\n", app.value("name", ""), app.value("installed", ""),
-               app.value("state", ""),
-               exited.empty() ? "" : fmt::format(": exited {}", fmt::join(exited, ", ")));
-    fmt::print("  components:\n");
-    for (const auto &c : app.at("components"))
-      fmt::print("    {:<20} {:<16} pid {:<8} {}{}\n", c.value("id", ""), c.value("device", ""),
-                 c.value("pid", 0L), c.value("state", ""),
-                 c.value("assembly_controller", false) ? "  (assembly controller)" : "");
-    if (!app.at("connections").empty())
-      fmt::print("  connections:\n");
-    for (const auto &c : app.at("connections"))
-      fmt::print("    {:<16} {} -> {}  [{}]\n", c.value("id", ""), c.value("uses", ""),
-                 c.value("provides", ""), c.value("topic", ""));
+// rsca channel create|destroy NAME.
+template <control::Operation Op>
+void add_channel_command(CLI::App &channel_cmd, const char *verb, const char *done,
+                         const GlobalOptions &global, int &exit_code) {
+  auto *cmd = channel_cmd.add_subcommand(verb, std::string(verb) + " an event channel");
+  auto channel = std::make_shared<std::string>();
+  cmd->add_option("name", *channel, "The channel's name")->required();
+  cmd->callback([=, &global, &exit_code] {
+    exit_code = simple_call<Op>(
+        fmt::format("channel {}", verb), {*channel}, global,
+        [done](const typename Op::Reply &r) { fmt::print("channel {}: {}\n", done, r.name); });
   });
+}
+
+// rsca start|stop|release APP: `print_text` prints the reply.
+template <control::Operation Op>
+void add_lifecycle_command(CLI::App &app, const char *verb, const char *help,
+                           const GlobalOptions &global, int &exit_code,
+                           std::function<void(const typename Op::Reply &)> print_text) {
+  auto *cmd = app.add_subcommand(verb, help);
+  auto target = std::make_shared<std::string>();
+  cmd->add_option("app", *target, "Running application")->required();
+  cmd->callback([=, &global, &exit_code] {
+    exit_code = simple_call<Op>(verb, {*target}, global, print_text);
+  });
+}
+
+void add_lifecycle_commands(CLI::App &app, const GlobalOptions &global, int &exit_code) {
+  const auto print_name = [](const char *verb) {
+    return [verb](const app_ops::ApplicationView &r) { fmt::print("{}: {}\n", verb, r.name); };
+  };
+  add_lifecycle_command<app_ops::Start>(app, "start", "Start a created or stopped application",
+                                        global, exit_code, print_name("start"));
+  add_lifecycle_command<app_ops::Stop>(app, "stop", "Stop a running application", global, exit_code,
+                                       print_name("stop"));
+  add_lifecycle_command<app_ops::Release>(
+      app, "release", "Tear an application down: its processes, connections and allocations",
+      global, exit_code, [](const app_ops::ReleaseReply &r) {
+        fmt::print("release: {}\n", r.name);
+        for (const auto &id : r.unconfirmed)
+          fmt::print("  {} did not confirm its release and was terminated by its node\n", id);
+      });
+}
+int show_application(const std::string &name, const GlobalOptions &global) {
+  return simple_call<app_ops::Show>(
+      "show", {name}, global, [](const app_ops::ApplicationView &app) {
+        fmt::print("application {} ({}) {}{}\n", app.name, app.installed, app.state,
+                   app.exited.empty() ? ""
+                                      : fmt::format(": exited {}", fmt::join(app.exited, ", ")));
+        fmt::print("  components:\n");
+        for (const auto &c : app.components)
+          fmt::print("    {:<20} {:<16} pid {:<8} {}{}\n", c.value("id", ""), c.value("device", ""),
+                     c.value("pid", 0L), c.value("state", ""),
+                     c.value("assembly_controller", false) ? "  (assembly controller)" : "");
+        if (!app.connections.empty())
+          fmt::print("  connections:\n");
+        for (const auto &c : app.connections)
+          fmt::print("    {:<16} {} -> {}  [{}]\n", c.value("id", ""), c.value("uses", ""),
+                     c.value("provides", ""), c.value("topic", ""));
+      });
 }
 
 void add_application_commands(CLI::App &app, const GlobalOptions &global, int &exit_code) {
@@ -371,9 +411,9 @@ void add_application_commands(CLI::App &app, const GlobalOptions &global, int &e
   auto installed = std::make_shared<std::string>();
   uninstall_cmd->add_option("name", *installed, "Installed application")->required();
   uninstall_cmd->callback([=, &global, &exit_code] {
-    exit_code =
-        simple_call("uninstall", "domain.uninstall", Json{{"name", *installed}}, global,
-                    [](const Json &r) { fmt::print("uninstalled {}\n", r.value("name", "")); });
+    exit_code = simple_call<protocol::domain::Uninstall>(
+        "uninstall", {*installed}, global,
+        [](const protocol::domain::Named &r) { fmt::print("uninstalled {}\n", r.name); });
   });
 
   auto *launch_cmd = app.add_subcommand(
@@ -409,9 +449,12 @@ void add_application_commands(CLI::App &app, const GlobalOptions &global, int &e
   connect_cmd->add_option("provides", *provides_end, "The provides port")->required();
   connect_cmd->add_option("--id", *connection_id, "The connection's id (default: runtime_N)");
   connect_cmd->add_option("--qos", *qos_args, "QoS as in the SAD: name=value (repeatable)");
+  auto filter = std::make_shared<std::string>();
+  connect_cmd->add_option("--filter", *filter,
+                          "A content filter for the provides end, as a SAD's <filter>");
   connect_cmd->callback([=, &global, &exit_code] {
-    auto uses = port_json(*uses_end);
-    auto provides = port_json(*provides_end);
+    auto uses = port_end(*uses_end);
+    auto provides = port_end(*provides_end);
     auto qos = parse_assignments(*qos_args);
     if (!uses || !provides || !qos) {
       fmt::print(stderr, "rsca connect: give ports as APP/COMPONENT.PORT, APP.PORT or "
@@ -419,63 +462,39 @@ void add_application_commands(CLI::App &app, const GlobalOptions &global, int &e
       exit_code = kUsage;
       return;
     }
-    Json body{{"uses", *uses}, {"provides", *provides}, {"qos", typed_qos(*qos)}};
+    connection_ops::CreateRequest request{*uses, *provides, std::nullopt, typed_qos(*qos),
+                                          std::nullopt};
     if (!connection_id->empty())
-      body["id"] = *connection_id;
-    exit_code = simple_call("connect", "connection.create", body, global, [](const Json &r) {
-      if (r.value("state", "") == "pending")
-        fmt::print("pending {}: {} -> {} (waiting: {})\n", r.value("id", ""), r.value("uses", ""),
-                   r.value("provides", ""), r.value("waiting_for", ""));
-      else
-        fmt::print("connected {}: {} -> {} [{}]\n", r.value("id", ""), r.value("uses", ""),
-                   r.value("provides", ""), r.value("topic", ""));
-    });
+      request.id = *connection_id;
+    if (!filter->empty())
+      request.filter = *filter;
+    exit_code = simple_call<connection_ops::Create>(
+        "connect", request, global, [](const connection_ops::CreateReply &r) {
+          if (r.state == connection_ops::ConnectionState::Pending)
+            fmt::print("pending {}: {} -> {} (waiting: {})\n", r.id, r.uses, r.provides,
+                       r.waiting_for.value_or(""));
+          else
+            fmt::print("connected {}: {} -> {} [{}]\n", r.id, r.uses, r.provides, r.topic);
+        });
   });
   auto *disconnect_cmd =
       app.add_subcommand("disconnect", "Remove a connection made with rsca connect");
   auto disconnect_id = std::make_shared<std::string>();
   disconnect_cmd->add_option("id", *disconnect_id, "The connection's id")->required();
   disconnect_cmd->callback([=, &global, &exit_code] {
-    exit_code =
-        simple_call("disconnect", "connection.destroy", Json{{"id", *disconnect_id}}, global,
-                    [](const Json &r) { fmt::print("disconnected {}\n", r.value("id", "")); });
+    exit_code = simple_call<connection_ops::Destroy>(
+        "disconnect", {*disconnect_id}, global,
+        [](const connection_ops::ConnectionId &r) { fmt::print("disconnected {}\n", r.id); });
   });
 
   auto *channel_cmd = app.add_subcommand(
       "channel", "Create or destroy an operator's event channel (it lives until destroyed)");
   channel_cmd->require_subcommand(1);
-  for (const auto &[verb, op] :
-       {std::pair{"create", "channel.create"}, std::pair{"destroy", "channel.destroy"}}) {
-    auto *cmd = channel_cmd->add_subcommand(verb, std::string(verb) + " an event channel");
-    auto channel = std::make_shared<std::string>();
-    cmd->add_option("name", *channel, "The channel's name")->required();
-    cmd->callback([=, verb = std::string(verb), op = std::string(op), &global, &exit_code] {
-      exit_code = simple_call(
-          ("channel " + verb).c_str(), op, Json{{"name", *channel}}, global, [verb](const Json &r) {
-            fmt::print("channel {}: {}\n", verb == "create" ? "created" : "destroyed",
-                       r.value("name", ""));
-          });
-    });
-  }
-
-  for (const auto &[verb, op, help] :
-       {std::tuple{"start", "app.start", "Start a created or stopped application"},
-        std::tuple{"stop", "app.stop", "Stop a running application"},
-        std::tuple{"release", "app.release",
-                   "Tear an application down: its processes, connections and allocations"}}) {
-    auto *cmd = app.add_subcommand(verb, help);
-    auto target = std::make_shared<std::string>();
-    cmd->add_option("app", *target, "Running application")->required();
-    cmd->callback([=, verb = std::string(verb), op = std::string(op), &global, &exit_code] {
-      exit_code =
-          simple_call(verb.c_str(), op, Json{{"app", *target}}, global, [verb](const Json &r) {
-            fmt::print("{}: {}\n", verb, r.value("name", ""));
-            for (const auto &id : r.value("unconfirmed", Json::array()))
-              fmt::print("  {} did not confirm its release and was terminated by its node\n",
-                         id.get<std::string>());
-          });
-    });
-  }
+  add_channel_command<connection_ops::CreateChannel>(*channel_cmd, "create", "created", global,
+                                                     exit_code);
+  add_channel_command<connection_ops::DestroyChannel>(*channel_cmd, "destroy", "destroyed", global,
+                                                      exit_code);
+  add_lifecycle_commands(app, global, exit_code);
 
   auto *configure_cmd = app.add_subcommand(
       "configure", "Set properties of an application's assembly controller, one component, or "
@@ -492,9 +511,11 @@ void add_application_commands(CLI::App &app, const GlobalOptions &global, int &e
       exit_code = kUsage;
       return;
     }
-    exit_code = simple_call("configure", "app.configure",
-                            target_json(*configure_target, {{"values", *values}}), global,
-                            [](const Json &) { fmt::print("configured\n"); });
+    app_ops::ConfigureRequest request;
+    set_target(*configure_target, request);
+    request.values.emplace(values->begin(), values->end());
+    exit_code = simple_call<app_ops::Configure>("configure", request, global,
+                                                [](const auto &) { fmt::print("configured\n"); });
   });
 
   auto *query_cmd = app.add_subcommand(
@@ -505,12 +526,14 @@ void add_application_commands(CLI::App &app, const GlobalOptions &global, int &e
   query_cmd->add_option("target", *query_target, "APP, APP/COMPONENT or NODE:DEVICE")->required();
   query_cmd->add_option("properties", *ids, "Property ids (default: all)");
   query_cmd->callback([=, &global, &exit_code] {
-    exit_code = simple_call("query", "app.query", target_json(*query_target, {{"ids", *ids}}),
-                            global, [](const Json &r) {
-                              const Json properties = r.value("properties", Json::object());
-                              for (const auto &[id, value] : properties.items())
-                                fmt::print("{} = {}\n", id, scalar_text(value));
-                            });
+    app_ops::QueryRequest request;
+    set_target(*query_target, request);
+    request.ids = *ids;
+    exit_code = simple_call<app_ops::Query>("query", request, global,
+                                            [](const protocol::component::QueryReply &r) {
+                                              for (const auto &[id, value] : r.properties.items())
+                                                fmt::print("{} = {}\n", id, scalar_text(value));
+                                            });
   });
 }
 

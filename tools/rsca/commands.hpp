@@ -1,12 +1,12 @@
 // The rsca subcommands; each registers itself on the CLI11 app and runs when chosen.
 #pragma once
 
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include <CLI/CLI.hpp>
-#include <nlohmann/json.hpp>
 
 namespace rsca::cli {
 
@@ -32,9 +32,9 @@ int install(const std::string &sad, const std::string &name, const GlobalOptions
             std::string *installed_name = nullptr);
 // `what` is a SAD file (installed first) or an installed name; the installed name. rc: exit code.
 std::string installed_name_of(const std::string &what, const GlobalOptions &global, int &rc);
-// --assign COMPONENT=DEVICE arguments as a JSON object; nullopt (after saying why) when malformed.
-std::optional<nlohmann::json> assignments_json(const std::vector<std::string> &assignments,
-                                               const char *command);
+// --assign COMPONENT=DEVICE arguments; nullopt (after saying why) when malformed.
+std::optional<std::map<std::string, std::string>>
+assignments_of(const std::vector<std::string> &assignments, const char *command);
 
 // rsca show APP when the argument is not a profile file.
 int show_application(const std::string &name, const GlobalOptions &global);

@@ -35,18 +35,6 @@ Expected<DomainClient> DomainClient::connect(const GlobalOptions &global) {
   return client;
 }
 
-std::future<control::CallResult<control::Json>>
-DomainClient::call_async(const std::string &operation, control::Json body,
-                         std::chrono::milliseconds timeout) const {
-  return endpoint_->call(protocol::domain_address(domain_), operation, std::move(body), timeout);
-}
-
-control::CallResult<control::Json> DomainClient::call(const std::string &operation,
-                                                      control::Json body,
-                                                      std::chrono::milliseconds timeout) const {
-  return call_async(operation, std::move(body), timeout).get();
-}
-
 int exit_code_of(control::Status status) {
   switch (status) {
   case control::Status::Ok:

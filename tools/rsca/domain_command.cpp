@@ -14,6 +14,7 @@
 #include "domain_client.hpp"
 #include "exit_codes.hpp"
 #include "process/spawn.hpp"
+#include "protocol/domain_ops.hpp"
 
 namespace rsca::cli {
 namespace {
@@ -179,7 +180,7 @@ int up(int nodes, const std::vector<std::string> &extra_dcds, const fs::path &ru
   }
   const auto deadline =
       std::chrono::steady_clock::now() + std::chrono::milliseconds(global.timeout_ms) * 4;
-  Json reply;
+  protocol::domain::NodesReply reply;
   for (;;) {
     for (const auto &[pid, log] : started)
       if (!alive(pid)) {
@@ -187,8 +188,8 @@ int up(int nodes, const std::vector<std::string> &extra_dcds, const fs::path &ru
                    tail(log));
         return kFailed;
       }
-    auto listed = client->call("domain.nodes", Json::object(), 1s);
-    if (listed && listed->at("nodes").size() >= expected) {
+    auto listed = client->call<protocol::domain::Nodes>({}, 1s);
+    if (listed && listed->nodes.size() >= expected) {
       reply = *listed;
       break;
     }
@@ -200,8 +201,9 @@ int up(int nodes, const std::vector<std::string> &extra_dcds, const fs::path &ru
     std::this_thread::sleep_for(50ms); // pacing a poll of the domain, not a wait for a condition
   }
   if (global.json) {
-    reply["run_dir"] = run.string();
-    print_json(reply);
+    Json shown = protocol::encode(reply);
+    shown["run_dir"] = run.string();
+    print_json(shown);
   } else {
     fmt::print("domain {} up: domaind pid {}, {} node(s); logs in {}\n", global.domain, *domaind,
                expected, run.string());

@@ -5,50 +5,54 @@
 #include "commands.hpp"
 #include "domain_client.hpp"
 #include "exit_codes.hpp"
+#include "protocol/application_ops.hpp"
+#include "protocol/connection_ops.hpp"
+#include "protocol/domain_ops.hpp"
 
 namespace rsca::cli {
 namespace {
 
+namespace app_ops = protocol::application;
+namespace connection_ops = protocol::connection;
+namespace domain_ops = protocol::domain;
 using control::Json;
 
-void print_apps(const Json &r) {
+void print_apps(const app_ops::ListReply &r) {
   fmt::print("{:<24} {:<24} {:<10} {}\n", "APPLICATION", "INSTALLED AS", "STATE", "COMPONENTS");
-  for (const auto &a : r.at("applications")) {
-    const Json exited = a.value("exited", Json::array());
-    fmt::print("{:<24} {:<24} {:<10} {}{}\n", a.value("name", ""), a.value("installed", ""),
-               a.value("state", ""), a.value("components", 0),
-               exited.empty() ? "" : fmt::format("  (exited: {})", fmt::join(exited, ", ")));
-  }
+  for (const auto &a : r.applications)
+    fmt::print("{:<24} {:<24} {:<10} {}{}\n", a.name, a.installed, a.state, a.components,
+               a.exited.empty() ? "" : fmt::format("  (exited: {})", fmt::join(a.exited, ", ")));
   // Left by an earlier run of the domain daemon (one that was killed): the domain cannot release
   // them, the operator can.
-  const Json unknown = r.value("unknown", Json::array());
-  if (unknown.empty())
+  if (r.unknown.empty())
     return;
   fmt::print("\n{} component process(es) run that no application of this domain launched (an "
              "earlier run of the domain daemon did):\n",
-             unknown.size());
-  for (const auto &u : unknown)
-    fmt::print("  pid {:<8} {}\n", u.value("pid", 0), u.value("address", ""));
+             r.unknown.size());
+  for (const auto &u : r.unknown)
+    fmt::print("  pid {:<8} {}\n", u.pid, u.address);
 }
 
-void print_installed(const Json &r) {
+void print_installed(const domain_ops::InstalledReply &r) {
   fmt::print("{:<24} {:<10} {}\n", "INSTALLED", "COMPONENTS", "SAD");
-  for (const auto &a : r.at("applications"))
-    fmt::print("{:<24} {:<10} {}\n", a.value("name", ""), a.value("components", 0),
-               a.value("sad", ""));
+  for (const auto &a : r.applications)
+    fmt::print("{:<24} {:<10} {}\n", a.name, a.components, a.sad);
 }
 
-void print_nodes(const Json &r) {
+void print_nodes(const domain_ops::NodesReply &r) {
   fmt::print("{:<16} {:<8} {:<8} {}\n", "NODE", "PID", "DEVICES", "ADDRESS");
-  for (const auto &n : r.at("nodes"))
-    fmt::print("{:<16} {:<8} {:<8} {}\n", n.value("name", ""), n.value("pid", 0L),
-               n.value("devices", 0), n.value("address", ""));
+  for (const auto &n : r.nodes)
+    fmt::print("{:<16} {:<8} {:<8} {}\n", n.name, n.pid, n.devices, n.address);
+  for (const auto &refused : r.refused)
+    fmt::print("refused: the endpoint at {} announced itself as a node in a form this domain does "
+               "not take: {}\n",
+               refused.address, refused.why);
 }
 
-void print_devices(const Json &r) {
+void print_devices(const domain_ops::DevicesReply &r) {
   fmt::print("{:<20} {:<8} {:<6} {:>28} {:>34}\n", "DEVICE", "NODE", "KIND",
              "CPU % (total/alloc/free)", "MEMORY MiB (total/alloc/free)");
-  for (const auto &d : r.at("devices")) {
+  for (const auto &d : r.devices) {
     auto cap = [&](const char *name) {
       const auto &c = d.at("capacity");
       if (!c.contains(name))
@@ -62,17 +66,15 @@ void print_devices(const Json &r) {
   }
 }
 
-void print_channels(const Json &r) {
+void print_channels(const connection_ops::ChannelsReply &r) {
   fmt::print("{:<20} {:<10} {:>10} {:>11}  {}\n", "CHANNEL", "OWNER", "PUBLISHERS", "SUBSCRIBERS",
              "TOPIC");
-  for (const auto &c : r.at("channels")) {
-    fmt::print("{:<20} {:<10} {:>10} {:>11}  {}\n", c.value("name", ""),
-               c.value("operator", false) ? "operator" : "apps", c.value("publishers", 0),
-               c.value("subscribers", 0), c.value("topic", ""));
-    for (const auto &m : c.at("members"))
-      fmt::print("  {:<10} {}/{}.{}{}\n", m.value("role", ""), m.value("application", ""),
-                 m.value("component", ""), m.value("port", ""),
-                 m.value("filter", "").empty() ? "" : "  filter: " + m.value("filter", ""));
+  for (const auto &c : r.channels) {
+    fmt::print("{:<20} {:<10} {:>10} {:>11}  {}\n", c.name, c.operator_owned ? "operator" : "apps",
+               c.publishers, c.subscribers, c.topic);
+    for (const auto &m : c.members)
+      fmt::print("  {:<10} {}/{}.{}{}\n", m.role, m.application, m.component, m.port,
+                 m.filter.empty() ? "" : "  filter: " + m.filter);
   }
 }
 
@@ -86,31 +88,36 @@ std::string end_state(const Json &state) {
                      state.value("in_host", false) ? " (in-host)" : "");
 }
 
-void print_connections(const Json &r) {
-  for (const auto &c : r.at("connections")) {
-    const std::string uses = c.value("uses", ""), provides = c.value("provides", "");
-    const std::string topic = c.value("topic", "");
-    fmt::print("{}/{}: {} -> {}  [{}]\n", c.value("application", ""), c.value("id", ""),
-               uses.empty() ? "(channel)" : uses, provides.empty() ? "(channel)" : provides,
-               topic.empty() ? "calls " + c.value("repid", "") : topic);
-    if (topic.empty()) {
+void print_connections(const connection_ops::ListReply &r) {
+  for (const auto &c : r.connections) {
+    fmt::print("{}/{}: {} -> {}  [{}]\n", c.application, c.id,
+               c.uses.empty() ? "(channel)" : c.uses, c.provides.empty() ? "(channel)" : c.provides,
+               c.topic.empty() ? "calls " + c.repid : c.topic);
+    if (c.topic.empty()) {
       // A uses port calling a component's supported interface: control calls, no DDS QoS.
-      const Json &state = c.at("uses_state");
+      const Json &state = c.uses_state;
       fmt::print("  uses: {}\n",
                  state.is_null() ? "-" : fmt::format("{} calls", state.value("calls", 0)));
       continue;
     }
-    const auto &q = c.at("qos");
+    const auto &q = c.qos;
     fmt::print("  qos {} {} {}{}\n", q.value("reliability", ""), q.value("durability", ""),
                q.value("history", ""),
                q.contains("depth") ? fmt::format(" depth {}", q.at("depth").dump()) : "");
-    if (c.value("state", "") == "pending") {
-      fmt::print("  pending: {}\n", c.value("waiting_for", ""));
+    if (c.state == connection_ops::ConnectionState::Pending) {
+      fmt::print("  pending: {}\n", c.waiting_for.value_or(""));
       continue;
     }
-    fmt::print("  uses: {}   provides: {}\n", end_state(c.at("uses_state")),
-               end_state(c.at("provides_state")));
+    fmt::print("  uses: {}   provides: {}\n", end_state(c.uses_state), end_state(c.provides_state));
   }
+}
+
+// One view of `rsca ls`: the domain's reply to `Op`, printed by `print_text`.
+template <control::Operation Op>
+int list(const GlobalOptions &global, const typename Op::Request &request,
+         void (*print_text)(const typename Op::Reply &)) {
+  return call_and_print<Op>(global, "ls", request, std::chrono::milliseconds(global.timeout_ms),
+                            print_text);
 }
 
 } // namespace
@@ -125,32 +132,13 @@ void add_ls_command(CLI::App &app, const GlobalOptions &global, int &exit_code) 
       ->check(CLI::IsMember({"apps", "nodes", "devices", "installed", "channels", "connections"}));
   cmd->add_option("app", *of_app, "connections: only this application's");
   cmd->callback([what, of_app, &global, &exit_code] {
-    struct View {
-      const char *operation;
-      void (*print)(const Json &);
-    };
-    const View view = *what == "nodes"         ? View{"domain.nodes", print_nodes}
-                      : *what == "devices"     ? View{"domain.devices", print_devices}
-                      : *what == "installed"   ? View{"domain.installed", print_installed}
-                      : *what == "channels"    ? View{"channel.list", print_channels}
-                      : *what == "connections" ? View{"connection.list", print_connections}
-                                               : View{"app.list", print_apps};
-    auto client = DomainClient::connect(global);
-    if (!client) {
-      fmt::print(stderr, "rsca ls: {}\n", client.error().to_string());
-      exit_code = kFailed;
-      return;
-    }
-    Json body = Json::object();
-    if (!of_app->empty())
-      body["app"] = *of_app;
-    auto reply = client->call(view.operation, body, std::chrono::milliseconds(global.timeout_ms));
-    if (!reply) {
-      exit_code = report_failure(global, "ls", reply.error());
-      return;
-    }
-    global.json ? print_json(*reply) : view.print(*reply);
-    exit_code = kOk;
+    exit_code =
+        *what == "nodes"         ? list<domain_ops::Nodes>(global, {}, print_nodes)
+        : *what == "devices"     ? list<domain_ops::Devices>(global, {}, print_devices)
+        : *what == "installed"   ? list<domain_ops::Installed>(global, {}, print_installed)
+        : *what == "channels"    ? list<connection_ops::ListChannels>(global, {}, print_channels)
+        : *what == "connections" ? list<connection_ops::List>(global, {*of_app}, print_connections)
+                                 : list<app_ops::List>(global, {}, print_apps);
   });
 }
 

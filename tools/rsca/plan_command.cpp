@@ -10,11 +10,13 @@
 #include "domain_client.hpp"
 #include "exit_codes.hpp"
 #include "profile/profile_loader.hpp"
+#include "protocol/application_ops.hpp"
 
 namespace rsca::cli {
 namespace {
 
 namespace fs = std::filesystem;
+namespace app_ops = protocol::application;
 using control::Json;
 
 struct PlanArgs {
@@ -36,19 +38,18 @@ std::string describe_demand(const Json &demand) {
   return out.empty() ? "no declared demand" : out;
 }
 
-void print_plan(const std::string &application, const Json &result) {
-  const bool admitted = result.value("admitted", false);
-  fmt::print("plan for {} (strategy {}): {}\n", application, result.value("strategy", ""),
-             admitted ? "admitted" : "rejected");
-  if (!admitted) {
-    for (const auto &r : result.at("rejections")) {
+void print_plan(const std::string &application, const app_ops::PlanReply &result) {
+  fmt::print("plan for {} (strategy {}): {}\n", application, result.strategy,
+             result.admitted ? "admitted" : "rejected");
+  if (!result.admitted) {
+    for (const auto &r : result.rejections.value_or(Json::array())) {
       fmt::print("  {}: cannot be placed\n", r.value("component", ""));
       for (const auto &reason : r.at("reasons"))
         fmt::print("    {}\n", reason.get<std::string>());
     }
     return;
   }
-  const Json &plan = result.at("plan");
+  const Json plan = result.plan.value_or(Json::object());
   for (const auto &p : plan.at("placements")) {
     fmt::print("  {:<20} -> {:<16} ({})  {}\n", p.value("component", ""), p.value("device", ""),
                p.value("implementation", ""), describe_demand(p.at("demand")));
@@ -69,12 +70,13 @@ void print_plan(const std::string &application, const Json &result) {
     fmt::print("  note: {}\n", note.get<std::string>());
 }
 
-int report(const std::string &application, const Json &result, const GlobalOptions &global) {
+int report(const std::string &application, const app_ops::PlanReply &result,
+           const GlobalOptions &global) {
   if (global.json)
-    print_json(result);
+    print_json(protocol::encode(result));
   else
     print_plan(application, result);
-  return result.value("admitted", false) ? kOk : kRejected;
+  return result.admitted ? kOk : kRejected;
 }
 
 // Offline: the devices the DCDs declare, valued from their PRFs and the DCDs alone.
@@ -93,7 +95,8 @@ Expected<allocator::DomainState> offline_domain(const std::vector<std::string> &
   return state;
 }
 
-int plan_offline(const PlanArgs &args, const Json &assign, const GlobalOptions &global) {
+int plan_offline(const PlanArgs &args, const std::map<std::string, std::string> &assign,
+                 const GlobalOptions &global) {
   const auto sdrroot =
       global.sdrroot.empty() ? std::nullopt : std::optional<fs::path>(fs::absolute(global.sdrroot));
   auto application = profile::ProfileLoader(sdrroot).load_application(args.what);
@@ -106,22 +109,15 @@ int plan_offline(const PlanArgs &args, const Json &assign, const GlobalOptions &
     fmt::print(stderr, "rsca plan: {}\n", domain.error().to_string());
     return kInvalidProfile;
   }
-  std::map<std::string, std::string> assignments;
-  for (const auto &[k, v] : assign.items())
-    assignments[k] = v.get<std::string>();
   const allocator::PlanOptions options{
       allocator::parse_strategy(args.strategy).value_or(allocator::Strategy::Pack)};
   auto plan =
-      allocator::make_plan(*domain, allocator::plan_request_of(*application, assignments), options);
-  Json result{{"strategy", to_string(options.strategy)}, {"admitted", plan.has_value()}};
-  if (plan)
-    result["plan"] = allocator::to_json(*plan);
-  else
-    result["rejections"] = allocator::to_json(plan.error());
-  return report(application->sad->name, result, global);
+      allocator::make_plan(*domain, allocator::plan_request_of(*application, assign), options);
+  return report(application->sad->name, allocator::plan_reply(plan, options.strategy), global);
 }
 
-int plan_online(const PlanArgs &args, const Json &assign, const GlobalOptions &global) {
+int plan_online(const PlanArgs &args, const std::map<std::string, std::string> &assign,
+                const GlobalOptions &global) {
   int rc = kOk;
   const std::string application = installed_name_of(args.what, global, rc);
   if (rc != kOk)
@@ -131,10 +127,10 @@ int plan_online(const PlanArgs &args, const Json &assign, const GlobalOptions &g
     fmt::print(stderr, "rsca plan: {}\n", client.error().to_string());
     return kFailed;
   }
-  Json request{{"application", application}, {"assign", assign}};
+  app_ops::PlanRequest request{application, assign, std::nullopt};
   if (!args.strategy.empty())
-    request["strategy"] = args.strategy;
-  auto reply = client->call("app.plan", request, std::chrono::milliseconds(global.timeout_ms));
+    request.strategy = args.strategy;
+  auto reply = client->call<app_ops::Plan>(request, std::chrono::milliseconds(global.timeout_ms));
   if (!reply)
     return report_failure(global, "plan", reply.error());
   return report(application, *reply, global);
@@ -156,7 +152,7 @@ void add_plan_command(CLI::App &app, const GlobalOptions &global, int &exit_code
                   "Placement: pack or spread (default: the domain's; offline: pack)")
       ->check(CLI::IsMember({"pack", "spread"}));
   cmd->callback([args, &global, &exit_code] {
-    auto assign = assignments_json(args->assignments, "plan");
+    auto assign = assignments_of(args->assignments, "plan");
     if (!assign) {
       exit_code = kUsage;
       return;

@@ -1,0 +1,267 @@
+// The app.* operations: what the CLI asks the domain daemon of applications (plan, launch and
+// its progress, start, stop, release, configure, query, list, show).
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <tuple>
+#include <vector>
+
+#include "protocol/codec.hpp"
+#include "protocol/component_ops.hpp"
+
+namespace rsca::protocol::application {
+
+// Admission and placement of an installed application, as app.plan and app.create take them.
+struct PlanRequest {
+  std::string application;                   // the installed application
+  std::map<std::string, std::string> assign; // component instantiation -> device id
+  std::optional<std::string> strategy;       // "pack" or "spread"; absent: the domain's
+  static constexpr auto fields() {
+    using R = PlanRequest;
+    return std::tuple{required("application", &R::application), optional("assign", &R::assign),
+                      optional("strategy", &R::strategy)};
+  }
+};
+
+// The allocator's answer: a plan when admitted, else the rejections per component, both as
+// allocator/plan_json.hpp makes them (also offline, by `rsca plan --node`).
+struct PlanReply {
+  bool admitted = false;
+  std::string strategy;
+  std::optional<Json> plan;
+  std::optional<Json> rejections;
+  static constexpr auto fields() {
+    using R = PlanReply;
+    return std::tuple{required("admitted", &R::admitted), required("strategy", &R::strategy),
+                      optional("plan", &R::plan), optional("rejections", &R::rejections)};
+  }
+};
+
+struct CreateRequest : PlanRequest {
+  std::optional<std::string> name;      // the running application's; absent: the installed name
+  std::optional<std::string> launch_id; // for app.progress and app.cancel; absent: the name
+  bool start = true;                    // false: create and connect only
+  static constexpr auto fields() {
+    using R = CreateRequest;
+    return std::tuple_cat(PlanRequest::fields(), std::tuple{optional("name", &R::name),
+                                                            optional("launch_id", &R::launch_id),
+                                                            optional("start", &R::start)});
+  }
+};
+
+struct StepView {
+  std::string step;   // "check", "allocate", "execute", "register", ...
+  std::string detail; // what was done; "failed" for the step that failed
+  double ms = 0;
+  static constexpr auto fields() {
+    return std::tuple{required("step", &StepView::step), required("detail", &StepView::detail),
+                      required("ms", &StepView::ms)};
+  }
+};
+
+// A running application. Its components and connections are application.cpp's view (to_json),
+// which holds free-form parts (schedules, QoS) and whose component states are being reworked.
+struct ApplicationView {
+  std::string name;
+  std::string installed;
+  std::string sad;
+  std::string state; // "created", "running", "stopped", "failed", or "degraded"
+  std::vector<std::string> exited;
+  Json components = Json::array();
+  Json connections = Json::array();
+  static constexpr auto fields() {
+    using R = ApplicationView;
+    return std::tuple{required("name", &R::name),
+                      required("installed", &R::installed),
+                      required("sad", &R::sad),
+                      required("state", &R::state),
+                      required("exited", &R::exited),
+                      required("components", &R::components),
+                      required("connections", &R::connections)};
+  }
+};
+
+struct LaunchReport {
+  std::vector<StepView> steps;
+  double ms = 0;
+  static constexpr auto fields() {
+    return std::tuple{required("steps", &LaunchReport::steps), required("ms", &LaunchReport::ms)};
+  }
+};
+
+struct CreateReply : ApplicationView {
+  LaunchReport launch;
+  static constexpr auto fields() {
+    return std::tuple_cat(ApplicationView::fields(),
+                          std::tuple{required("launch", &CreateReply::launch)});
+  }
+};
+
+struct LaunchId {
+  std::string launch_id;
+  static constexpr auto fields() { return std::tuple{required("launch_id", &LaunchId::launch_id)}; }
+};
+
+struct ProgressReply {
+  std::vector<StepView> steps;
+  bool done = false;
+  static constexpr auto fields() {
+    return std::tuple{required("steps", &ProgressReply::steps),
+                      required("done", &ProgressReply::done)};
+  }
+};
+
+struct CancelReply {
+  bool cancelled = false; // false: it had finished
+  bool done = false;
+  std::optional<bool> begun; // when cancelled; false: its create had not come yet
+  static constexpr auto fields() {
+    return std::tuple{required("cancelled", &CancelReply::cancelled),
+                      required("done", &CancelReply::done), optional("begun", &CancelReply::begun)};
+  }
+};
+
+// A request that names one running application.
+struct AppRequest {
+  std::string app;
+  static constexpr auto fields() { return std::tuple{required("app", &AppRequest::app)}; }
+};
+
+struct ReleaseReply {
+  std::string name;
+  std::vector<std::string> unconfirmed; // components its node terminated
+  static constexpr auto fields() {
+    return std::tuple{required("name", &ReleaseReply::name),
+                      required("unconfirmed", &ReleaseReply::unconfirmed)};
+  }
+};
+
+// Where app.configure and app.query go: a device (NODE:DEVICE), or else an application's
+// component (empty or absent: its assembly controller).
+struct Target {
+  std::optional<std::string> device;
+  std::optional<std::string> app;
+  std::optional<std::string> component;
+  static constexpr auto fields() {
+    return std::tuple{optional("device", &Target::device), optional("app", &Target::app),
+                      optional("component", &Target::component)};
+  }
+};
+
+struct ConfigureRequest : Target {
+  // Values as text (the CLI's prop=value), typed by the domain against the component's PRF.
+  std::optional<std::map<std::string, Json>> values;
+  // Values already typed (profile/property_json.hpp); `values` override them.
+  std::optional<std::map<std::string, Json>> properties;
+  static constexpr auto fields() {
+    using R = ConfigureRequest;
+    return std::tuple_cat(Target::fields(), std::tuple{optional("values", &R::values),
+                                                       optional("properties", &R::properties)});
+  }
+};
+
+struct QueryRequest : Target {
+  std::vector<std::string> ids; // none: every property
+  static constexpr auto fields() {
+    return std::tuple_cat(Target::fields(), std::tuple{optional("ids", &QueryRequest::ids)});
+  }
+};
+
+struct ApplicationSummary {
+  std::string name;
+  std::string installed;
+  std::string state;
+  std::vector<std::string> exited;
+  std::uint64_t components = 0;
+  static constexpr auto fields() {
+    using R = ApplicationSummary;
+    return std::tuple{required("name", &R::name), required("installed", &R::installed),
+                      required("state", &R::state), required("exited", &R::exited),
+                      required("components", &R::components)};
+  }
+};
+
+// A component process that no application of this run of the domain daemon launched.
+struct UnknownComponent {
+  std::string address;
+  std::string application;
+  std::string component;
+  std::int64_t pid = 0;
+  static constexpr auto fields() {
+    using R = UnknownComponent;
+    return std::tuple{required("address", &R::address), required("application", &R::application),
+                      required("component", &R::component), required("pid", &R::pid)};
+  }
+};
+
+struct ListReply {
+  std::vector<ApplicationSummary> applications;
+  std::vector<UnknownComponent> unknown;
+  static constexpr auto fields() {
+    return std::tuple{required("applications", &ListReply::applications),
+                      required("unknown", &ListReply::unknown)};
+  }
+};
+
+struct Plan {
+  static constexpr std::string_view name = "app.plan";
+  using Request = PlanRequest;
+  using Reply = PlanReply;
+};
+struct Create {
+  static constexpr std::string_view name = "app.create";
+  using Request = CreateRequest;
+  using Reply = CreateReply;
+};
+struct Progress {
+  static constexpr std::string_view name = "app.progress";
+  using Request = LaunchId;
+  using Reply = ProgressReply;
+};
+struct Cancel {
+  static constexpr std::string_view name = "app.cancel";
+  using Request = LaunchId;
+  using Reply = CancelReply;
+};
+struct Release {
+  static constexpr std::string_view name = "app.release";
+  using Request = AppRequest;
+  using Reply = ReleaseReply;
+};
+struct Start {
+  static constexpr std::string_view name = "app.start";
+  using Request = AppRequest;
+  using Reply = ApplicationView;
+};
+struct Stop {
+  static constexpr std::string_view name = "app.stop";
+  using Request = AppRequest;
+  using Reply = ApplicationView;
+};
+// Answered as the component (or device) answers component.configure and component.query.
+struct Configure {
+  static constexpr std::string_view name = "app.configure";
+  using Request = ConfigureRequest;
+  using Reply = Empty;
+};
+struct Query {
+  static constexpr std::string_view name = "app.query";
+  using Request = QueryRequest;
+  using Reply = component::QueryReply;
+};
+struct List {
+  static constexpr std::string_view name = "app.list";
+  using Request = Empty;
+  using Reply = ListReply;
+};
+struct Show {
+  static constexpr std::string_view name = "app.show";
+  using Request = AppRequest;
+  using Reply = ApplicationView;
+};
+
+} // namespace rsca::protocol::application
