@@ -19,23 +19,7 @@ std::string_view to_string(ApplicationState state) {
 }
 
 std::string_view to_string(ComponentState state) {
-  switch (state) {
-  case ComponentState::Allocated:
-    return "allocated";
-  case ComponentState::Executed:
-    return "executed";
-  case ComponentState::Registered:
-    return "registered";
-  case ComponentState::Running:
-    return "running";
-  case ComponentState::Stopped:
-    return "stopped";
-  case ComponentState::Exited:
-    return "exited";
-  case ComponentState::Released:
-    return "released";
-  }
-  return "unknown";
+  return protocol::enum_name(state);
 }
 
 ComponentInstance *Application::find_component(std::string_view id) {
@@ -64,35 +48,21 @@ std::string state_of(const Application &app) {
   return exited_components(app).empty() ? std::string(to_string(app.state)) : "degraded";
 }
 
-nlohmann::json to_json(const Application &app) {
-  nlohmann::json components = nlohmann::json::array();
+protocol::application::ApplicationView view_of(const Application &app) {
+  protocol::application::ApplicationView view{
+      app.name, app.installed, app.sad, state_of(app), exited_components(app), {}, {}};
   for (const auto &c : app.components) {
-    nlohmann::json entry{{"id", c.id},
-                         {"usage_name", c.usage_name},
-                         {"node", c.node},
-                         {"device", c.device},
-                         {"implementation", c.implementation},
-                         {"address", c.address},
-                         {"pid", c.pid},
-                         {"state", to_string(c.state)},
-                         {"assembly_controller", c.assembly_controller}};
+    protocol::application::ComponentView component{
+        c.id,    c.usage_name,          c.node,      c.device, c.implementation, c.address, c.pid,
+        c.state, c.assembly_controller, std::nullopt};
     for (const auto &p : app.plan.placements)
       if (p.instance == c.id && p.schedule)
-        entry["schedule"] = allocator::to_json(*p.schedule);
-    components.push_back(std::move(entry));
+        component.schedule = allocator::to_json(*p.schedule);
+    view.components.push_back(std::move(component));
   }
-  nlohmann::json connections = nlohmann::json::array();
   for (const auto &c : app.connections)
-    connections.push_back({{"id", c.id},
-                           {"uses", c.uses.name()},
-                           {"provides", c.provides.name()},
-                           {"repid", c.repid},
-                           {"topic", c.topic},
-                           {"qos", c.qos}});
-  return {
-      {"name", app.name},          {"installed", app.installed},       {"sad", app.sad},
-      {"state", state_of(app)},    {"exited", exited_components(app)}, {"components", components},
-      {"connections", connections}};
+    view.connections.push_back({c.id, c.uses.name(), c.provides.name(), c.repid, c.topic, c.qos});
+  return view;
 }
 
 } // namespace rsca::domain

@@ -10,23 +10,15 @@
 
 #include "allocator/resource_allocator.hpp"
 #include "profile/profile_loader.hpp"
+#include "protocol/application_ops.hpp"
 
 namespace rsca::domain {
 
 enum class ApplicationState : std::uint8_t { Created, Running, Stopped, Failed };
 std::string_view to_string(ApplicationState state);
 
-// A component's life as the domain sees it, in the order a launch and a release pass through.
-// Exited is final while the application runs: a component that exited is never called again.
-enum class ComponentState : std::uint8_t {
-  Allocated,  // placed, its device's capacity reserved
-  Executed,   // its process started
-  Registered, // it announced itself and was configured and connected
-  Running,
-  Stopped,
-  Exited, // its process ended without being asked to
-  Released
-};
+// A component's life as the domain sees it (protocol/application_ops.hpp: users see it).
+using ComponentState = protocol::application::ComponentState;
 std::string_view to_string(ComponentState state);
 
 struct ComponentInstance {
@@ -100,6 +92,7 @@ std::vector<std::string> exited_components(const Application &app);
 // released), else its lifecycle state.
 std::string state_of(const Application &app);
 
-nlohmann::json to_json(const Application &app);
+// The application as replies show it.
+protocol::application::ApplicationView view_of(const Application &app);
 
 } // namespace rsca::domain

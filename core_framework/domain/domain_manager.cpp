@@ -64,19 +64,6 @@ CallResult<Reply> as_domain_reply(CallResult<Reply> result) {
   return result;
 }
 
-// A running application as replies show it: its components and connections as application.cpp
-// makes them (to_json), the rest typed.
-app_ops::ApplicationView view_of(const Application &app) {
-  Json parts = to_json(app);
-  return {app.name,
-          app.installed,
-          app.sad,
-          state_of(app),
-          exited_components(app),
-          std::move(parts["components"]),
-          std::move(parts["connections"])};
-}
-
 } // namespace
 
 ApplicationFactory DomainManager::Impl::factory() {

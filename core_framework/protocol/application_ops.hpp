@@ -2,6 +2,7 @@
 // its progress, start, stop, release, configure, query, list, show).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <map>
 #include <optional>
@@ -12,6 +13,35 @@
 
 #include "protocol/codec.hpp"
 #include "protocol/component_ops.hpp"
+
+namespace rsca::protocol {
+namespace application {
+
+// A component's life as the domain sees it, in the order a launch and a release pass through.
+// Exited is final while the application runs: a component that exited is never called again.
+enum class ComponentState : std::uint8_t {
+  Allocated,  // placed, its device's capacity reserved
+  Executed,   // its process started
+  Registered, // it announced itself and was configured and connected
+  Running,
+  Stopped,
+  Exited, // its process ended without being asked to
+  Released
+};
+
+} // namespace application
+
+template <>
+struct EnumNames<application::ComponentState> {
+  using S = application::ComponentState;
+  static constexpr std::array names{
+      std::pair{S::Allocated, "allocated"},   std::pair{S::Executed, "executed"},
+      std::pair{S::Registered, "registered"}, std::pair{S::Running, "running"},
+      std::pair{S::Stopped, "stopped"},       std::pair{S::Exited, "exited"},
+      std::pair{S::Released, "released"}};
+};
+
+} // namespace rsca::protocol
 
 namespace rsca::protocol::application {
 
@@ -63,16 +93,61 @@ struct StepView {
   }
 };
 
-// A running application. Its components and connections are application.cpp's view (to_json),
-// which holds free-form parts (schedules, QoS) and whose component states are being reworked.
+// One component of a running application.
+struct ComponentView {
+  std::string id; // its componentinstantiation id
+  std::string usage_name;
+  std::string node;
+  std::string device;
+  std::string implementation;
+  std::string address; // its control endpoint
+  std::int64_t pid = 0;
+  ComponentState state = ComponentState::Allocated;
+  bool assembly_controller = false;
+  std::optional<Json> schedule; // a periodic component's: allocator/plan_json.hpp's form
+  static constexpr auto fields() {
+    using R = ComponentView;
+    return std::tuple{required("id", &R::id),
+                      required("usage_name", &R::usage_name),
+                      required("node", &R::node),
+                      required("device", &R::device),
+                      required("implementation", &R::implementation),
+                      required("address", &R::address),
+                      required("pid", &R::pid),
+                      required("state", &R::state),
+                      required("assembly_controller", &R::assembly_controller),
+                      optional("schedule", &R::schedule)};
+  }
+};
+
+// One connection of a running application's SAD.
+struct SadConnectionView {
+  std::string id;
+  std::string uses; // "owner.port"; empty: an event channel's publisher side
+  std::string provides;
+  std::string repid;
+  std::string topic;         // empty: a uses port calling a component's supported interface
+  Json qos = Json::object(); // dds/port_qos.hpp's JSON form
+  static constexpr auto fields() {
+    using R = SadConnectionView;
+    return std::tuple{required("id", &R::id),
+                      required("uses", &R::uses),
+                      required("provides", &R::provides),
+                      required("repid", &R::repid),
+                      required("topic", &R::topic),
+                      required("qos", &R::qos)};
+  }
+};
+
+// A running application.
 struct ApplicationView {
   std::string name;
   std::string installed;
   std::string sad;
   std::string state; // "created", "running", "stopped", "failed", or "degraded"
   std::vector<std::string> exited;
-  Json components = Json::array();
-  Json connections = Json::array();
+  std::vector<ComponentView> components;
+  std::vector<SadConnectionView> connections;
   static constexpr auto fields() {
     using R = ApplicationView;
     return std::tuple{required("name", &R::name),

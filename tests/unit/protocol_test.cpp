@@ -216,15 +216,22 @@ TEST_CASE("protocol: a launched application's reply round-trips with its launch"
   reply.sad = "dom/waveforms/PC/PC.sad.xml";
   reply.state = "degraded";
   reply.exited = {"Producer_1"};
-  reply.components = Json::array({{{"id", "Producer_1"}, {"pid", 12}}});
+  protocol::application::ComponentView producer;
+  producer.id = "Producer_1";
+  producer.pid = 12;
+  producer.state = protocol::application::ComponentState::Exited;
+  reply.components = {producer};
   reply.launch = {{{"check", "2 components", 0.5}, {"execute", "failed", 12.25}}, 13.0};
   const Json encoded = protocol::encode(reply);
   CHECK(encoded.at("launch").at("steps")[1].at("detail") == "failed");
   CHECK(encoded.at("connections") == Json::array());
+  CHECK(encoded.at("components")[0].at("state") == "exited");
+  CHECK_FALSE(encoded.at("components")[0].contains("schedule")); // only a periodic one has one
   const auto back = round_trip(reply);
   CHECK(back.name == "PC");
   CHECK(back.exited == std::vector<std::string>{"Producer_1"});
-  CHECK(back.components[0].at("pid") == 12);
+  CHECK(back.components[0].pid == 12);
+  CHECK(back.components[0].state == protocol::application::ComponentState::Exited);
   REQUIRE(back.launch.steps.size() == 2);
   CHECK(back.launch.steps[1].ms == 12.25);
   CHECK(back.launch.ms == 13.0);
@@ -315,8 +322,11 @@ TEST_CASE("protocol: a listed connection keeps a null end state null, and its st
 TEST_CASE("protocol: domain replies round-trip, and an install names its broken file",
           "[protocol]") {
   namespace dom = protocol::domain;
-  const auto nodes = round_trip(dom::NodesReply{{{"node1", "rsca/node/node1", 77, 3}}});
+  const auto nodes = round_trip(dom::NodesReply{{{"node1", "rsca/node/node1", 77, 3}},
+                                                {{"rsca/node/rogue", "missing field \"host\""}}});
   REQUIRE(nodes.nodes.size() == 1);
+  REQUIRE(nodes.refused.size() == 1);
+  CHECK(nodes.refused[0].why == "missing field \"host\"");
   CHECK(nodes.nodes[0].pid == 77);
   CHECK(nodes.nodes[0].devices == 3u);
   const auto channel = round_trip(protocol::connection::ChannelView{

@@ -385,14 +385,13 @@ int show_application(const std::string &name, const GlobalOptions &global) {
                                       : fmt::format(": exited {}", fmt::join(app.exited, ", ")));
         fmt::print("  components:\n");
         for (const auto &c : app.components)
-          fmt::print("    {:<20} {:<16} pid {:<8} {}{}\n", c.value("id", ""), c.value("device", ""),
-                     c.value("pid", 0L), c.value("state", ""),
-                     c.value("assembly_controller", false) ? "  (assembly controller)" : "");
+          fmt::print("    {:<20} {:<16} pid {:<8} {}{}\n", c.id, c.device, c.pid,
+                     protocol::enum_name(c.state),
+                     c.assembly_controller ? "  (assembly controller)" : "");
         if (!app.connections.empty())
           fmt::print("  connections:\n");
         for (const auto &c : app.connections)
-          fmt::print("    {:<16} {} -> {}  [{}]\n", c.value("id", ""), c.value("uses", ""),
-                     c.value("provides", ""), c.value("topic", ""));
+          fmt::print("    {:<16} {} -> {}  [{}]\n", c.id, c.uses, c.provides, c.topic);
       });
 }
 
