@@ -20,17 +20,6 @@ namespace {
 using control::Status;
 namespace op = protocol::node;
 
-struct RunningDevice {
-  std::string id;
-  std::string label;
-  std::string softpkg;
-  std::unique_ptr<LogicalDevice> device;
-  // For the allocator: the PRF's allocation properties and the DCD's deployerrequires.
-  Json allocation;
-  Json deployer_requires;
-  ExecutableDevice *executable() const { return dynamic_cast<ExecutableDevice *>(device.get()); }
-};
-
 // The DCD's property values for one device, keyed by property id and by name.
 Json overrides_of(const profile::ComponentInstantiation &ci, const profile::ResolvedSoftPkg &pkg) {
   Json out = Json::object();
@@ -50,6 +39,19 @@ Json overrides_of(const profile::ComponentInstantiation &ci, const profile::Reso
 } // namespace
 
 struct DeviceManager::Impl {
+  // A member, not in the anonymous namespace: a field of that type in Impl (external linkage) is
+  // an error (-Wsubobject-linkage) once this file is not the main file, in a unity build.
+  struct RunningDevice {
+    std::string id;
+    std::string label;
+    std::string softpkg;
+    std::unique_ptr<LogicalDevice> device;
+    // For the allocator: the PRF's allocation properties and the DCD's deployerrequires.
+    Json allocation;
+    Json deployer_requires;
+    ExecutableDevice *executable() const { return dynamic_cast<ExecutableDevice *>(device.get()); }
+  };
+
   NodeOptions options;
   std::shared_ptr<dds::Participant> participant;
   std::unique_ptr<control::Endpoint> endpoint;

@@ -9,11 +9,12 @@
 namespace rsca::profile {
 namespace {
 
-using Result = tl::expected<void, std::string>;
+using FieldResult = tl::expected<void, std::string>;
 
 // `text` as one of `values`, by their names in the model (profile::to_string).
 template <typename E, std::size_t N>
-Result set_enum(std::optional<E> &field, std::string_view text, const std::array<E, N> &values) {
+FieldResult set_enum(std::optional<E> &field, std::string_view text,
+                     const std::array<E, N> &values) {
   for (E v : values)
     if (text == to_string(v)) {
       field = v;
@@ -28,7 +29,7 @@ Result set_enum(std::optional<E> &field, std::string_view text, const std::array
 // `text` as an integer from `min` to the largest Int (xs:int for transportpriority and strength;
 // xs:positiveInteger for depth, bounded by what DDS takes: an int32).
 template <typename Int, typename Field>
-Result set_integer(std::optional<Field> &field, std::string_view text, Int min) {
+FieldResult set_integer(std::optional<Field> &field, std::string_view text, Int min) {
   constexpr Int kMax = std::numeric_limits<Int>::max();
   Int value{};
   auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
@@ -38,7 +39,7 @@ Result set_integer(std::optional<Field> &field, std::string_view text, Int min) 
   return {};
 }
 
-Result set_duration(std::optional<Duration> &field, std::string_view text) {
+FieldResult set_duration(std::optional<Duration> &field, std::string_view text) {
   auto duration = parse_duration(text);
   if (!duration)
     return tl::unexpected(std::string(
@@ -54,7 +55,7 @@ bool is_qos_attribute(std::string_view name) {
   return std::find(kQosAttributes.begin(), kQosAttributes.end(), name) != kQosAttributes.end();
 }
 
-Result set_qos_attribute(ConnectionQos &qos, std::string_view name, std::string_view text) {
+FieldResult set_qos_attribute(ConnectionQos &qos, std::string_view name, std::string_view text) {
   constexpr auto kInt32Min = std::numeric_limits<std::int32_t>::min();
   if (name == "reliability")
     return set_enum(qos.reliability, text,

@@ -55,7 +55,7 @@ void blank_doctype(std::string &text) {
   }
 }
 
-std::string_view trim(std::string_view s) {
+std::string_view trim_xml_space(std::string_view s) {
   auto first = s.find_first_not_of(" \t\r\n");
   if (first == std::string_view::npos)
     return {};
@@ -91,7 +91,7 @@ std::string XmlElement::child_text(std::string_view child_name) const {
 }
 
 std::string XmlElement::trimmed_text() const {
-  return std::string(trim(text));
+  return std::string(trim_xml_space(text));
 }
 
 Expected<XmlDocument> read_xml_profile_text(std::string_view text, std::string file_name) {

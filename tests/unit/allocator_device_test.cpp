@@ -7,7 +7,7 @@
 #include "allocator/device.hpp"
 
 using namespace rsca;
-using nlohmann::json;
+using Json = nlohmann::json;
 
 namespace {
 
@@ -27,7 +27,7 @@ allocator::Device offline_device(const std::filesystem::path &dcd) {
 
 TEST_CASE("a device from a node's announcement keeps the PRF's ids and actions",
           "[allocator][device]") {
-  const json entry = json::parse(R"({
+  const Json entry = Json::parse(R"({
     "id": "n1:GPP_1", "kind": "gpp",
     "properties": {"os_name": "Linux", "processor_name": "x86_64", "hostname": "robot",
                    "scheduling_policy": "edf"},

@@ -15,7 +15,8 @@ using profile::SimpleType;
 
 namespace {
 
-profile::SimpleProperty simple(std::string id, SimpleType type, std::optional<Scalar> value = {}) {
+profile::SimpleProperty simple_property(std::string id, SimpleType type,
+                                        std::optional<Scalar> value = {}) {
   profile::SimpleProperty p;
   p.id = std::move(id);
   p.type = {type, false};
@@ -38,8 +39,9 @@ profile::StructProperty stream_definition() {
   profile::StructProperty s;
   s.id = "stream";
   s.kinds = {profile::PropertyKind::Property};
-  s.members.emplace_back(simple("stream_id", SimpleType::String, Scalar(std::string("s0"))));
-  s.members.emplace_back(simple("sample_rate", SimpleType::Double));
+  s.members.emplace_back(
+      simple_property("stream_id", SimpleType::String, Scalar(std::string("s0"))));
+  s.members.emplace_back(simple_property("sample_rate", SimpleType::Double));
   profile::SimpleSequenceProperty taps;
   taps.id = "taps";
   taps.type = {SimpleType::Float, false};
@@ -51,15 +53,15 @@ profile::StructProperty stream_definition() {
 
 // A PRF like a component's: read-write, read-only, write-only, allocation-only and unbound ones.
 std::vector<profile::PropertyDefinition> definitions() {
-  auto rate = simple("rate_hz", SimpleType::Double, Scalar(100.0));
+  auto rate = simple_property("rate_hz", SimpleType::Double, Scalar(100.0));
   rate.range = profile::ValueRange{Scalar(0.1), Scalar(1000.0)};
-  auto count = simple("count", SimpleType::ULongLong, Scalar(std::uint64_t{0}));
+  auto count = simple_property("count", SimpleType::ULongLong, Scalar(std::uint64_t{0}));
   count.mode = profile::AccessMode::ReadOnly;
-  auto secret = simple("secret", SimpleType::String);
+  auto secret = simple_property("secret", SimpleType::String);
   secret.mode = profile::AccessMode::WriteOnly;
-  auto capacity = simple("capacity", SimpleType::Long);
+  auto capacity = simple_property("capacity", SimpleType::Long);
   capacity.kinds = {profile::PropertyKind::Allocation};
-  auto mode = simple("mode", SimpleType::Short, Scalar(std::int16_t{0}));
+  auto mode = simple_property("mode", SimpleType::Short, Scalar(std::int16_t{0}));
   mode.enumerations = {{"off", Scalar(std::int16_t{0})}, {"on", Scalar(std::int16_t{1})}};
   profile::SimpleSequenceProperty gains;
   gains.id = "gains";
@@ -72,7 +74,7 @@ std::vector<profile::PropertyDefinition> definitions() {
           mode,
           gains,
           stream_definition(),
-          simple("label", SimpleType::String, Scalar(std::string("none")))};
+          simple_property("label", SimpleType::String, Scalar(std::string("none")))};
 }
 
 // Variables bound to definitions(); "label" stays unbound.
@@ -103,7 +105,7 @@ struct Bound {
   }
 };
 
-std::string error_of(control::CallResult<std::vector<std::function<void()>>> result) {
+std::string configure_error(control::CallResult<std::vector<std::function<void()>>> result) {
   REQUIRE_FALSE(result.has_value());
   CHECK(result.error().status == control::Status::BadRequest);
   return result.error().message;
@@ -194,7 +196,7 @@ TEST_CASE("configure applies all values or none, then runs the change callbacks"
   CHECK(b.rate_changes == std::vector<std::pair<double, double>>{{100.0, 250.0}});
   CHECK(set.query({"label"})->at("label") == "x");
 
-  const auto message = error_of(set.configure(
+  const auto message = configure_error(set.configure(
       {{"rate_hz", 500}, {"count", 1}, {"capacity", 1}, {"unknown", 1}, {"mode", 3}}));
   CHECK_THAT(message, Catch::Contains("property \"count\" is read-only"));
   CHECK_THAT(message,
@@ -202,7 +204,7 @@ TEST_CASE("configure applies all values or none, then runs the change callbacks"
   CHECK_THAT(message, Catch::Contains("unknown property \"unknown\""));
   CHECK_THAT(message, Catch::Contains("property \"mode\": 3 is none of its enumerations"));
   CHECK(b.rate == 250.0); // the valid one was not applied either
-  CHECK(error_of(set.configure(Json::array())) ==
+  CHECK(configure_error(set.configure(Json::array())) ==
         "\"properties\" must be an object of property ids and values");
 
   auto secret = set.query({"secret"});

@@ -22,7 +22,7 @@ ConnectionQos from_json(const Json &json) {
   return *qos;
 }
 
-std::string error_of(const Json &json) {
+std::string qos_error(const Json &json) {
   auto qos = dds::connection_qos_from_json(json);
   REQUIRE_FALSE(qos.has_value());
   return qos.error().diagnostics().at(0).message;
@@ -69,18 +69,18 @@ TEST_CASE("connection QoS: the wire's form reads back as it was written", "[conn
 
 TEST_CASE("connection QoS: values the SAD refuses are refused, quoting an excerpt",
           "[connection_qos]") {
-  CHECK(error_of({{"deadline", 100}}) ==
+  CHECK(qos_error({{"deadline", 100}}) ==
         "\"deadline\" is 100, not a duration such as 100ms, 1.5s or infinite (units ns, us, ms, "
         "s; at most about 292 years)");
-  CHECK(error_of({{"depth", "0"}}) == "\"depth\" is \"0\", not an integer from 1 to 2147483647");
-  CHECK(error_of({{"depth", "4x"}}) == "\"depth\" is \"4x\", not an integer from 1 to 2147483647");
-  CHECK(error_of({{"deadline", "100ms"}, {"deadline_ns", 5}}) ==
+  CHECK(qos_error({{"depth", "0"}}) == "\"depth\" is \"0\", not an integer from 1 to 2147483647");
+  CHECK(qos_error({{"depth", "4x"}}) == "\"depth\" is \"4x\", not an integer from 1 to 2147483647");
+  CHECK(qos_error({{"deadline", "100ms"}, {"deadline_ns", 5}}) ==
         "give \"deadline\" or \"deadline_ns\", not both");
   const std::string huge(100 * 1024, 'x');
-  const std::string bad_value = error_of({{"lease", huge}});
+  const std::string bad_value = qos_error({{"lease", huge}});
   CHECK_THAT(bad_value, Catch::StartsWith("\"lease\" is \"xxxx"));
   CHECK(bad_value.size() < 300);
-  const std::string bad_key = error_of({{huge, 1}});
+  const std::string bad_key = qos_error({{huge, 1}});
   CHECK_THAT(bad_key, Catch::StartsWith("unknown QoS \"xxxx"));
   CHECK(bad_key.size() < 100);
 }

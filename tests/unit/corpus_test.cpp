@@ -6,6 +6,7 @@
 #include "profile/property_binding.hpp"
 #include "profile/sdr_root.hpp"
 #include "temp_dir.hpp"
+#include "test_files.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -23,13 +24,13 @@ using namespace rsca;
 using namespace rsca::profile;
 using Catch::Matchers::Contains;
 using Catch::Matchers::EndsWith;
+using rsca::test::kCorpus;
 using rsca::test::TempDir;
 
 namespace fs = std::filesystem;
 
 namespace {
 
-const fs::path kCorpus = fs::path(RSCA_CORPUS_DIR).lexically_normal();
 const fs::path kWaveforms = kCorpus / "dom/waveforms/rh";
 
 fs::path waveform(const std::string &name) {

@@ -88,10 +88,6 @@ const ComponentInstantiation &instantiation(const SoftwareAssembly &sad, std::st
   return *ci;
 }
 
-Duration ms(long long n) {
-  return Duration{std::chrono::milliseconds(n)};
-}
-
 // A copy of the project's components in an SDR root of its own, removed afterwards.
 class ScratchSdrRoot {
 public:
@@ -161,7 +157,7 @@ TEST_CASE("SAD: the ProducerConsumer application", "[descriptors][sad]") {
   CHECK_FALSE(consumer.timing.has_value());
 
   REQUIRE(producer->timing.has_value());
-  CHECK(producer->timing->period == ms(20));
+  CHECK(producer->timing->period == Duration{20ms});
   CHECK(producer->timing->priority == 10u);
   CHECK_FALSE(producer->timing->deadline.has_value());
   CHECK_FALSE(producer->timing->execution_time.has_value());
@@ -186,7 +182,7 @@ TEST_CASE("SAD: the ProducerConsumer application", "[descriptors][sad]") {
   CHECK(c.qos->reliability == Reliability::Reliable);
   CHECK(c.qos->history == History::KeepLast);
   CHECK(c.qos->depth == 16u);
-  CHECK(c.qos->deadline == ms(100));
+  CHECK(c.qos->deadline == Duration{100ms});
   CHECK_FALSE(c.qos->durability.has_value());
   CHECK_FALSE(c.qos->ownership.has_value());
   CHECK(c.qos->where.line == 50);

@@ -91,7 +91,7 @@ private:
   std::int64_t next_pid_ = 1000;
 };
 
-allocator::Device gpp(const std::string &node) {
+allocator::Device node_gpp(const std::string &node) {
   allocator::Device d;
   d.id = node + ":GPP_1";
   d.node = node;
@@ -105,7 +105,7 @@ allocator::Device gpp(const std::string &node) {
 
 struct Domain {
   Domain() {
-    allocator.set_node_devices("node1", {gpp("node1")});
+    allocator.set_node_devices("node1", {node_gpp("node1")});
     services.domain_name = "test";
     services.endpoint = &caller;
     services.allocator = &allocator;

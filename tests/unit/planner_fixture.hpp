@@ -97,8 +97,8 @@ inline PkgPtr softpkg(const std::string &name, const std::vector<ImplSpec> &impl
 }
 
 // A GPP with os_name / processor_name matching properties and cpu / mem capacities.
-inline Device gpp(std::string id, std::string node, double cpu = 100, double mem = 1024,
-                  std::string os = "Linux", std::string processor = "x86_64") {
+inline Device gpp_device(std::string id, std::string node, double cpu = 100, double mem = 1024,
+                         std::string os = "Linux", std::string processor = "x86_64") {
   Device d;
   d.id = std::move(id);
   d.node = std::move(node);
@@ -123,14 +123,14 @@ inline Device peripheral(std::string id, std::string node, std::vector<MatchingP
   return d;
 }
 
-inline DomainState domain(const std::vector<Device> &devices) {
+inline DomainState domain_state(const std::vector<Device> &devices) {
   DomainState state;
   for (const auto &d : devices)
     state[d.id] = DeviceState{d, {}};
   return state;
 }
 
-inline ComponentRequest component(std::string instance, const PkgPtr &pkg) {
+inline ComponentRequest component_request(std::string instance, const PkgPtr &pkg) {
   ComponentRequest c;
   c.instance = std::move(instance);
   c.softpkg = pkg.get();
@@ -139,7 +139,7 @@ inline ComponentRequest component(std::string instance, const PkgPtr &pkg) {
 
 inline ComponentRequest periodic(std::string instance, const PkgPtr &pkg, std::int64_t period_ms,
                                  std::int64_t execution_ms) {
-  ComponentRequest c = component(std::move(instance), pkg);
+  ComponentRequest c = component_request(std::move(instance), pkg);
   c.timing.emplace();
   c.timing->period = Duration{milliseconds{period_ms}};
   c.timing->execution_time = Duration{milliseconds{execution_ms}};

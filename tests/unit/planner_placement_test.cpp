@@ -22,12 +22,12 @@ using std::chrono::milliseconds;
 // 5
 // ------------------------------------------------------------------------------------------------
 TEST_CASE("planner: host collocation keeps a group on one node", "[planner]") {
-  const auto state = domain({gpp("n1:GPP", "n1"), gpp("n2:GPP", "n2")});
+  const auto state = domain_state({gpp_device("n1:GPP", "n1"), gpp_device("n2:GPP", "n2")});
   const auto spread = with(Strategy::Spread);
 
   SECTION("a group lands on one node although spreading would separate it") {
     auto pkg = softpkg("comp", {ImplSpec("cpp").utilization(0.3)});
-    PlanRequest request = request_of({component("a", pkg), component("b", pkg)});
+    PlanRequest request = request_of({component_request("a", pkg), component_request("b", pkg)});
     // Without the group: a on n1 (equal load, first id), b on n2 (0 % < 30 %).
     const Plan apart = require_plan(make_plan(state, request, spread));
     CHECK(device_of(apart, "a") == "n1:GPP");
@@ -41,7 +41,7 @@ TEST_CASE("planner: host collocation keeps a group on one node", "[planner]") {
 
   SECTION("a group that fits on no single node is rejected although its members fit apart") {
     auto pkg = softpkg("comp", {ImplSpec("cpp").utilization(0.6)});
-    PlanRequest request = request_of({component("a", pkg), component("b", pkg)});
+    PlanRequest request = request_of({component_request("a", pkg), component_request("b", pkg)});
     CHECK(make_plan(state, request).has_value()); // 60 % on each node
     request.components[0].collocation = request.components[1].collocation = "g";
     // 60 + 60 = 120 % > 100 % on either node.
@@ -50,10 +50,11 @@ TEST_CASE("planner: host collocation keeps a group on one node", "[planner]") {
   }
 
   SECTION("collocation is per node: a node's two GPPs can share a group") {
-    const auto two = domain({gpp("n1:GPP_1", "n1"), gpp("n1:GPP_2", "n1"), gpp("n2:GPP", "n2")});
+    const auto two = domain_state(
+        {gpp_device("n1:GPP_1", "n1"), gpp_device("n1:GPP_2", "n1"), gpp_device("n2:GPP", "n2")});
     auto pkg = softpkg("comp", {ImplSpec("cpp").utilization(0.6)});
-    PlanRequest request =
-        request_of({component("a", pkg), component("b", pkg), component("free", pkg)});
+    PlanRequest request = request_of(
+        {component_request("a", pkg), component_request("b", pkg), component_request("free", pkg)});
     request.components[0].collocation = request.components[1].collocation = "g";
     const Plan plan = require_plan(make_plan(two, request));
     // a and b need 60 % each: one per GPP of n1; "free" is not in the group and takes n2.
@@ -69,19 +70,19 @@ TEST_CASE("planner: host collocation keeps a group on one node", "[planner]") {
 TEST_CASE("planner: devicerequires and deployerrequires", "[planner]") {
   // n2:GPP offers (deployerrequires) safety=asil-b; n1:GPP offers nothing. Equal load, so pack
   // would take n1:GPP first for anything.
-  Device offering = gpp("n2:GPP", "n2");
+  Device offering = gpp_device("n2:GPP", "n2");
   offering.deployer_requires["safety"] = "asil-b";
-  const auto state = domain({gpp("n1:GPP", "n1"), offering});
+  const auto state = domain_state({gpp_device("n1:GPP", "n1"), offering});
   auto pkg = softpkg("comp", {ImplSpec("cpp")});
 
   SECTION("a component that requires goes only to the device that offers") {
-    ComponentRequest c = component("c", pkg);
+    ComponentRequest c = component_request("c", pkg);
     c.device_requires.push_back(ref("safety", "asil-b"));
     const Plan plan = require_plan(make_plan(state, request_of({c})));
     CHECK(device_of(plan, "c") == "n2:GPP");
 
     const auto rejections =
-        require_rejection(make_plan(domain({gpp("n1:GPP", "n1")}), request_of({c})));
+        require_rejection(make_plan(domain_state({gpp_device("n1:GPP", "n1")}), request_of({c})));
     CHECK(rejections[0].reasons ==
           std::vector<std::string>{"n1:GPP (cpp): devicerequires safety=asil-b, the device's "
                                    "deployerrequires do not offer it"});
@@ -91,11 +92,11 @@ TEST_CASE("planner: devicerequires and deployerrequires", "[planner]") {
   }
 
   SECTION("a device that offers refuses a component that does not require it") {
-    const Plan plan = require_plan(make_plan(state, request_of({component("c", pkg)})));
+    const Plan plan = require_plan(make_plan(state, request_of({component_request("c", pkg)})));
     CHECK(device_of(plan, "c") == "n1:GPP");
 
-    const auto rejections =
-        require_rejection(make_plan(domain({offering}), request_of({component("c", pkg)})));
+    const auto rejections = require_rejection(
+        make_plan(domain_state({offering}), request_of({component_request("c", pkg)})));
     CHECK(rejections[0].reasons ==
           std::vector<std::string>{"n2:GPP (cpp): deployerrequires safety=asil-b: the device takes "
                                    "only components that require it"});
@@ -105,9 +106,10 @@ TEST_CASE("planner: devicerequires and deployerrequires", "[planner]") {
 // 7
 // ------------------------------------------------------------------------------------------------
 TEST_CASE("planner: explicit assignment", "[planner]") {
-  const auto state = domain({gpp("n1:GPP", "n1"), gpp("n2:GPP", "n2", 100, 1024, "QNX")});
+  const auto state =
+      domain_state({gpp_device("n1:GPP", "n1"), gpp_device("n2:GPP", "n2", 100, 1024, "QNX")});
   auto pkg = softpkg("comp", {ImplSpec("cpp")});
-  ComponentRequest c = component("c", pkg);
+  ComponentRequest c = component_request("c", pkg);
 
   SECTION("honoured over the strategy's preference") {
     c.device = "n2:GPP"; // pack would take n1:GPP (equal load, first id)
@@ -126,7 +128,7 @@ TEST_CASE("planner: explicit assignment", "[planner]") {
 
   SECTION("an assigned device that cannot run it is rejected, though another could") {
     auto linux_only = softpkg("comp", {ImplSpec("cpp").os("Linux")});
-    ComponentRequest l = component("c", linux_only);
+    ComponentRequest l = component_request("c", linux_only);
     l.device = "n2:GPP";
     const auto rejections = require_rejection(make_plan(state, request_of({l})));
     CHECK(rejections[0].reasons ==
@@ -140,12 +142,12 @@ TEST_CASE("planner: usesdevice places on the used device's node and allocates it
   // n2 has a camera with one channel; n1 has none.
   const Device camera = peripheral(
       "n2:camera", "n2", {{"model", "model", "imx219", profile::Action::Eq}}, {{"channels", 1.0}});
-  const auto state = domain({gpp("n1:GPP", "n1"), gpp("n2:GPP", "n2"), camera});
+  const auto state = domain_state({gpp_device("n1:GPP", "n1"), gpp_device("n2:GPP", "n2"), camera});
   const auto cam = uses_device("cam", {ref("model", "imx219"), ref("channels", "1")});
   auto pkg = softpkg("comp", {ImplSpec("cpp").uses(cam)});
 
   SECTION("placed on the GPP of the camera's node, the channel reserved") {
-    const Plan plan = require_plan(make_plan(state, request_of({component("c", pkg)})));
+    const Plan plan = require_plan(make_plan(state, request_of({component_request("c", pkg)})));
     const Placement &p = placement_of(plan, "c");
     CHECK(p.device == "n2:GPP"); // n1 has no device with model imx219
     REQUIRE(p.used_devices.size() == 1);
@@ -156,12 +158,12 @@ TEST_CASE("planner: usesdevice places on the used device's node and allocates it
     commit(committed, plan);
     CHECK(allocated(committed, "n2:camera", "channels") == 1);
     // The channel is taken: the same component again does not fit.
-    CHECK_FALSE(make_plan(committed, request_of({component("c", pkg)})).has_value());
+    CHECK_FALSE(make_plan(committed, request_of({component_request("c", pkg)})).has_value());
   }
 
   SECTION("a second component needing the single channel is rejected") {
     const auto rejections = require_rejection(
-        make_plan(state, request_of({component("c1", pkg), component("c2", pkg)})));
+        make_plan(state, request_of({component_request("c1", pkg), component_request("c2", pkg)})));
     CHECK(rejections[0].instance == "c2");
     CHECK_THAT(to_string(rejections),
                Catch::Contains("usesdevice cam: no device in the domain fits"));
@@ -170,10 +172,10 @@ TEST_CASE("planner: usesdevice places on the used device's node and allocates it
   SECTION("a device on a node without a GPP is used across the network") {
     const Device sensor = peripheral("robot:sensor", "robot",
                                      {{"model", "model", "imx219", profile::Action::Eq}}, {});
-    const auto remote = domain({gpp("n1:GPP", "n1"), sensor});
-    const Plan plan = require_plan(make_plan(
-        remote,
-        request_of({component("c", softpkg("comp", {ImplSpec("cpp").uses(uses_device(
+    const auto remote = domain_state({gpp_device("n1:GPP", "n1"), sensor});
+    const Plan plan = require_plan(
+        make_plan(remote, request_of({component_request(
+                              "c", softpkg("comp", {ImplSpec("cpp").uses(uses_device(
                                                        "cam", {ref("model", "imx219")}))}))})));
     const Placement &p = placement_of(plan, "c");
     CHECK(p.device == "n1:GPP");
@@ -186,7 +188,7 @@ TEST_CASE("planner: usesdevice places on the used device's node and allocates it
     auto twice = softpkg("stereo", {ImplSpec("cpp")
                                         .uses(uses_device("left", {ref("channels", "1")}))
                                         .uses(uses_device("right", {ref("channels", "1")}))});
-    const auto result = make_plan(state, request_of({component("s", twice)}));
+    const auto result = make_plan(state, request_of({component_request("s", twice)}));
     if (result) {
       DomainState committed = state;
       commit(committed, *result);
@@ -198,7 +200,7 @@ TEST_CASE("planner: usesdevice places on the used device's node and allocates it
 
   SECTION("the application's own usesdevice is reserved in application_devices") {
     auto plain = softpkg("plain", {ImplSpec("cpp")});
-    PlanRequest request = request_of({component("c", plain)});
+    PlanRequest request = request_of({component_request("c", plain)});
     request.uses_devices.push_back(cam);
     const Plan plan = require_plan(make_plan(state, request));
     REQUIRE(plan.application_devices.size() == 1);
@@ -217,10 +219,11 @@ TEST_CASE("planner: usesdevice places on the used device's node and allocates it
                                      {{"slots", 1.0}});
     const Device radio2 = peripheral("n2:radio", "n2", {{"band", "band", "x", profile::Action::Eq}},
                                      {{"slots", 1.0}});
-    const auto radios = domain({gpp("n1:GPP", "n1"), radio1, gpp("n2:GPP", "n2"), radio2, camera});
+    const auto radios = domain_state(
+        {gpp_device("n1:GPP", "n1"), radio1, gpp_device("n2:GPP", "n2"), radio2, camera});
     auto linked =
         softpkg("linked", {ImplSpec("cpp").uses(uses_device("link", {ref("slots", "1")}))});
-    PlanRequest request = request_of({component("c", linked)});
+    PlanRequest request = request_of({component_request("c", linked)});
     request.uses_devices = {cam, uses_device("uplink", {ref("band", "s"), ref("slots", "1")})};
     // The plan exists: pinned to n2:GPP (so the search never tries n1), it is found.
     PlanRequest pinned = request;

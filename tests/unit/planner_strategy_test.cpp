@@ -23,9 +23,9 @@ using std::chrono::milliseconds;
 // 11
 // -----------------------------------------------------------------------------------------------
 TEST_CASE("planner: strategies, affinity and determinism", "[planner]") {
-  const auto state = domain({gpp("n1:GPP", "n1"), gpp("n2:GPP", "n2")});
+  const auto state = domain_state({gpp_device("n1:GPP", "n1"), gpp_device("n2:GPP", "n2")});
   auto pkg = softpkg("comp", {ImplSpec("cpp").utilization(0.3)});
-  PlanRequest pair = request_of({component("a", pkg), component("b", pkg)});
+  PlanRequest pair = request_of({component_request("a", pkg), component_request("b", pkg)});
 
   SECTION("pack puts two components on one device, spread on two") {
     // Pack: a on n1 (equal load, first id), then b on the most loaded device that fits: n1.
@@ -60,11 +60,12 @@ TEST_CASE("planner: strategies, affinity and determinism", "[planner]") {
   SECTION("spread: a chain lands as runs of neighbours, a fair share per device") {
     // Six in a chain on three devices: two each, neighbours together (2 connections cross
     // devices, not 5 as alternating would give).
-    const auto three = domain({gpp("n1:GPP", "n1"), gpp("n2:GPP", "n2"), gpp("n3:GPP", "n3")});
+    const auto three = domain_state(
+        {gpp_device("n1:GPP", "n1"), gpp_device("n2:GPP", "n2"), gpp_device("n3:GPP", "n3")});
     auto light = softpkg("light", {ImplSpec("cpp").utilization(0.01)});
     std::vector<ComponentRequest> chain;
     for (const char *id : {"c1", "c2", "c3", "c4", "c5", "c6"})
-      chain.push_back(component(id, light));
+      chain.push_back(component_request(id, light));
     PlanRequest request = request_of(chain);
     for (std::size_t k = 1; k < chain.size(); ++k)
       request.affinities.push_back({chain[k - 1].instance, chain[k].instance, 1.0});
@@ -79,9 +80,9 @@ TEST_CASE("planner: strategies, affinity and determinism", "[planner]") {
 
   SECTION("the same input gives the same plan") {
     auto other = softpkg("other", {ImplSpec("qnx").os("QNX"), ImplSpec("linux").utilization(0.2)});
-    PlanRequest request =
-        request_of({component("a", pkg), component("b", other), periodic("p", pkg, 10, 1),
-                    component("c", pkg), component("d", other)});
+    PlanRequest request = request_of({component_request("a", pkg), component_request("b", other),
+                                      periodic("p", pkg, 10, 1), component_request("c", pkg),
+                                      component_request("d", other)});
     request.components[0].collocation = request.components[3].collocation = "g";
     request.affinities.push_back({"b", "d", 3.0});
     for (const auto strategy : {Strategy::Pack, Strategy::Spread}) {
@@ -110,14 +111,14 @@ TEST_CASE("planner: strategies, affinity and determinism", "[planner]") {
 // -----------------------------------------------------------------------------------------------
 TEST_CASE("planner: ResourceAllocator commits whole plans and gives everything back", "[planner]") {
   ResourceAllocator allocator;
-  allocator.set_node_devices("n1", {gpp("n1:GPP", "n1")});
-  allocator.set_node_devices("n2", {gpp("n2:GPP", "n2")});
+  allocator.set_node_devices("n1", {gpp_device("n1:GPP", "n1")});
+  allocator.set_node_devices("n2", {gpp_device("n2:GPP", "n2")});
   const DomainState empty = allocator.snapshot();
 
   // app1: a (60 %, 512 MiB) and p (C=1,T=10: 10 %). Pack: a on n1 (first id), p follows to n1.
   auto big = softpkg("big", {ImplSpec("cpp").utilization(0.6).memory_mib(512)});
   auto tiny = softpkg("tiny", {ImplSpec("cpp")});
-  const PlanRequest app1 = request_of({component("a", big), periodic("p", tiny, 10, 1)});
+  const PlanRequest app1 = request_of({component_request("a", big), periodic("p", tiny, 10, 1)});
 
   const auto planned = allocator.plan(app1, {});
   REQUIRE(planned.has_value());
@@ -134,7 +135,7 @@ TEST_CASE("planner: ResourceAllocator commits whole plans and gives everything b
 
   SECTION("a rejected allocation leaves the state unchanged") {
     // x and y (60 % each) in one group: n1 has 30 % free, n2 100 %: no node takes 120 %.
-    PlanRequest app2 = request_of({component("x", big), component("y", big)});
+    PlanRequest app2 = request_of({component_request("x", big), component_request("y", big)});
     app2.components[0].collocation = app2.components[1].collocation = "g";
     CHECK_FALSE(allocator.allocate(app2, {}).has_value());
     CHECK(rsca::test::same_load(allocator.snapshot(), after_first));
@@ -152,8 +153,8 @@ TEST_CASE("planner: ResourceAllocator commits whole plans and gives everything b
   }
 
   SECTION("set_node_devices keeps the load of devices that remain") {
-    Device bigger = gpp("n1:GPP", "n1", 200, 2048);
-    allocator.set_node_devices("n1", {bigger, gpp("n1:GPP_2", "n1")});
+    Device bigger = gpp_device("n1:GPP", "n1", 200, 2048);
+    allocator.set_node_devices("n1", {bigger, gpp_device("n1:GPP_2", "n1")});
     const DomainState s = allocator.snapshot();
     REQUIRE(s.size() == 3);
     CHECK(s.at("n1:GPP").device.capacity.at(kCpuCapacity) == 200); // the new description
@@ -163,7 +164,7 @@ TEST_CASE("planner: ResourceAllocator commits whole plans and gives everything b
     CHECK(s.at("n2:GPP").load.allocated == after_first.at("n2:GPP").load.allocated);
 
     // A device the node no longer announces is gone.
-    allocator.set_node_devices("n1", {gpp("n1:GPP_2", "n1")});
+    allocator.set_node_devices("n1", {gpp_device("n1:GPP_2", "n1")});
     CHECK(allocator.snapshot().count("n1:GPP") == 0);
   }
 

@@ -31,7 +31,7 @@ TEST_CASE("planner: timing admission per CPU", "[planner]") {
       request_of({periodic("a", pkg, 5, 2), periodic("b", pkg, 7, 2), periodic("c", pkg, 7, 2)});
 
   SECTION("fixed priority, one CPU: the third task breaks RTA and is rejected") {
-    const auto state = domain({gpp("n1:GPP", "n1")});
+    const auto state = domain_state({gpp_device("n1:GPP", "n1")});
     CHECK(make_plan(state, request_of({three.components[0], three.components[1]})).has_value());
     const auto rejections = require_rejection(make_plan(state, three));
     REQUIRE(rejections.size() == 1);
@@ -42,9 +42,9 @@ TEST_CASE("planner: timing admission per CPU", "[planner]") {
   }
 
   SECTION("two CPUs: the third task goes to the second CPU, with its schedule") {
-    Device d = gpp("n1:GPP", "n1", 200);
+    Device d = gpp_device("n1:GPP", "n1", 200);
     d.cpus = 2;
-    const Plan plan = require_plan(make_plan(domain({d}), three));
+    const Plan plan = require_plan(make_plan(domain_state({d}), three));
     // Pack fills the most loaded CPU first: a and b on CPU 0, c does not fit there -> CPU 1.
     const auto &sa = placement_of(plan, "a").schedule;
     const auto &sb = placement_of(plan, "b").schedule;
@@ -71,12 +71,12 @@ TEST_CASE("planner: timing admission per CPU", "[planner]") {
     // (C=2,T=5), (C=4,T=7): U = 2/5 + 4/7 = 34/35 <= 1 -> EDF schedulable.
     // FP: R_b: w = 4 + 2 = 6, w = 4 + ceil(6/5)*2 = 8 > 7 -> misses.
     const PlanRequest pair = request_of({periodic("a", pkg, 5, 2), periodic("b", pkg, 7, 4)});
-    const auto fp = require_rejection(make_plan(domain({gpp("n1:GPP", "n1")}), pair));
+    const auto fp = require_rejection(make_plan(domain_state({gpp_device("n1:GPP", "n1")}), pair));
     CHECK_THAT(to_string(fp), Catch::Contains("task b"));
 
-    Device edf = gpp("n1:GPP", "n1");
+    Device edf = gpp_device("n1:GPP", "n1");
     edf.policy = SchedulingPolicy::Edf;
-    const Plan plan = require_plan(make_plan(domain({edf}), pair));
+    const Plan plan = require_plan(make_plan(domain_state({edf}), pair));
     const auto &sb = placement_of(plan, "b").schedule;
     REQUIRE(sb);
     CHECK(sb->policy == SchedulingPolicy::Edf);
@@ -91,7 +91,7 @@ TEST_CASE("planner: timing admission per CPU", "[planner]") {
     // R_x = 1, R_y: w = 10 + 1 = 11 -> 10 + ceil(11/4)*1 = 13 -> 10 + 4 = 14 -> 14 <= 100.
     // x must be delivered priority 2: at priority 1 it ties with y and can wait for y's 10 ms
     // (R_x = 1 + 10 = 11 > 4), a deadline miss the admission never checked.
-    const auto state = domain({gpp("n1:GPP", "n1")});
+    const auto state = domain_state({gpp_device("n1:GPP", "n1")});
     const Plan plan = require_plan(
         make_plan(state, request_of({periodic("x", pkg, 4, 1), periodic("y", pkg, 100, 10)})));
     const auto &sx = placement_of(plan, "x").schedule;
@@ -113,7 +113,7 @@ TEST_CASE("planner: timing admission per CPU", "[planner]") {
 // -----------------------------------------------------------------------------------------------
 TEST_CASE("planner: end-to-end latency paths", "[planner]") {
   auto pkg = softpkg("comp", {ImplSpec("cpp")});
-  const auto state = domain({gpp("n1:GPP", "n1")});
+  const auto state = domain_state({gpp_device("n1:GPP", "n1")});
   // One CPU, a (C=2,T=10) above b (C=3,T=20): R_a = 2; R_b: w = 3 + 2 = 5 -> 3 + ceil(5/10)*2 = 5.
   // Path a -> b: R_a + (T_b + R_b) = 2 + 20 + 5 = 27 ms.
   PlanRequest request = request_of({periodic("a", pkg, 10, 2), periodic("b", pkg, 20, 3)});

@@ -29,13 +29,14 @@
 #include "gpp/process_launcher.hpp"
 #include "process/spawn.hpp"
 #include "temp_dir.hpp"
+#include "test_files.hpp"
 
 using namespace std::chrono_literals;
 using rsca::gpp::ExecRequest;
-using rsca::gpp::ExitStatus;
 using rsca::gpp::ProcessId;
 using rsca::gpp::ProcessLauncher;
 using rsca::gpp::TerminateOptions;
+using rsca::test::slurp;
 using rsca::test::TempDir;
 namespace fs = std::filesystem;
 
@@ -47,7 +48,7 @@ using Clock = std::chrono::steady_clock;
 class ExitLog {
 public:
   ProcessLauncher::ExitCallback callback() {
-    return [this](ProcessId pid, ExitStatus status) {
+    return [this](ProcessId pid, rsca::gpp::ExitStatus status) {
       {
         const std::lock_guard lock(mutex_);
         exits_[pid] = status;
@@ -57,7 +58,7 @@ public:
     };
   }
 
-  std::optional<ExitStatus> wait(ProcessId pid, std::chrono::milliseconds timeout) {
+  std::optional<rsca::gpp::ExitStatus> wait(ProcessId pid, std::chrono::milliseconds timeout) {
     std::unique_lock lock(mutex_);
     changed_.wait_for(lock, timeout, [&] { return exits_.count(pid) != 0; });
     const auto it = exits_.find(pid);
@@ -72,7 +73,7 @@ public:
 private:
   mutable std::mutex mutex_;
   std::condition_variable changed_;
-  std::map<ProcessId, ExitStatus> exits_;
+  std::map<ProcessId, rsca::gpp::ExitStatus> exits_;
   int calls_ = 0;
 };
 
@@ -119,13 +120,6 @@ private:
   int fd_ = -1;
   std::string buffer_;
 };
-
-std::string slurp(const fs::path &path) {
-  std::ifstream in(path);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
 
 // Exists in /proc: running, or a zombie nobody has reaped.
 bool process_exists(pid_t pid) {

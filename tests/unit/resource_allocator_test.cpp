@@ -34,7 +34,7 @@ PkgPtr softpkg(const std::string &name, double utilization) {
 }
 
 // A GPP of one CPU (100 % cpu_capacity).
-Device gpp(const std::string &node) {
+Device one_cpu_gpp(const std::string &node) {
   Device d;
   d.id = node + ":GPP";
   d.node = node;
@@ -78,8 +78,8 @@ std::size_t tasks_on(const ResourceAllocator &allocator, const std::string &devi
 // An allocator of two nodes of one GPP each, and a package of a 30 % component.
 struct TwoNodes {
   TwoNodes() {
-    allocator.set_node_devices("n1", {gpp("n1")});
-    allocator.set_node_devices("n2", {gpp("n2")});
+    allocator.set_node_devices("n1", {one_cpu_gpp("n1")});
+    allocator.set_node_devices("n2", {one_cpu_gpp("n2")});
   }
   PkgPtr pkg = softpkg("worker", 0.3);
   ResourceAllocator allocator;
@@ -105,7 +105,7 @@ TEST_CASE_METHOD(TwoNodes,
 
   // n2 goes (its components die with it) and comes back empty.
   allocator.remove_node("n2");
-  allocator.set_node_devices("n2", {gpp("n2")});
+  allocator.set_node_devices("n2", {one_cpu_gpp("n2")});
   CHECK(cpu_allocated(allocator, "n2:GPP") == Approx(0).margin(1e-9));
 
   // B is placed on the new n2; then A is released.
@@ -135,10 +135,10 @@ TEST_CASE_METHOD(
   const auto a = allocator.allocate(spread_app(pkg), {});
   REQUIRE(a.has_value());
   // n2 announces itself without its GPP, then with it again (no remove_node in between).
-  Device other = gpp("n2");
+  Device other = one_cpu_gpp("n2");
   other.id = "n2:GPP_2";
   allocator.set_node_devices("n2", {other});
-  allocator.set_node_devices("n2", {other, gpp("n2")});
+  allocator.set_node_devices("n2", {other, one_cpu_gpp("n2")});
   CHECK(cpu_allocated(allocator, "n2:GPP") == Approx(0).margin(1e-9));
   PlanRequest b_request;
   b_request.components = {pinned("b", pkg, "n2:GPP")};
@@ -152,7 +152,7 @@ TEST_CASE_METHOD(TwoNodes,
                  "[allocator]") {
   const auto a = allocator.allocate(spread_app(pkg), {});
   REQUIRE(a.has_value());
-  allocator.set_node_devices("n2", {gpp("n2")}); // the same devices again
+  allocator.set_node_devices("n2", {one_cpu_gpp("n2")}); // the same devices again
   CHECK(cpu_allocated(allocator, "n2:GPP") == Approx(20));
   allocator.release(*a);
   CHECK(cpu_allocated(allocator, "n2:GPP") == Approx(0).margin(1e-9));

@@ -14,14 +14,16 @@
 
 #include <unistd.h>
 
+#include "test_files.hpp"
+
 using namespace rsca::profile;
 using Catch::Matchers::Contains;
 namespace fs = std::filesystem;
 using Json = nlohmann::json;
+using rsca::test::kCorpus;
 
 namespace {
 
-const fs::path kCorpus = fs::path(RSCA_CORPUS_DIR).lexically_normal();
 const fs::path kOwn = fs::path(RSCA_SOURCE_DIR) / "profiles";
 
 std::vector<fs::path> spds_under(const fs::path &root) {

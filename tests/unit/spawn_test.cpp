@@ -21,22 +21,17 @@
 
 #include "process/spawn.hpp"
 #include "temp_dir.hpp"
+#include "test_files.hpp"
 
 using namespace std::chrono_literals;
 using rsca::process::Child;
 using rsca::process::Command;
 using rsca::process::Group;
+using rsca::test::slurp;
 using rsca::test::TempDir;
 namespace fs = std::filesystem;
 
 namespace {
-
-std::string slurp(const fs::path &path) {
-  std::ifstream in(path);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
 
 Child start(const Command &command, Group group = Group::Own) {
   auto child = rsca::process::spawn(command, group);

@@ -22,7 +22,7 @@ bool mapped(const std::string &library) {
   return false;
 }
 
-const std::filesystem::path kProducer =
+const std::filesystem::path kProducerSpd =
     std::filesystem::path(RSCA_SOURCE_DIR) / "profiles/dom/components/Producer/Producer.spd.xml";
 
 } // namespace
@@ -33,7 +33,7 @@ TEST_CASE("Xerces is in the process only while a loader that read profiles lives
   std::shared_ptr<const profile::ResolvedSoftPkg> softpkg;
   {
     profile::ProfileLoader loader;
-    auto loaded = loader.load_softpkg(kProducer);
+    auto loaded = loader.load_softpkg(kProducerSpd);
     REQUIRE(loaded.has_value());
     softpkg = *loaded;
     CHECK(profile::XmlReader::loaded());
@@ -52,7 +52,7 @@ TEST_CASE("Xerces is in the process only while a loader that read profiles lives
 TEST_CASE("the XML reader loads again after it was unloaded", "[profile][xml]") {
   for (int round = 0; round < 2; ++round) {
     profile::ProfileLoader loader;
-    auto loaded = loader.load_softpkg(kProducer);
+    auto loaded = loader.load_softpkg(kProducerSpd);
     REQUIRE(loaded.has_value());
     CHECK((*loaded)->spd->name == "Producer");
   }
@@ -62,11 +62,11 @@ TEST_CASE("the XML reader loads again after it was unloaded", "[profile][xml]") 
 TEST_CASE("a missing XML reader module is a clear error, not a crash", "[profile][xml]") {
   REQUIRE_FALSE(profile::XmlReader::loaded());
   ::setenv("RSCA_XML_READER", "/nonexistent/librsca_xml_reader.so", 1);
-  auto document = profile::read_xml_profile(kProducer);
+  auto document = profile::read_xml_profile(kProducerSpd);
   ::unsetenv("RSCA_XML_READER");
   REQUIRE_FALSE(document.has_value());
   CHECK_THAT(document.error().to_string(),
              Catch::Contains("cannot load the XML reader module") &&
                  Catch::Contains("/nonexistent/librsca_xml_reader.so"));
-  CHECK(profile::read_xml_profile(kProducer).has_value()); // found where it is by default
+  CHECK(profile::read_xml_profile(kProducerSpd).has_value()); // found where it is by default
 }
