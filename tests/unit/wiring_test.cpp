@@ -16,22 +16,20 @@ namespace {
 using rsca::domain::Wire;
 using rsca::domain::WireEnd;
 using rsca::domain::Wiring;
-namespace control = rsca::control;
-namespace component = rsca::protocol::component;
-using Json = control::Json;
+using Json = rsca::control::Json;
 
 // Answers every call as a component would, except to `fail_at` (an address) or with fewer
 // matched peers than awaited when `match` is false; records each batch of calls.
-class FakeComponents final : public control::Caller {
+class FakeComponents final : public rsca::control::Caller {
 public:
   std::string fail_at;
   bool match = true;
-  std::vector<std::vector<control::Call>> batches;
+  std::vector<std::vector<rsca::control::Call>> batches;
 
-  std::vector<control::CallResult<Json>> call_all(const std::vector<control::Call> &calls,
-                                                  std::chrono::milliseconds) override {
+  std::vector<rsca::control::CallResult<Json>>
+  call_all(const std::vector<rsca::control::Call> &calls, std::chrono::milliseconds) override {
     batches.push_back(calls);
-    std::vector<control::CallResult<Json>> out;
+    std::vector<rsca::control::CallResult<Json>> out;
     for (const auto &c : calls) {
       if (c.target == fail_at) {
         out.emplace_back(tl::unexpect,
@@ -58,18 +56,19 @@ public:
   }
 
 private:
-  Json answer(const control::Call &c) const {
-    if (c.operation != component::AwaitMatched::name)
+  Json answer(const rsca::control::Call &c) const {
+    if (c.operation != rsca::protocol::component::AwaitMatched::name)
       return Json::object();
-    auto request = rsca::protocol::decode<component::AwaitMatchedRequest>(c.body).value();
-    component::AwaitMatchedReply reply{match, request.connections};
+    auto request =
+        rsca::protocol::decode<rsca::protocol::component::AwaitMatchedRequest>(c.body).value();
+    rsca::protocol::component::AwaitMatchedReply reply{match, request.connections};
     for (auto &awaited : reply.connections)
       awaited.matched = match ? awaited.peers : 0;
     return rsca::protocol::encode(reply);
   }
 };
 
-WireEnd end(std::string address, std::string port, std::string host = "") {
+WireEnd end_at(std::string address, std::string port, std::string host = "") {
   return {address, port, "c1", std::move(host), 1, address + "." + port};
 }
 
@@ -83,15 +82,15 @@ TEST_CASE("wiring: readers first, then writers, then one wait per address", "[wi
   FakeComponents fake;
   std::vector<WireEnd> made;
   auto wired = Wiring(fake, std::chrono::milliseconds(100))
-                   .connect({topic_wire(end("a", "out"), end("b", "in"))}, made);
+                   .connect({topic_wire(end_at("a", "out"), end_at("b", "in"))}, made);
   REQUIRE(wired.has_value());
   REQUIRE(fake.batches.size() == 3);
   CHECK(fake.batches[0].at(0).target == "b"); // the reader
   CHECK(fake.batches[1].at(0).target == "a"); // the writer
   CHECK(fake.batches[2].size() == 2);         // a wait at each end
-  CHECK(fake.batches[2].at(0).operation == component::AwaitMatched::name);
+  CHECK(fake.batches[2].at(0).operation == rsca::protocol::component::AwaitMatched::name);
   CHECK(made.size() == 2);
-  const auto connects = fake.requests<component::Connect>();
+  const auto connects = fake.requests<rsca::protocol::component::Connect>();
   REQUIRE(connects.size() == 2);
   CHECK(connects[0].direction == "provides");
   CHECK(connects[0].filter == "range < 2"); // the reader filters
@@ -103,15 +102,15 @@ TEST_CASE("wiring: both ends in one component host take the in-host path", "[wir
   FakeComponents fake;
   std::vector<WireEnd> made;
   REQUIRE(Wiring(fake, std::chrono::milliseconds(100))
-              .connect({topic_wire(end("a", "out", "host1"), end("b", "in", "host1"))}, made)
+              .connect({topic_wire(end_at("a", "out", "host1"), end_at("b", "in", "host1"))}, made)
               .has_value());
-  for (const auto &r : fake.requests<component::Connect>())
+  for (const auto &r : fake.requests<rsca::protocol::component::Connect>())
     CHECK(r.local == true);
   fake.batches.clear();
   REQUIRE(Wiring(fake, std::chrono::milliseconds(100))
-              .connect({topic_wire(end("a", "out", "host1"), end("b", "in", "host2"))}, made)
+              .connect({topic_wire(end_at("a", "out", "host1"), end_at("b", "in", "host2"))}, made)
               .has_value());
-  for (const auto &r : fake.requests<component::Connect>())
+  for (const auto &r : fake.requests<rsca::protocol::component::Connect>())
     CHECK(r.local == false);
 }
 
@@ -120,15 +119,16 @@ TEST_CASE("wiring: a failed writer leaves the reader made, for its caller to und
   fake.fail_at = "a";
   std::vector<WireEnd> made;
   Wiring wiring(fake, std::chrono::milliseconds(100));
-  auto wired = wiring.connect({topic_wire(end("a", "out"), end("b", "in"))}, made);
+  auto wired = wiring.connect({topic_wire(end_at("a", "out"), end_at("b", "in"))}, made);
   REQUIRE_FALSE(wired.has_value());
   CHECK(wired.error().message == "a.out: refused");
   REQUIRE(made.size() == 1);
   CHECK(made[0].address == "b");
-  CHECK(fake.requests<component::AwaitMatched>().empty()); // no wait after a failure
+  CHECK(
+      fake.requests<rsca::protocol::component::AwaitMatched>().empty()); // no wait after a failure
   fake.fail_at.clear();
   CHECK(wiring.disconnect(made).empty());
-  const auto disconnects = fake.requests<component::Disconnect>();
+  const auto disconnects = fake.requests<rsca::protocol::component::Disconnect>();
   REQUIRE(disconnects.size() == 1);
   CHECK(disconnects[0].connection == "c1");
   CHECK(disconnects[0].port == "in");
@@ -139,7 +139,7 @@ TEST_CASE("wiring: ends that do not match in time fail the connect, naming them"
   fake.match = false;
   std::vector<WireEnd> made;
   auto wired = Wiring(fake, std::chrono::milliseconds(100))
-                   .connect({topic_wire(end("a", "out"), end("b", "in"))}, made);
+                   .connect({topic_wire(end_at("a", "out"), end_at("b", "in"))}, made);
   REQUIRE_FALSE(wired.has_value());
   CHECK(wired.error().status == rsca::protocol::Status::Unavailable);
   CHECK_THAT(wired.error().message, Catch::Contains("c1 on port out: 0 of 1 peers matched"));
@@ -149,22 +149,22 @@ TEST_CASE("wiring: ends that do not match in time fail the connect, naming them"
 TEST_CASE("wiring: an interface connection calls its target, with nothing to await", "[wiring]") {
   FakeComponents fake;
   Wire w;
-  w.uses = end("a", "ctl");
+  w.uses = end_at("a", "ctl");
   w.interface_target = "target-address";
   w.repid = "IDL:Ctl:1.0";
   std::vector<WireEnd> made;
   REQUIRE(Wiring(fake, std::chrono::milliseconds(100)).connect({w}, made).has_value());
-  const auto connects = fake.requests<component::Connect>();
+  const auto connects = fake.requests<rsca::protocol::component::Connect>();
   REQUIRE(connects.size() == 1);
   CHECK(connects[0].target == "target-address");
   CHECK_FALSE(connects[0].topic.has_value());
-  CHECK(fake.requests<component::AwaitMatched>().empty());
+  CHECK(fake.requests<rsca::protocol::component::AwaitMatched>().empty());
 }
 
 TEST_CASE("wiring: a failed disconnect is reported by the end's name", "[wiring]") {
   FakeComponents fake;
   fake.fail_at = "b";
-  const auto failed =
-      Wiring(fake, std::chrono::milliseconds(100)).disconnect({end("a", "out"), end("b", "in")});
+  const auto failed = Wiring(fake, std::chrono::milliseconds(100))
+                          .disconnect({end_at("a", "out"), end_at("b", "in")});
   CHECK(failed == std::vector<std::string>{"b.in: refused"});
 }
