@@ -151,7 +151,7 @@ Expected<void> Host::open(std::shared_ptr<dds::Participant> participant,
   // The domain calls next (initialize): the way back to it is made before it asks.
   endpoint_->prepare_replies(domain_address());
   std::lock_guard lock(lifecycle_);
-  return endpoint_->announce(address_, "component", announcement());
+  return endpoint_->announce(address_, "component", protocol::encode(announcement()));
 }
 
 void Host::close() {
@@ -195,13 +195,13 @@ std::vector<protocol::node::DevicePort> Host::ports() const {
   return ports;
 }
 
-Json Host::announcement() const {
-  return {{"id", c().identifier()},
-          {"name", c().name()},
-          {"application", c().context().application},
-          {"pid", ::getpid()},
-          {"state", to_string(c().state())},
-          {"ports", protocol::encode(ports())}};
+protocol::component::Announcement Host::announcement() const {
+  return {c().identifier(),
+          c().name(),
+          c().context().application,
+          ::getpid(),
+          std::string(to_string(c().state())),
+          ports()};
 }
 
 // Called with lifecycle_ held.
@@ -210,7 +210,7 @@ void Host::set_state(State state) {
   log().info("{}", to_string(state));
   if (state == State::Released || !endpoint_)
     return;
-  if (auto ok = endpoint_->announce(address_, "component", announcement()); !ok)
+  if (auto ok = endpoint_->announce(address_, "component", protocol::encode(announcement())); !ok)
     log().warn("updating the announcement failed: {}", ok.error().to_string());
 }
 

@@ -68,7 +68,7 @@ private:
   void serve_operations();
   template <typename Op>
   void serve(Operation<Op> op);
-  Json announcement() const;
+  protocol::component::Announcement announcement() const;
   void set_state(State state);
   PortBase *find_port(const std::string &name) const;
   ResourceUsesPort *find_resource_port(const std::string &name) const;

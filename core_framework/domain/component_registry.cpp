@@ -29,12 +29,11 @@ std::vector<std::string> ComponentRegistry::node_gone(const std::string &node,
   return gone;
 }
 
-void ComponentRegistry::announced(const std::string &address, const nlohmann::json &body) {
+void ComponentRegistry::announced(const std::string &address) {
   {
     std::lock_guard lock(mutex_);
     auto &e = entries_[address];
     e.registered = true;
-    e.body = body;
   }
   changed_.notify_all();
 }
@@ -74,14 +73,6 @@ bool ComponentRegistry::registered(const std::string &address) const {
   std::lock_guard lock(mutex_);
   auto it = entries_.find(address);
   return it != entries_.end() && it->second.registered && !it->second.exited;
-}
-
-std::optional<nlohmann::json> ComponentRegistry::announcement(const std::string &address) const {
-  std::lock_guard lock(mutex_);
-  auto it = entries_.find(address);
-  if (it == entries_.end() || !it->second.registered)
-    return std::nullopt;
-  return it->second.body;
 }
 
 control::CallResult<void>

@@ -10,8 +10,6 @@
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
 #include "control/endpoint.hpp"
 
 namespace rsca::domain {
@@ -21,7 +19,7 @@ public:
   // A launch is about to start a component at this address: from now on its registration and
   // exit count. Exits of addresses nobody expects (released components) are ignored.
   void expect(const std::string &address, const std::string &node);
-  void announced(const std::string &address, const nlohmann::json &body);
+  void announced(const std::string &address);
   // Its endpoint disappeared from DDS: not registered until it announces itself again.
   void gone(const std::string &address);
   void exited(const std::string &address, const std::string &why);
@@ -31,7 +29,6 @@ public:
   void forget(const std::string &address);
 
   bool registered(const std::string &address) const;
-  std::optional<nlohmann::json> announcement(const std::string &address) const;
 
   // Waits until every address has registered; fails at once when one of them exits or when
   // `cancelled` (if given) is set and interrupt() called, or when `quiet` passes without one more
@@ -55,7 +52,6 @@ private:
     bool exited = false;
     std::string node;
     std::string why;
-    nlohmann::json body;
   };
   mutable std::mutex mutex_;
   std::condition_variable changed_;

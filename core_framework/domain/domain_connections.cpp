@@ -221,34 +221,43 @@ void DomainManager::Impl::node_gone(const std::string &address) {
 
 // A component announced itself. One that an earlier run of this domain daemon launched (its
 // address carries another incarnation) is running without an application this run knows: it is
-// reported, once, and never taken for a component of a launch of this run.
+// reported, once, and never taken for a component of a launch of this run. An announcement that
+// does not decode breaks the contract: the component is taken for exited, with why, so that a
+// launch waiting for it fails at once and names the field.
 void DomainManager::Impl::component_announced(const control::AnnouncementEvent &event) {
+  auto announced = protocol::decode<protocol::component::Announcement>(event.body);
+  if (!announced) {
+    const auto why = fmt::format("its announcement is not taken: {}", announced.error());
+    spdlog::warn("component {}: {}", excerpt(event.address), why);
+    components.exited(event.address, why);
+    return;
+  }
   const auto launched_by = protocol::incarnation_of(event.address);
   if (!launched_by || *launched_by == incarnation) {
-    components.announced(event.address, event.body);
+    components.announced(event.address);
     return;
   }
   std::lock_guard lock(unknown_mutex);
   const bool first = unknown.count(event.address) == 0;
-  unknown[event.address] = {event.address, event.body};
+  unknown[event.address] = {event.address, std::move(*announced)};
   if (!first)
     return;
+  const auto &a = unknown[event.address].announcement;
   spdlog::warn("component {} (pid {}) runs but no application of this domain daemon launched "
                "it: an earlier run (incarnation {}, this one is {}) did; stop it by hand or "
                "restart its node",
-               event.address, event.body.value("pid", 0), *launched_by, incarnation);
+               event.address, a.pid, *launched_by, incarnation);
   events->publish("component.unknown", {{"address", event.address},
-                                        {"application", event.body.value("application", "")},
-                                        {"component", event.body.value("id", "")},
-                                        {"pid", event.body.value("pid", 0)}});
+                                        {"application", a.application},
+                                        {"component", a.id},
+                                        {"pid", a.pid}});
 }
 
 std::vector<app_ops::UnknownComponent> DomainManager::Impl::unknown_components() {
   std::lock_guard lock(unknown_mutex);
   std::vector<app_ops::UnknownComponent> list;
   for (const auto &[address, u] : unknown)
-    list.push_back({address, u.announcement.value("application", ""),
-                    u.announcement.value("id", ""), u.announcement.value("pid", 0)});
+    list.push_back({address, u.announcement.application, u.announcement.id, u.announcement.pid});
   return list;
 }
 

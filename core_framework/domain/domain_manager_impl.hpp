@@ -24,6 +24,7 @@
 #include "domain/launch_tracker.hpp"
 #include "domain/node_directory.hpp"
 #include "protocol/application_ops.hpp"
+#include "protocol/component_ops.hpp"
 #include "protocol/connection_ops.hpp"
 #include "protocol/domain_ops.hpp"
 
@@ -38,7 +39,7 @@ namespace domain_ops = protocol::domain;
 // a domain daemon that was killed, or by another domain on the same DDS domain and tag.
 struct UnknownComponent {
   std::string address;
-  control::Json announcement;
+  protocol::component::Announcement announcement;
 };
 
 struct DomainManager::Impl {

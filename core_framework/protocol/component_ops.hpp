@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "protocol/codec.hpp"
+#include "protocol/node_ops.hpp"
 
 namespace rsca::protocol::component {
 
@@ -104,6 +105,28 @@ struct StatusReply {
   static constexpr auto fields() {
     return std::tuple{required("state", &StatusReply::state),
                       required("ports", &StatusReply::ports)};
+  }
+};
+
+// What a component announces (announcement kind "component") when it registers and at each
+// change of its state. The domain takes a component for registered on it; an announcement that
+// does not decode is not taken (component/host.cpp builds it, domain/domain_connections.cpp
+// reads it).
+struct Announcement {
+  std::string id;          // the component instance's id in its SAD
+  std::string name;        // its usage name
+  std::string application; // the application's name
+  std::int64_t pid = 0;    // the process it runs in (a component host's, when hosted)
+  std::string state;       // the runtime's lifecycle state (component/component.hpp), for people
+  std::vector<node::DevicePort> ports;
+  static constexpr auto fields() {
+    using R = Announcement;
+    return std::tuple{required("id", &R::id),
+                      required("name", &R::name),
+                      required("application", &R::application),
+                      required("pid", &R::pid),
+                      required("state", &R::state),
+                      required("ports", &R::ports)};
   }
 };
 

@@ -32,7 +32,7 @@ TEST_CASE("the wait ends when every component has registered", "[unit][registry]
   auto addresses = expect_all(registry, 3);
   std::thread announcer([&] {
     for (const auto &a : addresses)
-      registry.announced(a, nlohmann::json::object());
+      registry.announced(a);
   });
   auto ok = registry.wait_registered(addresses, 10s);
   announcer.join();
@@ -49,7 +49,7 @@ TEST_CASE("registrations that keep coming extend the wait beyond one quiet inter
   std::thread announcer([&] {
     for (const auto &a : addresses) {
       std::this_thread::sleep_for(150ms); // the pace of the stimulus, not a wait for a condition
-      registry.announced(a, nlohmann::json::object());
+      registry.announced(a);
     }
   });
   auto ok = registry.wait_registered(addresses, quiet);
@@ -63,7 +63,7 @@ TEST_CASE("a quiet interval without a registration fails and names who is missin
           "[unit][registry]") {
   ComponentRegistry registry;
   auto addresses = expect_all(registry, 3);
-  registry.announced(addresses[0], nlohmann::json::object());
+  registry.announced(addresses[0]);
   auto ok = registry.wait_registered(addresses, 50ms);
   REQUIRE_FALSE(ok.has_value());
   CHECK(ok.error().status == Status::Timeout);
@@ -86,10 +86,10 @@ TEST_CASE("an endpoint that disappears is waited for again, not taken for an exi
           "[unit][registry]") {
   ComponentRegistry registry;
   auto addresses = expect_all(registry, 1);
-  registry.announced(addresses[0], nlohmann::json::object());
+  registry.announced(addresses[0]);
   registry.gone(addresses[0]); // its DDS lease ran out while its process lives on
   CHECK_FALSE(registry.registered(addresses[0]));
-  std::thread announcer([&] { registry.announced(addresses[0], nlohmann::json::object()); });
+  std::thread announcer([&] { registry.announced(addresses[0]); });
   auto ok = registry.wait_registered(addresses, 10s);
   announcer.join();
   CHECK(ok.has_value());
@@ -100,7 +100,7 @@ TEST_CASE("a cancelled wait ends when interrupted, long before its quiet interva
           "[unit][registry]") {
   ComponentRegistry registry;
   auto addresses = expect_all(registry, 2);
-  registry.announced(addresses[0], nlohmann::json::object());
+  registry.announced(addresses[0]);
   std::atomic<bool> cancelled{false};
   std::thread canceller([&] {
     cancelled = true;
@@ -120,7 +120,7 @@ TEST_CASE("a wait cancelled before it began still counts who had registered", "[
   // The interrupt may come before the wait's first look (CI saw "0 of 2" here).
   ComponentRegistry registry;
   auto addresses = expect_all(registry, 2);
-  registry.announced(addresses[0], nlohmann::json::object());
+  registry.announced(addresses[0]);
   std::atomic<bool> cancelled{true};
   auto ok = registry.wait_registered(addresses, 1h, &cancelled);
   REQUIRE_FALSE(ok.has_value());
@@ -133,7 +133,7 @@ TEST_CASE("an interrupt without a cancellation leaves a wait waiting", "[unit][r
   std::atomic<bool> cancelled{false};
   std::thread other([&] {
     registry.interrupt(); // another launch's cancel
-    registry.announced(addresses[0], nlohmann::json::object());
+    registry.announced(addresses[0]);
   });
   auto ok = registry.wait_registered(addresses, 10s, &cancelled);
   other.join();

@@ -67,7 +67,7 @@ private:
       started.insert(pid);
       if (register_components)
         for (const auto &address : protocol::control_addresses(request->args))
-          registry_.announced(address, Json{{"pid", pid}});
+          registry_.announced(address);
       return protocol::encode(protocol::node::ExecuteReply{pid, "/tmp/fake.log"});
     }
     if (c.operation == protocol::node::Terminate::name) {

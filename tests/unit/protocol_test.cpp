@@ -64,6 +64,24 @@ TEST_CASE("protocol: nested messages round-trip", "[protocol]") {
   CHECK(back.processes[0].pid == 7);
 }
 
+TEST_CASE("protocol: a component's announcement round-trips, and one without its pid is refused",
+          "[protocol]") {
+  const protocol::component::Announcement a{
+      "C_1", "C", "app", 42, "initialized", {{"samples_out", "uses", "IDL:rsca/Samples:1.0"}}};
+  const auto back = round_trip(a);
+  CHECK(back.id == "C_1");
+  CHECK(back.pid == 42);
+  CHECK(back.state == "initialized");
+  REQUIRE(back.ports.size() == 1);
+  CHECK(back.ports[0].direction == "uses");
+
+  Json without_pid = protocol::encode(a);
+  without_pid.erase("pid");
+  const auto refused = protocol::decode<protocol::component::Announcement>(without_pid);
+  REQUIRE_FALSE(refused.has_value());
+  CHECK_THAT(refused.error(), Catch::Contains("pid"));
+}
+
 TEST_CASE("protocol: a malformed message names the field and what is wrong", "[protocol]") {
   using protocol::decode;
   using protocol::node::ExecuteRequest;
