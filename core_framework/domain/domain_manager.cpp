@@ -35,13 +35,6 @@ std::vector<app_ops::StepView> steps_of(const std::vector<LaunchStep> &steps) {
   return out;
 }
 
-InstallRequest install_request_of(const domain_ops::InstallRequest &wire) {
-  InstallRequest request{wire.sad, {}, wire.name};
-  for (const auto &f : wire.files)
-    request.files.push_back({f.path, f.content});
-  return request;
-}
-
 // The strategy a launch or plan request names, if any.
 CallResult<std::optional<allocator::Strategy>> strategy_of(const std::optional<std::string> &name) {
   if (!name)
@@ -95,7 +88,7 @@ ApplicationFactory::ApplyChange DomainManager::Impl::apply_to(const std::string 
 
 CallResult<domain_ops::InstallReply>
 DomainManager::Impl::install(const domain_ops::InstallRequest &request) {
-  auto installed = repository->install(install_request_of(request));
+  auto installed = repository->install(request);
   if (!installed)
     return tl::unexpected(installed.error());
   spdlog::info("installed application {} ({} files)", installed->name, request.files.size());

@@ -21,6 +21,7 @@
 #include "control/endpoint.hpp"
 #include "domain/domain_store.hpp"
 #include "profile/profile_loader.hpp"
+#include "protocol/domain_ops.hpp"
 
 namespace rsca::domain {
 
@@ -30,16 +31,9 @@ struct InstalledApplication {
   std::shared_ptr<const profile::ResolvedApplication> profile;
 };
 
-struct InstallFile {
-  std::string path; // relative to the SDR root the profiles came from
-  std::string content;
-};
-
-struct InstallRequest {
-  std::string sad; // the SAD's path among the files
-  std::vector<InstallFile> files;
-  std::optional<std::string> name; // the SAD's name (or id) when not given
-};
+// What to install: the SAD and every file it needs, as `domain.install` carries them.
+using InstallFile = protocol::domain::InstallFile;
+using InstallRequest = protocol::domain::InstallRequest;
 
 class InstalledRepository {
 public:
