@@ -14,6 +14,7 @@
 #include "component/in_process.hpp"
 #include "component/process.hpp"
 #include "component/runtime.hpp"
+#include "control/node_link.hpp"
 
 namespace rsca::component {
 
@@ -66,18 +67,28 @@ Context context_of(const ExecParams &p) {
                  p.schedule};
 }
 
-// The host's one control endpoint, serving every component's address too. Its workers run the
-// batches of calls the domain sends for all the host's components at once.
-Expected<std::shared_ptr<control::Endpoint>>
-open_endpoint(const HostParams &host, std::shared_ptr<dds::Participant> participant) {
+// The host's one control presence, serving every component's address too: its link to the node
+// that started it, else an endpoint of its own on DDS. Its workers run the batches of calls the
+// domain sends for all the host's components at once.
+Expected<std::shared_ptr<control::Server>> open_server(const HostParams &host,
+                                                       ParticipantSource &participants) {
+  if (auto link = control::NodeLink::inherited()) {
+    auto opened = control::NodeLink::open(std::move(*link), host.control_address);
+    if (!opened)
+      return tl::unexpected(opened.error());
+    return std::shared_ptr<control::Server>(std::move(*opened));
+  }
+  auto participant = participants.get();
+  if (!participant)
+    return tl::unexpected(participant.error());
   control::EndpointOptions options{
       .workers = 4, .senders = 2, .on_announcement = {}, .aliases = {}, .prepare_kinds = {}};
   for (const auto &h : host.components)
     options.aliases.push_back(h.control_address);
-  auto endpoint = control::Endpoint::open(std::move(participant), host.control_address, options);
+  auto endpoint = control::Endpoint::open(*participant, host.control_address, options);
   if (!endpoint)
     return tl::unexpected(endpoint.error());
-  return std::shared_ptr<control::Endpoint>(std::move(*endpoint));
+  return std::shared_ptr<control::Server>(std::move(*endpoint));
 }
 
 int serve_hosted(const HostParams &host, const ExitEvents &events, spdlog::logger &log) {
@@ -90,12 +101,8 @@ int serve_hosted(const HostParams &host, const ExitEvents &events, spdlog::logge
     log.error("{}", softpkgs.error());
     return kExitProfile;
   }
-  auto participant = dds::Participant::create(dds::DdsSettings::from_environment());
-  if (!participant) {
-    log.error("{}", participant.error().to_string());
-    return kExitFailure;
-  }
-  auto endpoint = open_endpoint(host, *participant);
+  auto participants = std::make_shared<ParticipantSource>();
+  auto endpoint = open_server(host, *participants);
   if (!endpoint) {
     log.error("{}", endpoint.error().to_string());
     return kExitFailure;
@@ -113,7 +120,7 @@ int serve_hosted(const HostParams &host, const ExitEvents &events, spdlog::logge
       log.error("{}: {}", h.identifier, factory.error());
       return kExitFailure;
     }
-    auto component = InProcessComponent::open(*factory, context_of(h), (*softpkgs)[i], *participant,
+    auto component = InProcessComponent::open(*factory, context_of(h), (*softpkgs)[i], participants,
                                               h.others, on_released, *endpoint);
     if (!component) {
       log.error("{}: {}", h.identifier, component.error().to_string());

@@ -118,6 +118,8 @@ CallResult<protocol::Empty> Host::connect_resource_port(ResourceUsesPort &port,
   std::lock_guard lock(lifecycle_);
   if (c().state() == State::Released)
     return released();
+  if (r.via && !r.via->empty())
+    endpoint_->route(target, *r.via);
   port.connect(r.connection, target, endpoint_);
   log().info("port {}: connection {} to the component at {}", port.name(), r.connection, target);
   return Empty{};
@@ -161,8 +163,16 @@ CallResult<protocol::Empty> Host::op_connect(const op::ConnectRequest &r, const 
   if (c().state() == State::Released)
     return released();
   const bool local = r.local.value_or(false); // the other end is in this process
-  if (auto ok = port->connect(participant_->get(), loop_.get(), r.connection, topic, qos->get(),
-                              std::move(filter), local);
+  // In-host connections need no DDS: the process joins DDS at its first connection that does.
+  std::shared_ptr<dds::Participant> participant;
+  if (!local) {
+    auto joined = participants_->get();
+    if (!joined)
+      return control::call_error(Status::Failed, joined.error().to_string());
+    participant = std::move(*joined);
+  }
+  if (auto ok = port->connect(participant ? participant->get() : 0, loop_.get(), r.connection,
+                              topic, qos->get(), std::move(filter), local);
       !ok)
     return control::call_error(Status::Failed, ok.error());
   watch_connections();

@@ -129,10 +129,10 @@ Expected<void> Host::prepare(const std::vector<std::pair<std::string, std::strin
   return {};
 }
 
-Expected<void> Host::open(std::shared_ptr<dds::Participant> participant,
-                          std::shared_ptr<control::Endpoint> endpoint,
+Expected<void> Host::open(std::shared_ptr<ParticipantSource> participants,
+                          std::shared_ptr<control::Server> endpoint,
                           std::function<void()> on_released, control::EndpointOptions options) {
-  participant_ = std::move(participant);
+  participants_ = std::move(participants);
   on_released_ = std::move(on_released);
   address_ = c().context().control_address;
   auto loop = ReceiveLoop::start([this] { poll_ports(); });
@@ -141,7 +141,10 @@ Expected<void> Host::open(std::shared_ptr<dds::Participant> participant,
   loop_ = std::move(*loop);
   configure_thread(loop_->thread(), "rx:");
   if (!endpoint) {
-    auto own = control::Endpoint::open(participant_, address_, std::move(options));
+    auto participant = participants_->get();
+    if (!participant)
+      return tl::unexpected(participant.error());
+    auto own = control::Endpoint::open(*participant, address_, std::move(options));
     if (!own)
       return tl::unexpected(own.error());
     endpoint = std::move(*own);
@@ -168,7 +171,7 @@ void Host::close() {
   endpoint_.reset();
   component_.reset(); // its ports detach from the stopped loop
   loop_.reset();
-  participant_.reset();
+  participants_.reset();
 }
 
 Expected<void> Host::bring_up(const Json &properties) {
@@ -201,7 +204,8 @@ protocol::component::Announcement Host::announcement() const {
           c().context().application,
           ::getpid(),
           std::string(to_string(c().state())),
-          ports()};
+          ports(),
+          std::nullopt};
 }
 
 // Called with lifecycle_ held.

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "component/component.hpp"
+#include "component/participant_source.hpp"
 #include "component/receive_loop.hpp"
 #include "control/endpoint.hpp"
 #include "dds/participant.hpp"
@@ -42,12 +43,13 @@ public:
   // defaults and the execparams (DEBUG_LEVEL sets the log level).
   Expected<void> prepare(const std::vector<std::pair<std::string, std::string>> &execparams);
   // Starts the receive thread, serves the operations at the component's control address and
-  // announces it there: on `endpoint` when given (its host's, which has the address among its
-  // aliases), else on an endpoint of its own opened with `options`. `on_released` runs once the
-  // component is released, by component.release or shutdown.
-  Expected<void> open(std::shared_ptr<dds::Participant> participant,
-                      std::shared_ptr<control::Endpoint> endpoint,
-                      std::function<void()> on_released, control::EndpointOptions options = {});
+  // announces it there: on `server` when given (its host's, which serves the address too, or
+  // the process's link to its node), else on an endpoint of its own opened with `options` on
+  // the participant. Data connections over DDS join the participant `participants` gives.
+  // `on_released` runs once the component is released, by component.release or shutdown.
+  Expected<void> open(std::shared_ptr<ParticipantSource> participants,
+                      std::shared_ptr<control::Server> server, std::function<void()> on_released,
+                      control::EndpointOptions options = {});
   // Stops (when started) and releases the component and drops its connections. Idempotent.
   void shutdown(std::string_view why);
   // Initializes, configures with `properties` and starts the component: what the domain would
@@ -106,9 +108,9 @@ private:
 
   std::unique_ptr<Component> component_;
   std::shared_ptr<const profile::ResolvedSoftPkg> softpkg_;
-  std::shared_ptr<dds::Participant> participant_;
+  std::shared_ptr<ParticipantSource> participants_;
   std::unique_ptr<ReceiveLoop> loop_;
-  std::shared_ptr<control::Endpoint> endpoint_;
+  std::shared_ptr<control::Server> endpoint_;
   std::string address_; // the component's control address
   std::function<void()> on_released_;
 

@@ -17,10 +17,10 @@ InProcessComponent::~InProcessComponent() {
 Expected<std::unique_ptr<InProcessComponent>>
 InProcessComponent::open(const Factory &factory, Context context,
                          std::shared_ptr<const profile::ResolvedSoftPkg> softpkg,
-                         std::shared_ptr<dds::Participant> participant,
+                         std::shared_ptr<ParticipantSource> participants,
                          const std::vector<std::pair<std::string, std::string>> &execparams,
                          std::function<void()> on_released,
-                         std::shared_ptr<control::Endpoint> endpoint) {
+                         std::shared_ptr<control::Server> server) {
   const std::string address = context.control_address;
   const std::string where = softpkg->spd_path.string();
   std::unique_ptr<Component> component;
@@ -37,7 +37,7 @@ InProcessComponent::open(const Factory &factory, Context context,
   const control::EndpointOptions options{
       .workers = 2, .senders = 1, .on_announcement = {}, .aliases = {}, .prepare_kinds = {}};
   if (auto opened =
-          host->open(std::move(participant), std::move(endpoint), std::move(on_released), options);
+          host->open(std::move(participants), std::move(server), std::move(on_released), options);
       !opened)
     return tl::unexpected(opened.error());
   return std::unique_ptr<InProcessComponent>(new InProcessComponent(std::move(host), address));

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "component/component.hpp"
+#include "component/participant_source.hpp"
 #include "component/runtime.hpp"
 #include "control/endpoint.hpp"
 #include "dds/participant.hpp"
@@ -26,16 +27,16 @@ class Host;
 class InProcessComponent {
 public:
   // Constructs the component, checks it against its profile (PRF and SCD), applies `execparams`
-  // and serves it at `context.control_address` on `participant`: through `endpoint` when given
-  // (a component host's, with that address among its aliases), else through one of its own.
-  // `on_released` runs once the domain has released it (component.release).
+  // and serves it at `context.control_address`: through `server` when given (a component
+  // host's endpoint, with that address among its aliases, or its link to its node), else through
+  // an endpoint of its own on the participant. Its DDS data connections join the participant
+  // `participants` gives. `on_released` runs once the domain has released it (component.release).
   static Expected<std::unique_ptr<InProcessComponent>>
   open(const Factory &factory, Context context,
        std::shared_ptr<const profile::ResolvedSoftPkg> softpkg,
-       std::shared_ptr<dds::Participant> participant,
+       std::shared_ptr<ParticipantSource> participants,
        const std::vector<std::pair<std::string, std::string>> &execparams = {},
-       std::function<void()> on_released = {},
-       std::shared_ptr<control::Endpoint> endpoint = nullptr);
+       std::function<void()> on_released = {}, std::shared_ptr<control::Server> server = nullptr);
   ~InProcessComponent(); // stops and releases the component, then withdraws it
   InProcessComponent(const InProcessComponent &) = delete;
   InProcessComponent &operator=(const InProcessComponent &) = delete;

@@ -15,7 +15,7 @@ std::map<std::string, ResourceUsesPort::Target> ResourceUsesPort::targets() cons
 }
 
 void ResourceUsesPort::connect(const std::string &connection, const std::string &target,
-                               std::weak_ptr<control::Endpoint> endpoint) {
+                               std::weak_ptr<control::Server> endpoint) {
   std::lock_guard lock(mutex_);
   targets_[connection] = Target{target, 0};
   endpoint_ = std::move(endpoint);
@@ -36,7 +36,7 @@ control::CallResult<std::map<std::string, typename Op::Reply>>
 ResourceUsesPort::call_each(const typename Op::Request &request,
                             std::chrono::milliseconds timeout) {
   std::map<std::string, Target> targets;
-  std::shared_ptr<control::Endpoint> endpoint;
+  std::shared_ptr<control::Server> endpoint;
   {
     // The calls run without the lock: a disconnect meanwhile does not wait for them.
     std::lock_guard lock(mutex_);

@@ -21,7 +21,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "control/endpoint.hpp"
+#include "control/server.hpp"
 
 namespace rsca::component {
 
@@ -56,7 +56,7 @@ public:
 
   // For the runtime: `connect` replaces a connection of the same id.
   void connect(const std::string &connection, const std::string &target,
-               std::weak_ptr<control::Endpoint> endpoint);
+               std::weak_ptr<control::Server> endpoint);
   bool disconnect(const std::string &connection);
   void disconnect_all();
 
@@ -69,7 +69,7 @@ private:
   std::string name_;
   mutable std::mutex mutex_;
   std::map<std::string, Target> targets_; // by connection id
-  std::weak_ptr<control::Endpoint> endpoint_;
+  std::weak_ptr<control::Server> endpoint_;
 };
 
 } // namespace rsca::component

@@ -23,6 +23,7 @@
 #include "common/exec_environment.hpp"
 #include "component/host.hpp"
 #include "component/process.hpp"
+#include "control/node_link.hpp"
 
 namespace rsca::component {
 
@@ -86,12 +87,20 @@ int run_host(const ExecParams &params, const ExitEvents &events, const Factory &
     logger->error("the component does not fit its profile:\n{}", prepared.error().to_string());
     return kExitProfile;
   }
-  auto participant = dds::Participant::create(dds::DdsSettings::from_environment());
-  if (!participant) {
-    logger->error("{}", participant.error().to_string());
-    return kExitFailure;
+  // Started by a node, the process talks to the control plane through it and joins DDS only
+  // for a data connection that needs DDS; started otherwise, it opens its own endpoint.
+  auto participants = std::make_shared<ParticipantSource>();
+  std::shared_ptr<control::Server> server;
+  if (auto link = control::NodeLink::inherited()) {
+    auto opened = control::NodeLink::open(std::move(*link), params.control_address);
+    if (!opened) {
+      logger->error("{}", opened.error().to_string());
+      return kExitFailure;
+    }
+    server = std::move(*opened);
   }
-  if (auto opened = host.open(*participant, nullptr, [&events] { events.notify_released(); });
+  if (auto opened =
+          host.open(participants, std::move(server), [&events] { events.notify_released(); });
       !opened) {
     logger->error("{}", opened.error().to_string());
     return kExitFailure;

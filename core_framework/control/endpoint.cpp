@@ -148,6 +148,8 @@ CallResult<Json> Endpoint::Impl::dispatch(const RequestContext &context, const J
     std::lock_guard lock(state_mutex);
     auto it = handlers.find({context.target, context.operation});
     if (it == handlers.end())
+      it = handlers.find({context.target, std::string(kAnyOperation)});
+    if (it == handlers.end())
       it = handlers.find({std::string(), context.operation});
     if (it == handlers.end())
       return call_error(Status::BadRequest, fmt::format("{} does not serve operation \"{}\"",

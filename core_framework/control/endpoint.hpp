@@ -23,6 +23,7 @@
 
 #include "common/diagnostic.hpp"
 #include "control/caller.hpp"
+#include "control/server.hpp"
 #include "dds/participant.hpp"
 #include "protocol/status.hpp"
 
@@ -36,18 +37,6 @@ using protocol::CallError;
 using protocol::CallResult;
 using protocol::Status;
 using protocol::to_string;
-
-struct RequestContext {
-  std::string id;
-  std::string sender;
-  std::string operation;
-  std::string target; // the address called: the endpoint's own or one of its aliases
-  // When the request arrived: a handler that waits counts its time from here, as its caller
-  // does, also when it ran late (after others of the same batch).
-  std::chrono::steady_clock::time_point received = std::chrono::steady_clock::now();
-};
-
-using Handler = std::function<CallResult<Json>(const Json &body, const RequestContext &context)>;
 
 // An endpoint's announcement as others see it.
 struct AnnouncementEvent {
@@ -76,7 +65,7 @@ struct EndpointOptions {
   bool hold_requests = false;
 };
 
-class Endpoint final : public Caller {
+class Endpoint final : public Server {
 public:
   static Expected<std::unique_ptr<Endpoint>> open(std::shared_ptr<dds::Participant> participant,
                                                   std::string address,
@@ -88,18 +77,18 @@ public:
   Endpoint(const Endpoint &) = delete;
   Endpoint &operator=(const Endpoint &) = delete;
 
-  const std::string &address() const;
+  const std::string &address() const override;
 
   // Serves `operation` at every address of the endpoint; a later registration replaces an
   // earlier one.
-  void on(const std::string &operation, Handler handler);
+  void on(const std::string &operation, Handler handler) override;
   // Serves `operation` at `address` (its own or an alias) only, before any handler of
   // on(operation).
-  void on(const std::string &address, const std::string &operation, Handler handler);
+  void on(const std::string &address, const std::string &operation, Handler handler) override;
   // Serves the requests held since open (EndpointOptions::hold_requests) and those that follow.
   void start_serving();
   // Drops the handlers of `address` and returns once none of them is running any more.
-  void stop_serving(const std::string &address);
+  void stop_serving(const std::string &address) override;
   // Takes no more requests and returns once the handlers under way have returned; calls still
   // work. The destructor does it first. An owner whose handlers reach the endpoint through a
   // pointer calls it before clearing the pointer.
@@ -109,11 +98,7 @@ public:
   // (Unavailable), or as soon as its addressee leaves DDS after it was sent (Unavailable,
   // maybe_received): it exited or lost its lease, and will not reply.
   std::future<CallResult<Json>> call(const std::string &target, const std::string &operation,
-                                     Json body, std::chrono::milliseconds timeout);
-  CallResult<Json> call_sync(const std::string &target, const std::string &operation, Json body,
-                             std::chrono::milliseconds timeout) {
-    return call(target, operation, std::move(body), timeout).get();
-  }
+                                     Json body, std::chrono::milliseconds timeout) override;
   // Makes every call at once and waits for all; each result in the order of the calls. Calls to
   // addresses routed through the same endpoint travel as one request ("endpoint.batch"), whose
   // handlers run one after another.
@@ -128,7 +113,7 @@ public:
   void prepare(const std::string &target) override;
   // The same for the replies to `caller` (the domain, for a node or component), whose first
   // call then does not wait for DDS to match a new reply writer.
-  void prepare_replies(const std::string &caller);
+  void prepare_replies(const std::string &caller) override;
   // Fails every call to `target` under way, saying `why`: its caller knows the addressee is dead
   // (its node saw it exit) sooner than DDS would (the addressee's lease).
   void abandon(const std::string &target, const std::string &why);
@@ -139,8 +124,9 @@ public:
   Expected<void> announce(const std::string &kind, const Json &body);
   void withdraw();
   // The same for one of its aliases.
-  Expected<void> announce(const std::string &alias, const std::string &kind, const Json &body);
-  void withdraw(const std::string &alias);
+  Expected<void> announce(const std::string &alias, const std::string &kind,
+                          const Json &body) override;
+  void withdraw(const std::string &alias) override;
 
   struct Impl;
 

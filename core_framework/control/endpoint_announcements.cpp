@@ -35,10 +35,18 @@ void Endpoint::Impl::take_announcements() {
       } else {
         continue;
       }
+      // An address served by another endpoint on its behalf (a node relaying for a process it
+      // started) says which: calls to it go there.
+      if (event.kind == AnnouncementEvent::Kind::Alive && event.body.is_object())
+        if (auto via = event.body.find(kAnnouncedVia);
+            via != event.body.end() && via->is_string() && !via->get<std::string>().empty()) {
+          std::lock_guard lock(routes_mutex);
+          routes[event.address] = via->get<std::string>();
+        }
       if (event.kind == AnnouncementEvent::Kind::Alive &&
           std::find(options.prepare_kinds.begin(), options.prepare_kinds.end(),
                     event.endpoint_kind) != options.prepare_kinds.end())
-        request_ways->writer_for(event.address); // not waited for
+        request_ways->writer_for(route_of(event.address)); // not waited for
       handler(event);
     }
     dds_return_loan(announcement_reader.get(), samples, n);

@@ -50,7 +50,7 @@ CallResult<typename Op::Reply> reply_of(CallResult<Json> raw) {
 }
 
 template <Operation Op>
-CallResult<typename Op::Reply> call(Endpoint &endpoint, const std::string &target,
+CallResult<typename Op::Reply> call(Server &endpoint, const std::string &target,
                                     const typename Op::Request &request,
                                     std::chrono::milliseconds timeout) {
   return reply_of<Op>(
@@ -59,7 +59,7 @@ CallResult<typename Op::Reply> call(Endpoint &endpoint, const std::string &targe
 
 // A call whose reply nobody waits for (a report): its result is dropped when it comes.
 template <Operation Op>
-void send(Endpoint &endpoint, const std::string &target, const typename Op::Request &request,
+void send(Server &endpoint, const std::string &target, const typename Op::Request &request,
           std::chrono::milliseconds timeout) {
   endpoint.call(target, std::string(Op::name), protocol::encode(request), timeout);
 }
@@ -85,13 +85,13 @@ Handler typed_handler(OperationHandler<Op> handler) {
 
 // Serves `Op` at every address of `endpoint`.
 template <Operation Op>
-void serve(Endpoint &endpoint, OperationHandler<Op> handler) {
+void serve(Server &endpoint, OperationHandler<Op> handler) {
   endpoint.on(std::string(Op::name), typed_handler<Op>(std::move(handler)));
 }
 
 // Serves `Op` at `address` only (the endpoint's own or an alias).
 template <Operation Op>
-void serve(Endpoint &endpoint, const std::string &address, OperationHandler<Op> handler) {
+void serve(Server &endpoint, const std::string &address, OperationHandler<Op> handler) {
   endpoint.on(address, std::string(Op::name), typed_handler<Op>(std::move(handler)));
 }
 

@@ -29,6 +29,7 @@ struct ComponentInstance {
   std::string implementation;
   std::string address; // its control endpoint
   std::string host;    // the address of the component host that serves it, if it is hosted
+  std::string via;     // the endpoint that serves its address (its node or host); empty: itself
   std::string spd;     // the SPD it runs from
   long pid = 0;
   ComponentState state = ComponentState::Allocated;

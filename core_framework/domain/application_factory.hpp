@@ -60,6 +60,8 @@ struct DomainServices {
   ComponentRegistry *components = nullptr;
   EventChannelManager *channels = nullptr;
   std::function<std::optional<std::string>(const std::string &node)> node_address;
+  // Whether a node relays the control of the processes it starts (null: none does).
+  std::function<bool(const std::string &node)> node_relays;
   std::function<std::optional<DevicePorts>(const std::string &device)> device_ports;
   // An identity unique to each launch in this domain, also across restarts of the domain daemon:
   // component addresses and topics carry it, so an application re-launched under the same name

@@ -116,6 +116,7 @@ CallResult<void> ConnectionManager::wire(RuntimeConnection &c) {
          wire_end(c, *provides, c.provides),
          c.topic,
          "",
+         "",
          c.repid,
          c.qos,
          c.filter};

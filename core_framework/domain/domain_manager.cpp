@@ -67,6 +67,7 @@ ApplicationFactory DomainManager::Impl::factory() {
   s.components = &components;
   s.channels = &*channels;
   s.node_address = [this](const std::string &node) { return nodes.address_of(node); };
+  s.node_relays = [this](const std::string &node) { return nodes.relays_processes(node); };
   s.device_ports = [this](const std::string &id) -> std::optional<DevicePorts> {
     auto device = nodes.device(id);
     if (!device || device->address.empty())

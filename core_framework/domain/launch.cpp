@@ -163,6 +163,18 @@ CallResult<void> ApplicationFactory::Launch::allocate() {
   return {};
 }
 
+// Where calls to a component go: to its node when the node relays for the processes it starts
+// (protocol/node_link.hpp), else to its component host when it is hosted, else to itself.
+void ApplicationFactory::Launch::route(ComponentInstance &c) {
+  const auto node =
+      s_.node_relays && s_.node_relays(c.node) ? s_.node_address(c.node) : std::nullopt;
+  c.via = node ? *node : c.host;
+  if (!c.via.empty())
+    s_.endpoint->route(c.address, c.via);
+  if (node && !c.host.empty())
+    s_.endpoint->route(c.host, *node);
+}
+
 CallResult<void> ApplicationFactory::Launch::execute() {
   // From here on, components are expected and routed, and processes may start: undone by
   // releasing them (and terminating what runs) whatever this step gets to.
@@ -175,8 +187,7 @@ CallResult<void> ApplicationFactory::Launch::execute() {
   // Discovery of each component's endpoint starts now and overlaps with its process start.
   for (auto &c : app_->components) {
     s_.components->expect(c.address, c.node);
-    if (!c.host.empty())
-      s_.endpoint->route(c.address, c.host);
+    route(c);
     s_.endpoint->prepare(c.address);
   }
   std::vector<protocol::node::ExecuteRequest> requests;

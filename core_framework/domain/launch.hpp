@@ -57,6 +57,7 @@ private:
   // One process per Executable component, and one component host per device for the
   // application's SharedLibrary components on it; all started at once.
   CallResult<void> execute();
+  void route(ComponentInstance &c);
 
   CallResult<void> await_registration();
 

@@ -94,6 +94,8 @@ Wire ApplicationFactory::Launch::wire_of(const ConnectionInstance &ci) const {
   };
   if (ci.is_interface()) {
     w.interface_target = ci.provides.address;
+    if (const auto *target = component_of(ci.provides.component))
+      w.interface_via = target->via;
     w.uses =
         end_of(ci.uses, 0, fmt::format("{} ({} -> {})", ci.id, ci.uses.name(), ci.provides.name()));
     return w;

@@ -59,6 +59,12 @@ std::optional<std::string> NodeDirectory::address_of(const std::string &node) co
   return it->second.address;
 }
 
+bool NodeDirectory::relays_processes(const std::string &node) const {
+  std::lock_guard lock(mutex_);
+  auto it = nodes_.find(node);
+  return it != nodes_.end() && it->second.announcement.relays_processes.value_or(false);
+}
+
 std::optional<protocol::node::DeviceRecord> NodeDirectory::device(const std::string &id) const {
   std::lock_guard lock(mutex_);
   const auto *device = find_device(id);

@@ -38,6 +38,8 @@ public:
 
   bool contains(const std::string &node) const;
   std::optional<std::string> address_of(const std::string &node) const;
+  // The node relays the control of the processes it starts (protocol/node_link.hpp).
+  bool relays_processes(const std::string &node) const;
   // The device of that id ("NODE:LABEL").
   std::optional<protocol::node::DeviceRecord> device(const std::string &id) const;
   std::vector<Node> snapshot() const;

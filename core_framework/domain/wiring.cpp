@@ -24,6 +24,8 @@ protocol::component::ConnectRequest connect_request(const Wire &wire, const Wire
   request.repid = wire.repid;
   if (wire.to_interface()) {
     request.target = wire.interface_target;
+    if (!wire.interface_via.empty())
+      request.via = wire.interface_via;
     return request;
   }
   request.topic = wire.topic;

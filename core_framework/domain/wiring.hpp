@@ -35,6 +35,7 @@ struct Wire {
   // Empty: a uses port calling a component's supported interface at `interface_target`.
   std::string topic;
   std::string interface_target;
+  std::string interface_via; // the endpoint that serves interface_target; empty: itself
   std::string repid;
   nlohmann::json qos; // dds/port_qos.hpp's JSON form
   std::string filter; // the reader's content filter

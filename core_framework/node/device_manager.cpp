@@ -55,6 +55,7 @@ struct DeviceManager::Impl {
   NodeOptions options;
   std::shared_ptr<dds::Participant> participant;
   std::unique_ptr<control::Endpoint> endpoint;
+  std::unique_ptr<ProcessLinks> links; // relays through the endpoint
   std::shared_ptr<const profile::DeviceConfiguration> dcd;
   profile::ResolvedNode node;
   std::vector<RunningDevice> devices;
@@ -95,7 +96,8 @@ Expected<void> DeviceManager::Impl::start_devices(const DeviceRegistry &registry
                             options.exec_path,
                             options.log_dir,
                             participant->settings(),
-                            [this](const auto &report) { report_exit(report); }};
+                            [this](const auto &report) { report_exit(report); },
+                            links.get()};
       auto device = (*factory)(context);
       if (!device)
         return tl::unexpected(device.error());
@@ -114,7 +116,7 @@ Expected<void> DeviceManager::Impl::start_devices(const DeviceRegistry &registry
 op::NodeAnnouncement DeviceManager::Impl::announcement() const {
   char host[256] = {};
   gethostname(host, sizeof(host) - 1);
-  op::NodeAnnouncement out{dcd->name, static_cast<std::int64_t>(getpid()), host, {}};
+  op::NodeAnnouncement out{dcd->name, static_cast<std::int64_t>(getpid()), host, {}, true};
   for (const auto &d : devices) {
     op::DeviceRecord record{d.id,
                             d.label,
@@ -196,6 +198,7 @@ DeviceManager::DeviceManager(std::unique_ptr<Impl> impl) : impl_(std::move(impl)
 DeviceManager::~DeviceManager() {
   impl_->stopping = true;
   impl_->endpoint->withdraw();
+  impl_->links->close(); // relays under way fail: the endpoint's handlers return
   // The endpoint goes first: closing it waits for the handlers still running, which use the
   // devices (a node.terminate still escalating while the devices went was a double free).
   {
@@ -203,6 +206,7 @@ DeviceManager::~DeviceManager() {
     impl_->endpoint.reset();
   }
   impl_->devices.clear(); // terminates whatever the GPP still runs
+  impl_->links.reset();
 }
 
 const std::string &DeviceManager::node_name() const {
@@ -229,6 +233,10 @@ DeviceManager::create(std::shared_ptr<dds::Participant> participant, NodeOptions
   if (!endpoint)
     return tl::unexpected(endpoint.error());
   impl->endpoint = std::move(*endpoint);
+  auto links = ProcessLinks::start(*impl->endpoint);
+  if (!links)
+    return tl::unexpected(links.error());
+  impl->links = std::move(*links);
   if (auto ok = impl->start_devices(registry); !ok)
     return tl::unexpected(ok.error());
   impl->serve();

@@ -32,8 +32,9 @@ Expected<std::unique_ptr<LogicalDevice>> HostedDevice::create(const DeviceContex
       protocol::device_address(context.domain, context.node, context.label),
       component::in_process_logger(context.id),
       std::nullopt};
-  auto component = component::InProcessComponent::open(factory, component_context, context.softpkg,
-                                                       context.participant);
+  auto component = component::InProcessComponent::open(
+      factory, component_context, context.softpkg,
+      std::make_shared<component::ParticipantSource>(context.participant));
   if (!component)
     return tl::unexpected(component.error());
   if (auto up = (*component)->bring_up(values_by_id(context)); !up)

@@ -12,6 +12,7 @@
 #include "control/endpoint.hpp"
 #include "dds/dds_settings.hpp"
 #include "dds/participant.hpp"
+#include "node/process_links.hpp"
 #include "profile/profile_loader.hpp"
 #include "protocol/domain_ops.hpp"
 #include "protocol/node_ops.hpp"
@@ -36,6 +37,9 @@ struct DeviceContext {
   dds::DdsSettings dds;                          // what launched processes must join
   // Reports a process that exited on its own (a crash, for a component). Must not block.
   std::function<void(const protocol::domain::ComponentExitedReport &report)> report_exit;
+  // The node's links to the processes it starts (node/process_links.hpp): a started process
+  // gets one, and its control goes through the node. Null: processes join DDS on their own.
+  ProcessLinks *links = nullptr;
 };
 
 class LogicalDevice {

@@ -121,8 +121,9 @@ private:
   posix_spawnattr_t attributes_{};
 };
 
-// stdin from /dev/null, stdout and stderr to the log, the working directory, and no other
-// descriptor of this process, whether close-on-exec or not. Returns 0 or an errno value.
+// stdin from /dev/null, stdout and stderr to the log, the working directory, the one descriptor
+// the command hands over, and no other descriptor of this process, close-on-exec or not. Returns 0
+// or an errno value.
 int prepare_files(SpawnActions &actions, const Command &command, int log_fd) {
   int rc =
       ::posix_spawn_file_actions_addopen(actions.get(), STDIN_FILENO, "/dev/null", O_RDONLY, 0);
@@ -135,8 +136,14 @@ int prepare_files(SpawnActions &actions, const Command &command, int log_fd) {
   if (rc == 0 && !command.working_dir.empty()) {
     rc = ::posix_spawn_file_actions_addchdir_np(actions.get(), command.working_dir.c_str());
   }
+  int first_closed = STDERR_FILENO + 1;
+  if (rc == 0 && command.inherit) {
+    rc =
+        ::posix_spawn_file_actions_adddup2(actions.get(), command.inherit->fd, command.inherit->as);
+    first_closed = command.inherit->as + 1;
+  }
   if (rc == 0) {
-    rc = ::posix_spawn_file_actions_addclosefrom_np(actions.get(), STDERR_FILENO + 1);
+    rc = ::posix_spawn_file_actions_addclosefrom_np(actions.get(), first_closed);
   }
   return rc;
 }

@@ -8,7 +8,8 @@
 //   failures come back from posix_spawn itself (glibc starts the child vfork-style and reports
 //   the exec's errno);
 // - the child gets stdin from /dev/null, stdout and stderr appended to the log file (or this
-//   process's), and no other descriptor of this process, close-on-exec or not;
+//   process's), the one descriptor the command hands over (its node link), and no other
+//   descriptor of this process, close-on-exec or not;
 // - an empty signal mask and every signal's default action: an ignored signal would stay ignored
 //   across exec, and a blocked one blocked (a daemon started from a shell that ignores SIGINT
 //   would never stop on it). Only glibc's own two signals below SIGRTMIN stay ignored when this
@@ -22,6 +23,7 @@
 #include <chrono>
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -52,6 +54,13 @@ struct Command {
   // stdout and stderr are appended to this file, its directories created if missing. Empty:
   // the child shares this process's stdout and stderr. stdin is always /dev/null.
   std::filesystem::path log_file{};
+  // One descriptor of this process the child gets, as descriptor `as` (above stderr): the node
+  // link (protocol/node_link.hpp). Every descriptor above it is closed in the child.
+  struct Inherited {
+    int fd = -1;
+    int as = 3;
+  };
+  std::optional<Inherited> inherit{};
 };
 
 // A started process. Not reaped by its destructor: whoever started it reaps it, or leaves it to

@@ -25,13 +25,14 @@ struct ConnectRequest {
   std::optional<std::string> filter; // a provides port's content filter
   std::optional<bool> local;         // both ends are in this process: no DDS
   std::optional<std::string> target; // a control interface's component address
+  std::optional<std::string> via;    // the endpoint that serves `target` (its node or host)
   static constexpr auto fields() {
     using R = ConnectRequest;
     return std::tuple{required("connection", &R::connection), required("port", &R::port),
                       required("direction", &R::direction),   optional("repid", &R::repid),
                       optional("topic", &R::topic),           optional("qos", &R::qos),
                       optional("filter", &R::filter),         optional("local", &R::local),
-                      optional("target", &R::target)};
+                      optional("target", &R::target),         optional("via", &R::via)};
   }
 };
 
@@ -119,6 +120,9 @@ struct Announcement {
   std::int64_t pid = 0;    // the process it runs in (a component host's, when hosted)
   std::string state;       // the runtime's lifecycle state (component/component.hpp), for people
   std::vector<node::DevicePort> ports;
+  // The endpoint that serves the component's address: its node, which relays to it and adds
+  // this (control/server.hpp's kAnnouncedVia). Absent: the component serves it itself.
+  std::optional<std::string> via;
   static constexpr auto fields() {
     using R = Announcement;
     return std::tuple{required("id", &R::id),
@@ -126,7 +130,8 @@ struct Announcement {
                       required("application", &R::application),
                       required("pid", &R::pid),
                       required("state", &R::state),
-                      required("ports", &R::ports)};
+                      required("ports", &R::ports),
+                      optional("via", &R::via)};
   }
 };
 

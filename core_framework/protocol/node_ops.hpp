@@ -104,10 +104,15 @@ struct NodeAnnouncement {
   std::int64_t pid = 0;
   std::string host;
   std::vector<DeviceRecord> devices;
+  // The node relays the control of the processes it starts (protocol/node_link.hpp): the domain
+  // calls their components through the node. Absent: a node that does not, whose processes
+  // serve their own addresses.
+  std::optional<bool> relays_processes;
   static constexpr auto fields() {
     using R = NodeAnnouncement;
     return std::tuple{required("node", &R::node), required("pid", &R::pid),
-                      required("host", &R::host), required("devices", &R::devices)};
+                      required("host", &R::host), required("devices", &R::devices),
+                      optional("relays_processes", &R::relays_processes)};
   }
 };
 

@@ -52,10 +52,16 @@ tl::unexpected<CallError> call_error(Status status, const Error &findings) {
   return tl::unexpected(std::move(error));
 }
 
+nlohmann::json error_body_json(const CallError &error) {
+  if (error.details.empty())
+    return nlohmann::json::object();
+  return nlohmann::json{{"details", error.details}};
+}
+
 std::string error_body(const CallError &error) {
   if (error.details.empty())
     return {};
-  return nlohmann::json{{"details", error.details}}.dump();
+  return error_body_json(error).dump();
 }
 
 std::vector<std::string> details_of_text(std::string_view body) {

@@ -54,6 +54,8 @@ tl::unexpected<CallError> call_error(Status status, const Error &findings);
 // The details of an error reply, as its body carries them ({"details": [...]}), and back; a body
 // without them gives none.
 std::string error_body(const CallError &error);
+// The same as a JSON object (empty without details), for a transport that carries JSON.
+nlohmann::json error_body_json(const CallError &error);
 std::vector<std::string> details_of(const nlohmann::json &body);
 std::vector<std::string> details_of_text(std::string_view body);
 

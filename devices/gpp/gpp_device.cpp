@@ -6,6 +6,7 @@
 #include <spdlog/spdlog.h>
 
 #include "common/exec_environment.hpp"
+#include "control/link_socket.hpp"
 #include "host_info.hpp"
 #include "protocol/exec_params.hpp"
 
@@ -80,16 +81,33 @@ GppDevice::execute(const protocol::node::ExecuteRequest &r) {
   request.env.emplace_back(kNodePidVariable, std::to_string(::getpid()));
   request.log_file = context_.log_dir / application / (component + ".log");
   request.label = fmt::format("{}/{}", application, component);
+  // The process's control goes through this node (node/process_links.hpp): it gets its end of
+  // the link as a known descriptor.
+  std::optional<std::pair<process::Fd, process::Fd>> link;
+  if (context_.links != nullptr) {
+    auto pair = control::make_link_pair();
+    if (!pair)
+      return control::call_error(Status::Failed, fmt::format("{}: {}", context_.id, pair.error()));
+    link = std::move(*pair);
+    request.inherit = process::Command::Inherited{link->second.get(), protocol::link::kNodeLinkFd};
+    request.env.emplace_back(protocol::link::kNodeLinkVariable,
+                             std::to_string(protocol::link::kNodeLinkFd));
+  }
   auto pid = launcher_.execute(request);
   if (!pid)
     return control::call_error(Status::Failed,
                                fmt::format("{}: {}", context_.id, pid.error().to_string()));
+  auto addresses = protocol::control_addresses(request.args);
+  if (link) {
+    link->second.reset(); // the child's end is the child's alone
+    context_.links->attach(*pid, std::move(link->first), addresses);
+  }
   {
     std::lock_guard lock(mutex_);
     protocol::domain::ComponentExitedReport owner;
     owner.application = application;
     owner.component = component;
-    owner.addresses = protocol::control_addresses(request.args);
+    owner.addresses = std::move(addresses);
     owners_[*pid] = std::move(owner);
   }
   spdlog::info("{}: executed {} as pid {} (log {})", context_.id, request.program.string(), *pid,
@@ -125,6 +143,8 @@ std::vector<protocol::node::ProcessRecord> GppDevice::processes() const {
 }
 
 void GppDevice::on_exit(ProcessId pid, const ExitStatus &status) {
+  if (context_.links != nullptr)
+    context_.links->detach(pid);
   if (status.requested)
     return;
   protocol::domain::ComponentExitedReport report;

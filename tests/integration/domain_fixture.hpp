@@ -63,7 +63,11 @@ public:
     for (const auto &dcd : dcds)
       launch_node(dcd);
     auto pp = rsca::test::participant();
-    auto endpoint = rsca::control::Endpoint::open(pp, fmt::format("rsca/cli/test-{}", getpid()));
+    // Following announcements, the client learns which node serves each component's address.
+    rsca::control::EndpointOptions options;
+    options.on_announcement = [](const rsca::control::AnnouncementEvent &) {};
+    auto endpoint =
+        rsca::control::Endpoint::open(pp, fmt::format("rsca/cli/test-{}", getpid()), options);
     REQUIRE(endpoint.has_value());
     participant_ = pp;
     client_ = std::move(*endpoint);

@@ -67,11 +67,13 @@ TEST_CASE("protocol: nested messages round-trip", "[protocol]") {
 TEST_CASE("protocol: a component's announcement round-trips, and one without its pid is refused",
           "[protocol]") {
   const protocol::component::Announcement a{
-      "C_1", "C", "app", 42, "initialized", {{"samples_out", "uses", "IDL:rsca/Samples:1.0"}}};
+      "C_1",      "C", "app", 42, "initialized", {{"samples_out", "uses", "IDL:rsca/Samples:1.0"}},
+      "d/node/n1"};
   const auto back = round_trip(a);
   CHECK(back.id == "C_1");
   CHECK(back.pid == 42);
   CHECK(back.state == "initialized");
+  CHECK(back.via == std::optional<std::string>("d/node/n1"));
   REQUIRE(back.ports.size() == 1);
   CHECK(back.ports[0].direction == "uses");
 

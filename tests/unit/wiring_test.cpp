@@ -73,7 +73,7 @@ WireEnd end_at(std::string address, std::string port, std::string host = "") {
 }
 
 Wire topic_wire(WireEnd uses, WireEnd provides) {
-  return {uses, provides, "rsca/test/c1", "", "IDL:T:1.0", Json::object(), "range < 2"};
+  return {uses, provides, "rsca/test/c1", "", "", "IDL:T:1.0", Json::object(), "range < 2"};
 }
 
 } // namespace

@@ -1,0 +1,123 @@
+#include "control/link_socket.hpp"
+
+#include <cerrno>
+#include <cstring>
+
+#include <fmt/format.h>
+#include <sys/socket.h>
+#include <sys/time.h>
+
+namespace rsca::control {
+
+namespace link = protocol::link;
+
+protocol::CallResult<nlohmann::json> reply_result(const link::Reply &reply) {
+  using protocol::call_error;
+  using protocol::Status;
+  if (reply.status == static_cast<std::int32_t>(Status::Ok))
+    return reply.body;
+  // A status this version does not know is a failure all the same, said as it came.
+  auto error =
+      protocol::is_known(reply.status)
+          ? call_error(static_cast<Status>(reply.status), reply.error)
+          : call_error(Status::Failed, fmt::format("status {}: {}", reply.status, reply.error));
+  error.value().details = protocol::details_of(reply.body);
+  return error;
+}
+
+link::Reply link_reply(const std::string &id, const protocol::CallResult<nlohmann::json> &result) {
+  if (result)
+    return {id, 0, "", *result};
+  return {id, static_cast<std::int32_t>(result.error().status), result.error().message,
+          protocol::error_body_json(result.error())};
+}
+
+tl::expected<std::pair<process::Fd, process::Fd>, std::string> make_link_pair() {
+  int fds[2] = {-1, -1};
+  if (::socketpair(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0, fds) != 0)
+    return tl::unexpected(fmt::format("socketpair: {}", std::strerror(errno)));
+  return std::pair{process::Fd(fds[0]), process::Fd(fds[1])};
+}
+
+LinkWriter::LinkWriter(int fd, std::chrono::milliseconds timeout) : fd_(fd) {
+  timeval tv{};
+  tv.tv_sec = static_cast<time_t>(timeout.count() / 1000);
+  tv.tv_usec = static_cast<suseconds_t>((timeout.count() % 1000) * 1000);
+  ::setsockopt(fd_, SOL_SOCKET, SO_SNDTIMEO, &tv, sizeof(tv));
+}
+
+tl::expected<void, std::string> LinkWriter::send(const link::Frame &frame) {
+  const std::string text = link::encode_frame(frame).dump();
+  if (text.size() > link::kMaxLinkFrame)
+    return tl::unexpected(fmt::format("a frame of {} bytes is over the link's limit of {}",
+                                      text.size(), link::kMaxLinkFrame));
+  const auto size = static_cast<std::uint32_t>(text.size());
+  std::string wire;
+  wire.reserve(4 + text.size());
+  for (int shift = 24; shift >= 0; shift -= 8)
+    wire.push_back(static_cast<char>((size >> static_cast<unsigned>(shift)) & 0xffU));
+  wire += text;
+  std::lock_guard lock(mutex_);
+  std::size_t sent = 0;
+  while (sent < wire.size()) {
+    const ssize_t n = ::send(fd_, wire.data() + sent, wire.size() - sent, MSG_NOSIGNAL);
+    if (n < 0 && errno == EINTR)
+      continue;
+    if (n < 0)
+      return tl::unexpected(errno == EAGAIN ? std::string("the peer does not read its link")
+                                            : fmt::format("send: {}", std::strerror(errno)));
+    sent += static_cast<std::size_t>(n);
+  }
+  return {};
+}
+
+bool FrameReader::read_from(int fd, std::vector<link::Frame> &frames, std::string &why) {
+  char chunk[64 * 1024];
+  const ssize_t n = ::recv(fd, chunk, sizeof(chunk), 0);
+  if (n < 0 && (errno == EINTR || errno == EAGAIN))
+    return true;
+  if (n < 0) {
+    why = fmt::format("recv: {}", std::strerror(errno));
+    return false;
+  }
+  if (n == 0) {
+    why = "the link was closed";
+    return false;
+  }
+  buffer_.append(chunk, static_cast<std::size_t>(n));
+  return cut(frames, why);
+}
+
+bool FrameReader::cut(std::vector<link::Frame> &frames, std::string &why) {
+  std::size_t at = 0;
+  while (buffer_.size() - at >= 4) {
+    std::uint32_t size = 0;
+    for (std::size_t i = 0; i < 4; ++i)
+      size = (size << 8U) | static_cast<unsigned char>(buffer_[at + i]);
+    if (size > link::kMaxLinkFrame) {
+      why = fmt::format("a frame of {} bytes is over the link's limit of {}", size,
+                        link::kMaxLinkFrame);
+      return false;
+    }
+    if (buffer_.size() - at - 4 < size)
+      break;
+    auto json = nlohmann::json::parse(buffer_.begin() + static_cast<std::ptrdiff_t>(at + 4),
+                                      buffer_.begin() + static_cast<std::ptrdiff_t>(at + 4 + size),
+                                      nullptr, false);
+    if (json.is_discarded()) {
+      why = "a frame is not JSON";
+      return false;
+    }
+    auto frame = link::decode_frame(json);
+    if (!frame) {
+      why = frame.error();
+      return false;
+    }
+    frames.push_back(std::move(*frame));
+    at += 4 + size;
+  }
+  buffer_.erase(0, at);
+  return true;
+}
+
+} // namespace rsca::control

@@ -1,0 +1,53 @@
+// The node link's framing (protocol/node_link.hpp) over a Unix stream socket: whole frames out,
+// whole frames in. Both parties use it: the process's NodeLink (control/node_link.hpp) and the
+// node's ProcessLinks (node/process_links.hpp).
+#pragma once
+
+#include <chrono>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include <tl/expected.hpp>
+
+#include "process/fd.hpp"
+#include "protocol/node_link.hpp"
+#include "protocol/status.hpp"
+
+namespace rsca::control {
+
+// A Reply as the result of the call it answers, and a call's result as its Reply.
+protocol::CallResult<nlohmann::json> reply_result(const protocol::link::Reply &reply);
+protocol::link::Reply link_reply(const std::string &id,
+                                 const protocol::CallResult<nlohmann::json> &result);
+
+// Makes a connected pair of Unix stream sockets, close-on-exec: [0] for the node, [1] for the
+// process it starts (the spawn hands it over as kNodeLinkFd).
+tl::expected<std::pair<process::Fd, process::Fd>, std::string> make_link_pair();
+
+// Writes frames to a link, whole, from any thread. The socket is blocking with a send timeout:
+// a peer that stops reading fails a write after `timeout`, never holds its writer forever.
+class LinkWriter {
+public:
+  explicit LinkWriter(int fd, std::chrono::milliseconds timeout = std::chrono::seconds(5));
+  tl::expected<void, std::string> send(const protocol::link::Frame &frame);
+
+private:
+  int fd_;
+  std::mutex mutex_;
+};
+
+// Collects the bytes read from a link and cuts them into frames.
+class FrameReader {
+public:
+  // Reads what the socket has (once; blocking unless the socket is non-blocking) and appends the
+  // whole frames it completes to `frames`. False, with why, at the end of the link (the peer
+  // closed it or died) or on a frame that breaks the protocol; the link is then to be closed.
+  bool read_from(int fd, std::vector<protocol::link::Frame> &frames, std::string &why);
+
+private:
+  bool cut(std::vector<protocol::link::Frame> &frames, std::string &why);
+  std::string buffer_;
+};
+
+} // namespace rsca::control

@@ -1,0 +1,338 @@
+#include "node/process_links.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <cerrno>
+#include <cstring>
+#include <future>
+#include <map>
+#include <mutex>
+#include <set>
+#include <thread>
+
+#include <fcntl.h>
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+#include <sys/epoll.h>
+#include <sys/eventfd.h>
+
+#include "control/link_socket.hpp"
+#include "control/worker_pool.hpp"
+#include "protocol/addresses.hpp"
+
+namespace rsca::node {
+
+namespace link = protocol::link;
+using control::call_error;
+using control::CallResult;
+using control::Json;
+using control::Status;
+
+namespace {
+
+// How long a relayed request may take, at most: the longest a component operation is given
+// (await_matched, a component's own configure) with room to spare. A dead process fails its
+// requests at once, not at this bound.
+constexpr std::chrono::seconds kRelayBound{60};
+// A process's own call is given what it asks for, up to this.
+constexpr std::chrono::seconds kCallBound{30};
+
+} // namespace
+
+// One process the node started, and its link.
+struct LinkedProcess {
+  pid_t pid = 0;
+  process::Fd fd;
+  std::unique_ptr<control::LinkWriter> writer;
+  control::FrameReader reader;
+  std::vector<std::string> addresses;
+  std::set<std::string> announced;
+  bool ended = false;
+  std::string why; // why it ended
+};
+
+struct ProcessLinks::Impl {
+  control::Endpoint *endpoint = nullptr;
+  process::Fd epoll;
+  process::Fd wake;
+  std::thread thread;
+  std::unique_ptr<control::WorkerPool> outgoing; // the processes' own calls
+  std::atomic<bool> stopping{false};
+
+  std::mutex mutex; // guards what follows
+  std::map<pid_t, std::shared_ptr<LinkedProcess>> by_pid;
+  std::map<int, std::shared_ptr<LinkedProcess>> by_fd;
+  std::map<std::string, std::shared_ptr<LinkedProcess>> by_address;
+  struct Relayed {
+    pid_t pid = 0;
+    std::promise<CallResult<Json>> promise;
+  };
+  std::map<std::string, Relayed> relayed; // requests under way, by id
+  std::uint64_t next_id = 0;
+  bool closed = false;
+
+  CallResult<Json> relay(const Json &body, const control::RequestContext &context);
+  void poll_loop();
+  void read(int fd);
+  void take(const std::shared_ptr<LinkedProcess> &process, link::Frame frame);
+  void make_call(const std::shared_ptr<LinkedProcess> &process, link::Request request);
+  void announce(LinkedProcess &process, const link::Announce &a);
+  // The link ended: its relayed requests fail, its announcements go. Called with the mutex held.
+  void end(LinkedProcess &process, const std::string &why);
+};
+
+CallResult<Json> ProcessLinks::Impl::relay(const Json &body,
+                                           const control::RequestContext &context) {
+  std::shared_ptr<LinkedProcess> process;
+  std::string id;
+  std::future<CallResult<Json>> reply;
+  {
+    std::lock_guard lock(mutex);
+    auto it = by_address.find(context.target);
+    if (closed || it == by_address.end())
+      return call_error(Status::Unavailable, fmt::format("{} is not served here", context.target));
+    process = it->second;
+    if (process->ended)
+      return call_error(Status::Unavailable,
+                        fmt::format("pid {} has exited: {}", process->pid, process->why));
+    id = std::to_string(++next_id);
+    auto &r = relayed[id];
+    r.pid = process->pid;
+    reply = r.promise.get_future();
+  }
+  const link::Request request{id,
+                              context.target,
+                              context.operation,
+                              context.sender,
+                              std::chrono::milliseconds(kRelayBound).count(),
+                              body};
+  if (auto sent = process->writer->send(request); !sent) {
+    std::lock_guard lock(mutex);
+    relayed.erase(id);
+    return call_error(Status::Unavailable, fmt::format("pid {}: {}", process->pid, sent.error()));
+  }
+  if (reply.wait_for(kRelayBound) == std::future_status::ready)
+    return reply.get();
+  std::lock_guard lock(mutex);
+  relayed.erase(id);
+  return call_error(Status::Timeout, fmt::format("pid {} did not answer {} in {} s", process->pid,
+                                                 context.operation, kRelayBound.count()));
+}
+
+void ProcessLinks::Impl::poll_loop() {
+  constexpr int kEvents = 64;
+  epoll_event events[kEvents];
+  while (!stopping) {
+    const int n = ::epoll_wait(epoll.get(), events, kEvents, -1);
+    if (n < 0 && errno != EINTR) {
+      spdlog::error("process links: epoll_wait: {}", std::strerror(errno));
+      return;
+    }
+    for (int i = 0; i < n && !stopping; ++i)
+      if (events[i].data.fd != wake.get())
+        read(events[i].data.fd);
+  }
+}
+
+void ProcessLinks::Impl::read(int fd) {
+  std::shared_ptr<LinkedProcess> process;
+  {
+    std::lock_guard lock(mutex);
+    auto it = by_fd.find(fd);
+    if (it == by_fd.end())
+      return;
+    process = it->second;
+  }
+  std::vector<link::Frame> frames;
+  std::string why;
+  const bool open = process->reader.read_from(fd, frames, why);
+  for (auto &f : frames)
+    take(process, std::move(f));
+  if (open)
+    return;
+  std::lock_guard lock(mutex);
+  ::epoll_ctl(epoll.get(), EPOLL_CTL_DEL, fd, nullptr);
+  by_fd.erase(fd);
+  end(*process, why);
+}
+
+void ProcessLinks::Impl::take(const std::shared_ptr<LinkedProcess> &process, link::Frame frame) {
+  if (auto *reply = std::get_if<link::Reply>(&frame)) {
+    std::lock_guard lock(mutex);
+    auto it = relayed.find(reply->id);
+    // Only the process asked may answer: a reply to another's request is dropped.
+    if (it == relayed.end() || it->second.pid != process->pid)
+      return;
+    it->second.promise.set_value(control::reply_result(*reply));
+    relayed.erase(it);
+  } else if (auto *request = std::get_if<link::Request>(&frame)) {
+    outgoing->post(
+        [this, process, r = std::move(*request)]() mutable { make_call(process, std::move(r)); });
+  } else if (auto *a = std::get_if<link::Announce>(&frame)) {
+    announce(*process, *a);
+  } else if (auto *w = std::get_if<link::Withdraw>(&frame)) {
+    std::lock_guard lock(mutex);
+    if (process->announced.erase(w->address) != 0)
+      endpoint->withdraw(w->address);
+  } else if (auto *r = std::get_if<link::Route>(&frame)) {
+    // A process may say where a component is served, nothing else: the domain's and the nodes'
+    // ways stay the node's own.
+    if (!protocol::incarnation_of(r->target)) {
+      spdlog::warn("pid {} asked to route {}, which is no component's address: ignored",
+                   process->pid, r->target);
+      return;
+    }
+    endpoint->route(r->target, r->via);
+  }
+}
+
+void ProcessLinks::Impl::make_call(const std::shared_ptr<LinkedProcess> &process,
+                                   link::Request request) {
+  const auto timeout =
+      std::clamp(std::chrono::milliseconds(request.timeout_ms), std::chrono::milliseconds(1),
+                 std::chrono::milliseconds(kCallBound));
+  auto result = endpoint->call(request.target, request.operation, std::move(request.body), timeout);
+  // Polled, so that closing the node does not wait for a call's whole timeout.
+  while (result.wait_for(std::chrono::milliseconds(100)) != std::future_status::ready)
+    if (stopping)
+      return;
+  const auto reply = control::link_reply(request.id, result.get());
+  if (auto sent = process->writer->send(reply); !sent)
+    spdlog::debug("pid {}: the reply to its {} is lost: {}", process->pid, request.operation,
+                  sent.error());
+}
+
+void ProcessLinks::Impl::announce(LinkedProcess &process, const link::Announce &a) {
+  std::lock_guard lock(mutex);
+  if (std::find(process.addresses.begin(), process.addresses.end(), a.address) ==
+      process.addresses.end()) {
+    spdlog::warn("pid {} announced {}, which it was not started to serve: ignored", process.pid,
+                 a.address);
+    return;
+  }
+  if (process.ended)
+    return;
+  Json body = a.body;
+  if (body.is_object())
+    body[control::kAnnouncedVia] = endpoint->address();
+  if (auto ok = endpoint->announce(a.address, a.kind, body); !ok) {
+    spdlog::warn("announcing {} for pid {}: {}", a.address, process.pid, ok.error().to_string());
+    return;
+  }
+  process.announced.insert(a.address);
+}
+
+void ProcessLinks::Impl::end(LinkedProcess &process, const std::string &why) {
+  if (process.ended)
+    return;
+  process.ended = true;
+  process.why = why;
+  spdlog::debug("pid {}: its link ended: {}", process.pid, why);
+  for (auto it = relayed.begin(); it != relayed.end();) {
+    if (it->second.pid != process.pid) {
+      ++it;
+      continue;
+    }
+    it->second.promise.set_value(
+        call_error(Status::Unavailable, fmt::format("pid {} has exited: {}", process.pid, why)));
+    it = relayed.erase(it);
+  }
+  for (const auto &address : process.announced)
+    endpoint->withdraw(address);
+  process.announced.clear();
+  process.fd.reset();
+}
+
+ProcessLinks::ProcessLinks(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+
+Expected<std::unique_ptr<ProcessLinks>> ProcessLinks::start(control::Endpoint &endpoint) {
+  auto impl = std::make_unique<Impl>();
+  impl->endpoint = &endpoint;
+  impl->epoll = process::Fd(::epoll_create1(EPOLL_CLOEXEC));
+  impl->wake = process::Fd(::eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK));
+  if (!impl->epoll || !impl->wake)
+    return make_error({"node", 0, 0}, "process-links",
+                      fmt::format("epoll or eventfd: {}", std::strerror(errno)));
+  epoll_event event{};
+  event.events = EPOLLIN;
+  event.data.fd = impl->wake.get();
+  ::epoll_ctl(impl->epoll.get(), EPOLL_CTL_ADD, impl->wake.get(), &event);
+  impl->outgoing = std::make_unique<control::WorkerPool>(4);
+  Impl *raw = impl.get();
+  impl->thread = std::thread([raw] { raw->poll_loop(); });
+  return std::unique_ptr<ProcessLinks>(new ProcessLinks(std::move(impl)));
+}
+
+ProcessLinks::~ProcessLinks() {
+  close();
+}
+
+void ProcessLinks::attach(pid_t pid, process::Fd link, std::vector<std::string> addresses) {
+  auto process = std::make_shared<LinkedProcess>();
+  process->pid = pid;
+  process->addresses = std::move(addresses);
+  ::fcntl(link.get(), F_SETFL, ::fcntl(link.get(), F_GETFL) | O_NONBLOCK);
+  process->writer = std::make_unique<control::LinkWriter>(link.get());
+  const int fd = link.get();
+  process->fd = std::move(link);
+  {
+    std::lock_guard lock(impl_->mutex);
+    if (impl_->closed)
+      return;
+    impl_->by_pid[pid] = process;
+    impl_->by_fd[fd] = process;
+    for (const auto &a : process->addresses)
+      impl_->by_address[a] = process;
+  }
+  Impl *raw = impl_.get();
+  for (const auto &a : process->addresses)
+    impl_->endpoint->on(a, std::string(control::kAnyOperation),
+                        [raw](const Json &body, const control::RequestContext &context) {
+                          return raw->relay(body, context);
+                        });
+  epoll_event event{};
+  event.events = EPOLLIN;
+  event.data.fd = fd;
+  ::epoll_ctl(impl_->epoll.get(), EPOLL_CTL_ADD, fd, &event);
+}
+
+void ProcessLinks::detach(pid_t pid) {
+  std::shared_ptr<LinkedProcess> process;
+  {
+    std::lock_guard lock(impl_->mutex);
+    if (impl_->closed)
+      return;
+    auto it = impl_->by_pid.find(pid);
+    if (it == impl_->by_pid.end())
+      return;
+    process = it->second;
+    impl_->by_pid.erase(it);
+    if (process->fd) {
+      ::epoll_ctl(impl_->epoll.get(), EPOLL_CTL_DEL, process->fd.get(), nullptr);
+      impl_->by_fd.erase(process->fd.get());
+    }
+    for (const auto &a : process->addresses)
+      impl_->by_address.erase(a);
+    impl_->end(*process, "the process has exited");
+  }
+  for (const auto &a : process->addresses)
+    impl_->endpoint->stop_serving(a); // waits for its relays, which have failed
+}
+
+void ProcessLinks::close() {
+  {
+    std::lock_guard lock(impl_->mutex);
+    if (impl_->closed)
+      return;
+    impl_->closed = true;
+    for (auto &[pid, process] : impl_->by_pid)
+      impl_->end(*process, "the node is stopping");
+  }
+  impl_->stopping = true;
+  const std::uint64_t one = 1;
+  [[maybe_unused]] auto n = ::write(impl_->wake.get(), &one, sizeof(one));
+  impl_->thread.join();
+  impl_->outgoing->stop();
+}
+
+} // namespace rsca::node

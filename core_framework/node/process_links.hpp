@@ -1,0 +1,44 @@
+// The node's end of the links to the processes it started (protocol/node_link.hpp): the node as
+// its host's agent for control. It serves each process's control addresses on the node's own
+// endpoint and relays their requests over the link, makes the process's calls on DDS for it,
+// and publishes its announcements. A process's death is seen at once as the end of its link.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <sys/types.h>
+
+#include "common/diagnostic.hpp"
+#include "control/endpoint.hpp"
+#include "process/fd.hpp"
+
+namespace rsca::node {
+
+class ProcessLinks {
+public:
+  // Relays through `endpoint`, which must outlive close().
+  static Expected<std::unique_ptr<ProcessLinks>> start(control::Endpoint &endpoint);
+  ~ProcessLinks();
+  ProcessLinks(const ProcessLinks &) = delete;
+  ProcessLinks &operator=(const ProcessLinks &) = delete;
+
+  // Takes the node's end of the link of process `pid`, which serves `addresses`: from now on
+  // the node serves them and relays to it. Requests that come before the process reads its link
+  // wait in the socket.
+  void attach(pid_t pid, process::Fd link, std::vector<std::string> addresses);
+  // The process has exited and been reaped: its addresses are served no longer.
+  void detach(pid_t pid);
+  // Stops relaying (calls under way fail) and lets go of the endpoint; attach and detach do
+  // nothing afterwards. The destructor does it.
+  void close();
+
+  struct Impl;
+
+private:
+  explicit ProcessLinks(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+} // namespace rsca::node
