@@ -150,6 +150,8 @@ Expected<void> Host::open(std::shared_ptr<ParticipantSource> participants,
     endpoint = std::move(*own);
   }
   endpoint_ = std::move(endpoint);
+  if (!c().ports_.empty())
+    participants_->join_in_background();
   serve_operations();
   // The domain calls next (initialize): the way back to it is made before it asks.
   endpoint_->prepare_replies(domain_address());

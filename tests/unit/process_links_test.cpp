@@ -1,0 +1,178 @@
+// The node's end of the node links (node/process_links.hpp) with real DDS endpoints: a caller
+// reaches a process's address through the node, the process's announcements are published for
+// it (and only for addresses it was started to serve), and the end of its link fails at once
+// what waits on it. The process is this test, on the other end of a real socket pair.
+#include <catch2/catch.hpp>
+
+#include <thread>
+
+#include "control/link_socket.hpp"
+#include "node/process_links.hpp"
+#include "test_domain.hpp"
+
+using namespace rsca;
+using namespace std::chrono_literals;
+namespace frames = rsca::protocol::link;
+
+namespace {
+
+constexpr const char *kChild = "t/component/app.1.1/C_1";
+constexpr const char *kNode = "t/node/n1";
+
+// The process's side of a link: frames out, frames in.
+struct FakeProcess {
+  process::Fd fd;
+  std::unique_ptr<control::LinkWriter> writer;
+  control::FrameReader reader;
+  std::vector<frames::Frame> in;
+
+  explicit FakeProcess(process::Fd end)
+      : fd(std::move(end)), writer(std::make_unique<control::LinkWriter>(fd.get())) {}
+  frames::Frame next() {
+    while (in.empty()) {
+      std::string why;
+      REQUIRE(reader.read_from(fd.get(), in, why));
+    }
+    auto f = std::move(in.front());
+    in.erase(in.begin());
+    return f;
+  }
+};
+
+// A node endpoint with its links, a process linked to it, and a caller that follows
+// announcements (so it learns the way to the process's address, as the domain does).
+struct Rig {
+  std::shared_ptr<dds::Participant> participant = test::participant();
+  std::unique_ptr<control::Endpoint> node;
+  std::unique_ptr<node::ProcessLinks> links;
+  std::unique_ptr<control::Endpoint> caller;
+  std::unique_ptr<FakeProcess> process;
+  std::vector<control::AnnouncementEvent> heard;
+  std::mutex heard_mutex;
+
+  Rig() {
+    auto n = control::Endpoint::open(participant, kNode);
+    REQUIRE(n.has_value());
+    node = std::move(*n);
+    auto l = node::ProcessLinks::start(*node);
+    REQUIRE(l.has_value());
+    links = std::move(*l);
+    control::EndpointOptions options;
+    options.on_announcement = [this](const control::AnnouncementEvent &e) {
+      std::lock_guard lock(heard_mutex);
+      heard.push_back(e);
+    };
+    auto c = control::Endpoint::open(participant, "t/cli/test", options);
+    REQUIRE(c.has_value());
+    caller = std::move(*c);
+    auto pair = control::make_link_pair();
+    REQUIRE(pair.has_value());
+    links->attach(4242, std::move(pair->first), {kChild});
+    process = std::make_unique<FakeProcess>(std::move(pair->second));
+  }
+  ~Rig() {
+    links->close();
+    caller.reset();
+    node.reset();
+  }
+  bool heard_alive(const std::string &address) {
+    std::lock_guard lock(heard_mutex);
+    for (const auto &e : heard)
+      if (e.address == address && e.kind == control::AnnouncementEvent::Kind::Alive)
+        return true;
+    return false;
+  }
+};
+
+template <typename Condition>
+bool eventually(Condition condition) {
+  const auto deadline = std::chrono::steady_clock::now() + 10s;
+  while (std::chrono::steady_clock::now() < deadline) {
+    if (condition())
+      return true;
+    std::this_thread::sleep_for(10ms);
+  }
+  return false;
+}
+
+} // namespace
+
+TEST_CASE("process links: a call to the process's address goes through its node and back",
+          "[process-links]") {
+  Rig rig;
+  REQUIRE(rig.process->writer->send(frames::Announce{kChild, "component", {{"pid", 4242}}}));
+  REQUIRE(eventually([&] { return rig.heard_alive(kChild); }));
+  {
+    std::lock_guard lock(rig.heard_mutex);
+    for (const auto &e : rig.heard)
+      if (e.address == kChild)
+        CHECK(e.body.at(control::kAnnouncedVia) == kNode); // the node says it serves it
+  }
+  // The caller routes through the node from the announcement alone.
+  auto reply = rig.caller->call(kChild, "component.status", {{"x", 1}}, 10s);
+  auto frame = rig.process->next();
+  auto *request = std::get_if<frames::Request>(&frame);
+  REQUIRE(request != nullptr);
+  CHECK(request->target == kChild);
+  CHECK(request->operation == "component.status");
+  CHECK(request->sender == "t/cli/test");
+  CHECK(request->body.at("x") == 1);
+  REQUIRE(rig.process->writer->send(frames::Reply{request->id, 0, "", {{"state", "started"}}}));
+  const auto answer = reply.get();
+  REQUIRE(answer.has_value());
+  CHECK(answer->at("state") == "started");
+}
+
+TEST_CASE("process links: a process announces only what it was started to serve",
+          "[process-links]") {
+  Rig rig;
+  REQUIRE(rig.process->writer->send(
+      frames::Announce{"t/component/app.1.1/SOMEONE_ELSE", "component", {{"pid", 1}}}));
+  REQUIRE(rig.process->writer->send(frames::Announce{kChild, "component", {{"pid", 4242}}}));
+  REQUIRE(eventually([&] { return rig.heard_alive(kChild); }));
+  // Frames are taken in order: the foreign one came first and was not published.
+  CHECK_FALSE(rig.heard_alive("t/component/app.1.1/SOMEONE_ELSE"));
+}
+
+TEST_CASE("process links: the end of a process's link fails its calls at once and withdraws it",
+          "[process-links]") {
+  Rig rig;
+  REQUIRE(rig.process->writer->send(frames::Announce{kChild, "component", {{"pid", 4242}}}));
+  REQUIRE(eventually([&] { return rig.heard_alive(kChild); }));
+  auto reply = rig.caller->call(kChild, "component.release", {}, 30s);
+  REQUIRE(std::holds_alternative<frames::Request>(rig.process->next()));
+  const auto ended = std::chrono::steady_clock::now();
+  rig.process->fd.reset(); // the process dies without answering
+  REQUIRE(reply.wait_for(10s) == std::future_status::ready);
+  const auto answer = reply.get();
+  REQUIRE_FALSE(answer.has_value());
+  CHECK(answer.error().status == protocol::Status::Unavailable);
+  CHECK_THAT(answer.error().message, Catch::Contains("4242"));
+  // Well before the call's own 30 s: the node saw the link end.
+  CHECK(std::chrono::steady_clock::now() - ended < 10s);
+  REQUIRE(eventually([&] {
+    std::lock_guard lock(rig.heard_mutex);
+    return !rig.heard.empty() && rig.heard.back().address == kChild &&
+           rig.heard.back().kind == control::AnnouncementEvent::Kind::Gone;
+  }));
+  // Once reaped, the address is served no longer: a call fails, it does not hang.
+  rig.links->detach(4242);
+  auto after = rig.caller->call_sync(kChild, "component.status", {}, 2s);
+  REQUIRE_FALSE(after.has_value());
+}
+
+TEST_CASE("process links: a process's own call is made on DDS by its node", "[process-links]") {
+  Rig rig;
+  rig.caller->on("test.echo", [](const control::Json &body, const control::RequestContext &c) {
+    return control::CallResult<control::Json>(control::Json{{"echo", body}, {"from", c.sender}});
+  });
+  REQUIRE(rig.process->writer->send(
+      frames::Request{"1", "t/cli/test", "test.echo", kChild, 5000, {{"n", 7}}}));
+  auto frame = rig.process->next();
+  auto *reply = std::get_if<frames::Reply>(&frame);
+  REQUIRE(reply != nullptr);
+  CHECK(reply->id == "1");
+  REQUIRE(reply->status == 0);
+  CHECK(reply->body.at("echo").at("n") == 7);
+  CHECK(reply->body.at("from") == kNode); // the node made it
+}
