@@ -16,13 +16,13 @@ namespace link_frames = rsca::protocol::link;
 namespace {
 
 // The test's side of the link: writes frames and reads them whole.
-struct FakeNode {
+struct LinkFakeNode {
   process::Fd fd;
   std::unique_ptr<control::LinkWriter> writer;
   control::FrameReader reader;
   std::vector<link_frames::Frame> frames;
 
-  explicit FakeNode(process::Fd end) : fd(std::move(end)) {
+  explicit LinkFakeNode(process::Fd end) : fd(std::move(end)) {
     writer = std::make_unique<control::LinkWriter>(fd.get());
   }
   // Blocks until a frame comes (the socket is blocking); fails the test on the link's end.
@@ -37,24 +37,24 @@ struct FakeNode {
   }
 };
 
-struct Linked {
+struct LinkEnds {
   std::unique_ptr<control::NodeLink> link;
-  std::unique_ptr<FakeNode> node;
+  std::unique_ptr<LinkFakeNode> node;
 };
 
-Linked make_linked(const std::string &address) {
+LinkEnds make_link_ends(const std::string &address) {
   auto pair = control::make_link_pair();
   REQUIRE(pair.has_value());
   auto link = control::NodeLink::open(std::move(pair->second), address);
   REQUIRE(link.has_value());
-  return {std::move(*link), std::make_unique<FakeNode>(std::move(pair->first))};
+  return {std::move(*link), std::make_unique<LinkFakeNode>(std::move(pair->first))};
 }
 
 } // namespace
 
 TEST_CASE("node link: a request from the node is served at its address and answered",
           "[node-link]") {
-  auto [link, node] = make_linked("d/component/app.1.1/C_1");
+  auto [link, node] = make_link_ends("d/component/app.1.1/C_1");
   link->on("d/component/app.1.1/C_1", "component.query",
            [](const control::Json &body, const control::RequestContext &context) {
              return control::CallResult<control::Json>(
@@ -83,7 +83,7 @@ TEST_CASE("node link: a request from the node is served at its address and answe
 
 TEST_CASE("node link: a call goes to the node and its error comes back with every detail",
           "[node-link]") {
-  auto [link, node] = make_linked("d/component/app.1.1/C_1");
+  auto [link, node] = make_link_ends("d/component/app.1.1/C_1");
   auto result =
       link->call("d/domain", "domain.connection_problem", {{"n", 1}}, std::chrono::seconds(5));
   auto frame = node->next();
@@ -104,7 +104,7 @@ TEST_CASE("node link: a call goes to the node and its error comes back with ever
 
 TEST_CASE("node link: an unanswered call times out, and the link's end fails the rest at once",
           "[node-link]") {
-  auto [link, node] = make_linked("d/component/app.1.1/C_1");
+  auto [link, node] = make_link_ends("d/component/app.1.1/C_1");
   auto late = link->call("d/domain", "x", {}, std::chrono::milliseconds(50));
   CHECK(late.get().error().status == protocol::Status::Timeout);
 
@@ -120,7 +120,7 @@ TEST_CASE("node link: an unanswered call times out, and the link's end fails the
 
 TEST_CASE("node link: announcements, withdrawals and routes go to the node as frames",
           "[node-link]") {
-  auto [link, node] = make_linked("d/component/app.1.1/C_1");
+  auto [link, node] = make_link_ends("d/component/app.1.1/C_1");
   REQUIRE(link->announce("d/component/app.1.1/C_1", "component", {{"pid", 1}}));
   link->route("d/component/app.1.1/C_2", "d/node/n1");
   link->withdraw("d/component/app.1.1/C_1");

@@ -12,23 +12,23 @@
 
 using namespace rsca;
 using namespace std::chrono_literals;
-namespace frames = rsca::protocol::link;
+namespace link_msgs = rsca::protocol::link;
 
 namespace {
 
-constexpr const char *kChild = "t/component/app.1.1/C_1";
-constexpr const char *kNode = "t/node/n1";
+constexpr const char *kLinkedChild = "t/component/app.1.1/C_1";
+constexpr const char *kLinkingNode = "t/node/n1";
 
 // The process's side of a link: frames out, frames in.
-struct FakeProcess {
+struct LinkedFakeProcess {
   process::Fd fd;
   std::unique_ptr<control::LinkWriter> writer;
   control::FrameReader reader;
-  std::vector<frames::Frame> in;
+  std::vector<link_msgs::Frame> in;
 
-  explicit FakeProcess(process::Fd end)
+  explicit LinkedFakeProcess(process::Fd end)
       : fd(std::move(end)), writer(std::make_unique<control::LinkWriter>(fd.get())) {}
-  frames::Frame next() {
+  link_msgs::Frame next() {
     while (in.empty()) {
       std::string why;
       REQUIRE(reader.read_from(fd.get(), in, why));
@@ -41,17 +41,17 @@ struct FakeProcess {
 
 // A node endpoint with its links, a process linked to it, and a caller that follows
 // announcements (so it learns the way to the process's address, as the domain does).
-struct Rig {
+struct LinksRig {
   std::shared_ptr<dds::Participant> participant = test::participant();
   std::unique_ptr<control::Endpoint> node;
   std::unique_ptr<node::ProcessLinks> links;
   std::unique_ptr<control::Endpoint> caller;
-  std::unique_ptr<FakeProcess> process;
+  std::unique_ptr<LinkedFakeProcess> process;
   std::vector<control::AnnouncementEvent> heard;
   std::mutex heard_mutex;
 
-  Rig() {
-    auto n = control::Endpoint::open(participant, kNode);
+  LinksRig() {
+    auto n = control::Endpoint::open(participant, kLinkingNode);
     REQUIRE(n.has_value());
     node = std::move(*n);
     auto l = node::ProcessLinks::start(*node);
@@ -67,10 +67,10 @@ struct Rig {
     caller = std::move(*c);
     auto pair = control::make_link_pair();
     REQUIRE(pair.has_value());
-    links->attach(4242, std::move(pair->first), {kChild});
-    process = std::make_unique<FakeProcess>(std::move(pair->second));
+    links->attach(4242, std::move(pair->first), {kLinkedChild});
+    process = std::make_unique<LinkedFakeProcess>(std::move(pair->second));
   }
-  ~Rig() {
+  ~LinksRig() {
     links->close();
     caller.reset();
     node.reset();
@@ -85,7 +85,7 @@ struct Rig {
 };
 
 template <typename Condition>
-bool eventually(Condition condition) {
+bool links_eventually(Condition condition) {
   const auto deadline = std::chrono::steady_clock::now() + 10s;
   while (std::chrono::steady_clock::now() < deadline) {
     if (condition())
@@ -99,25 +99,26 @@ bool eventually(Condition condition) {
 
 TEST_CASE("process links: a call to the process's address goes through its node and back",
           "[process-links]") {
-  Rig rig;
-  REQUIRE(rig.process->writer->send(frames::Announce{kChild, "component", {{"pid", 4242}}}));
-  REQUIRE(eventually([&] { return rig.heard_alive(kChild); }));
+  LinksRig rig;
+  REQUIRE(
+      rig.process->writer->send(link_msgs::Announce{kLinkedChild, "component", {{"pid", 4242}}}));
+  REQUIRE(links_eventually([&] { return rig.heard_alive(kLinkedChild); }));
   {
     std::lock_guard lock(rig.heard_mutex);
     for (const auto &e : rig.heard)
-      if (e.address == kChild)
-        CHECK(e.body.at(control::kAnnouncedVia) == kNode); // the node says it serves it
+      if (e.address == kLinkedChild)
+        CHECK(e.body.at(control::kAnnouncedVia) == kLinkingNode); // the node says it serves it
   }
   // The caller routes through the node from the announcement alone.
-  auto reply = rig.caller->call(kChild, "component.status", {{"x", 1}}, 10s);
+  auto reply = rig.caller->call(kLinkedChild, "component.status", {{"x", 1}}, 10s);
   auto frame = rig.process->next();
-  auto *request = std::get_if<frames::Request>(&frame);
+  auto *request = std::get_if<link_msgs::Request>(&frame);
   REQUIRE(request != nullptr);
-  CHECK(request->target == kChild);
+  CHECK(request->target == kLinkedChild);
   CHECK(request->operation == "component.status");
   CHECK(request->sender == "t/cli/test");
   CHECK(request->body.at("x") == 1);
-  REQUIRE(rig.process->writer->send(frames::Reply{request->id, 0, "", {{"state", "started"}}}));
+  REQUIRE(rig.process->writer->send(link_msgs::Reply{request->id, 0, "", {{"state", "started"}}}));
   const auto answer = reply.get();
   REQUIRE(answer.has_value());
   CHECK(answer->at("state") == "started");
@@ -125,22 +126,24 @@ TEST_CASE("process links: a call to the process's address goes through its node 
 
 TEST_CASE("process links: a process announces only what it was started to serve",
           "[process-links]") {
-  Rig rig;
+  LinksRig rig;
   REQUIRE(rig.process->writer->send(
-      frames::Announce{"t/component/app.1.1/SOMEONE_ELSE", "component", {{"pid", 1}}}));
-  REQUIRE(rig.process->writer->send(frames::Announce{kChild, "component", {{"pid", 4242}}}));
-  REQUIRE(eventually([&] { return rig.heard_alive(kChild); }));
+      link_msgs::Announce{"t/component/app.1.1/SOMEONE_ELSE", "component", {{"pid", 1}}}));
+  REQUIRE(
+      rig.process->writer->send(link_msgs::Announce{kLinkedChild, "component", {{"pid", 4242}}}));
+  REQUIRE(links_eventually([&] { return rig.heard_alive(kLinkedChild); }));
   // Frames are taken in order: the foreign one came first and was not published.
   CHECK_FALSE(rig.heard_alive("t/component/app.1.1/SOMEONE_ELSE"));
 }
 
 TEST_CASE("process links: the end of a process's link fails its calls at once and withdraws it",
           "[process-links]") {
-  Rig rig;
-  REQUIRE(rig.process->writer->send(frames::Announce{kChild, "component", {{"pid", 4242}}}));
-  REQUIRE(eventually([&] { return rig.heard_alive(kChild); }));
-  auto reply = rig.caller->call(kChild, "component.release", {}, 30s);
-  REQUIRE(std::holds_alternative<frames::Request>(rig.process->next()));
+  LinksRig rig;
+  REQUIRE(
+      rig.process->writer->send(link_msgs::Announce{kLinkedChild, "component", {{"pid", 4242}}}));
+  REQUIRE(links_eventually([&] { return rig.heard_alive(kLinkedChild); }));
+  auto reply = rig.caller->call(kLinkedChild, "component.release", {}, 30s);
+  REQUIRE(std::holds_alternative<link_msgs::Request>(rig.process->next()));
   const auto ended = std::chrono::steady_clock::now();
   rig.process->fd.reset(); // the process dies without answering
   REQUIRE(reply.wait_for(10s) == std::future_status::ready);
@@ -150,29 +153,29 @@ TEST_CASE("process links: the end of a process's link fails its calls at once an
   CHECK_THAT(answer.error().message, Catch::Contains("4242"));
   // Well before the call's own 30 s: the node saw the link end.
   CHECK(std::chrono::steady_clock::now() - ended < 10s);
-  REQUIRE(eventually([&] {
+  REQUIRE(links_eventually([&] {
     std::lock_guard lock(rig.heard_mutex);
-    return !rig.heard.empty() && rig.heard.back().address == kChild &&
+    return !rig.heard.empty() && rig.heard.back().address == kLinkedChild &&
            rig.heard.back().kind == control::AnnouncementEvent::Kind::Gone;
   }));
   // Once reaped, the address is served no longer: a call fails, it does not hang.
   rig.links->detach(4242);
-  auto after = rig.caller->call_sync(kChild, "component.status", {}, 2s);
+  auto after = rig.caller->call_sync(kLinkedChild, "component.status", {}, 2s);
   REQUIRE_FALSE(after.has_value());
 }
 
 TEST_CASE("process links: a process's own call is made on DDS by its node", "[process-links]") {
-  Rig rig;
+  LinksRig rig;
   rig.caller->on("test.echo", [](const control::Json &body, const control::RequestContext &c) {
     return control::CallResult<control::Json>(control::Json{{"echo", body}, {"from", c.sender}});
   });
   REQUIRE(rig.process->writer->send(
-      frames::Request{"1", "t/cli/test", "test.echo", kChild, 5000, {{"n", 7}}}));
+      link_msgs::Request{"1", "t/cli/test", "test.echo", kLinkedChild, 5000, {{"n", 7}}}));
   auto frame = rig.process->next();
-  auto *reply = std::get_if<frames::Reply>(&frame);
+  auto *reply = std::get_if<link_msgs::Reply>(&frame);
   REQUIRE(reply != nullptr);
   CHECK(reply->id == "1");
   REQUIRE(reply->status == 0);
   CHECK(reply->body.at("echo").at("n") == 7);
-  CHECK(reply->body.at("from") == kNode); // the node made it
+  CHECK(reply->body.at("from") == kLinkingNode); // the node made it
 }
