@@ -1,0 +1,81 @@
+// The node as its host's agent for control (protocol/node_link.hpp), end to end with real
+// daemons: a component process started by a node is controlled through the node, and has no DDS
+// participant (no UDP socket) unless it has data ports to connect.
+#include <catch2/catch.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "domain_fixture.hpp"
+
+using namespace rsca::test;
+
+namespace {
+
+// The inodes of the UDP sockets this network namespace has (/proc/net/udp and udp6).
+std::set<std::string> udp_socket_inodes() {
+  std::set<std::string> inodes;
+  for (const char *table : {"/proc/net/udp", "/proc/net/udp6"}) {
+    std::ifstream in(table);
+    std::string line;
+    std::getline(in, line); // the header
+    while (std::getline(in, line)) {
+      std::istringstream fields(line);
+      std::string field;
+      for (int i = 0; i < 10 && fields >> field; ++i) {
+      }
+      inodes.insert(field); // the tenth column
+    }
+  }
+  return inodes;
+}
+
+// How many UDP sockets process `pid` holds.
+int udp_sockets_of(long pid) {
+  const auto udp = udp_socket_inodes();
+  int count = 0;
+  for (const auto &fd : std::filesystem::directory_iterator(fmt::format("/proc/{}/fd", pid))) {
+    std::error_code error;
+    const auto target = std::filesystem::read_symlink(fd.path(), error).string();
+    if (error || !target.starts_with("socket:["))
+      continue;
+    if (udp.contains(target.substr(8, target.size() - 9)))
+      ++count;
+  }
+  return count;
+}
+
+const Json &component_named(const Json &app, const std::string &id) {
+  for (const auto &c : app.at("components"))
+    if (c.at("id") == id)
+      return c;
+  FAIL("no component " << id);
+  throw std::logic_error("unreachable");
+}
+
+} // namespace
+
+TEST_CASE("a component process with no data ports has no UDP socket: its node serves its control",
+          "[integration][node-agent]") {
+  TestDomain domain;
+  // Supervisor_1 has only a uses port of a control interface; Producer_1 has data ports.
+  const Json app = domain.create("Supervised");
+  const long supervisor = component_named(app, "Supervisor_1").at("pid").get<long>();
+  const long producer = component_named(app, "Producer_1").at("pid").get<long>();
+  // The component with data ports joins DDS (in the background, as it starts): the test can see
+  // UDP sockets at all, so the count below is not zero for want of seeing them.
+  REQUIRE(TestDomain::wait_for([&] { return udp_sockets_of(producer) > 0; }));
+  CHECK(udp_sockets_of(supervisor) == 0);
+  // Controlled all the same: its node relays (query, and the supervisor's own calls to the
+  // producer's address through the nodes, which its start made).
+  auto q = domain.call("app.query", Json{{"app", "Supervised"}, {"component", "Supervisor_1"}});
+  REQUIRE(q.has_value());
+  auto shown = domain.call("app.show", Json{{"app", "Supervised"}});
+  REQUIRE(shown.has_value());
+  CHECK(component_named(*shown, "Supervisor_1").at("state") == "running");
+  CHECK(udp_sockets_of(supervisor) == 0);
+  REQUIRE(domain.call("app.release", Json{{"app", "Supervised"}}).has_value());
+  domain.require_clean(pids_of(app));
+}
