@@ -141,14 +141,40 @@ void Endpoint::Impl::take_requests() {
   }
 }
 
+std::optional<std::future<CallResult<Json>>>
+Endpoint::Impl::start_relay(const RequestContext &context, const Json &body) {
+  RelayHandler relay;
+  {
+    std::lock_guard lock(state_mutex);
+    auto it = relays.find(context.target);
+    if (it == relays.end())
+      return std::nullopt;
+    relay = it->second;
+    ++running[context.target];
+  }
+  return relay(body, context);
+}
+
+CallResult<Json> Endpoint::Impl::finish(const std::string &target,
+                                        std::future<CallResult<Json>> started) {
+  CallResult<Json> result = started.get();
+  {
+    std::lock_guard lock(state_mutex);
+    if (--running[target] == 0)
+      running.erase(target);
+  }
+  handler_done.notify_all();
+  return result;
+}
+
 // Runs the handler for the request's address and operation. stop_serving waits for it.
 CallResult<Json> Endpoint::Impl::dispatch(const RequestContext &context, const Json &body) {
+  if (auto started = start_relay(context, body))
+    return finish(context.target, std::move(*started));
   Handler handler;
   {
     std::lock_guard lock(state_mutex);
     auto it = handlers.find({context.target, context.operation});
-    if (it == handlers.end())
-      it = handlers.find({context.target, std::string(kAnyOperation)});
     if (it == handlers.end())
       it = handlers.find({std::string(), context.operation});
     if (it == handlers.end())
@@ -167,19 +193,31 @@ CallResult<Json> Endpoint::Impl::dispatch(const RequestContext &context, const J
   return result;
 }
 
-// The calls of one batch, one after another; a result each.
+// The calls of one batch, a result each: the relayed ones all started first, the others run one
+// after another meanwhile, then the relayed ones waited for.
 CallResult<Json> Endpoint::Impl::run_batch(const RequestContext &context, const Json &body) {
   auto calls = body.find("calls");
   if (calls == body.end() || !calls->is_array())
     return call_error(Status::BadRequest, "a batch needs \"calls\", an array");
-  Json results = Json::array();
+  std::vector<RequestContext> items;
+  std::vector<Json> bodies;
+  std::vector<std::optional<std::future<CallResult<Json>>>> started;
   for (const auto &c : *calls) {
     RequestContext item{context.id, context.sender, c.value("operation", ""), c.value("target", ""),
                         context.received};
-    const Json item_body = c.value("body", Json::object());
-    results.push_back(reply_json(item.operation == kBatch
+    bodies.push_back(c.value("body", Json::object()));
+    started.push_back(item.operation == kBatch ? std::nullopt : start_relay(item, bodies.back()));
+    items.push_back(std::move(item));
+  }
+  Json results = Json::array();
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    if (started[i]) {
+      results.push_back(reply_json(finish(items[i].target, std::move(*started[i]))));
+      continue;
+    }
+    results.push_back(reply_json(items[i].operation == kBatch
                                      ? call_error(Status::BadRequest, "batches do not nest")
-                                     : dispatch(item, item_body)));
+                                     : dispatch(items[i], bodies[i])));
   }
   return Json{{"results", std::move(results)}};
 }
@@ -299,6 +337,11 @@ void Endpoint::on(const std::string &address, const std::string &operation, Hand
   impl_->handlers[{address, operation}] = std::move(handler);
 }
 
+void Endpoint::relay(const std::string &address, RelayHandler handler) {
+  std::lock_guard lock(impl_->state_mutex);
+  impl_->relays[address] = std::move(handler);
+}
+
 void Endpoint::start_serving() {
   dds_set_status_mask(impl_->request_reader.get(), DDS_DATA_AVAILABLE_STATUS);
   impl_->serving = true;
@@ -316,6 +359,7 @@ void Endpoint::stop_serving() {
 void Endpoint::stop_serving(const std::string &address) {
   std::unique_lock lock(impl_->state_mutex);
   std::erase_if(impl_->handlers, [&](const auto &entry) { return entry.first.first == address; });
+  impl_->relays.erase(address);
   impl_->handler_done.wait(lock, [&] { return !impl_->running.contains(address); });
 }
 

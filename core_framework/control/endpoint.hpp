@@ -48,6 +48,9 @@ struct AnnouncementEvent {
 };
 using AnnouncementHandler = std::function<void(const AnnouncementEvent &)>;
 
+using RelayHandler =
+    std::function<std::future<CallResult<Json>>(const Json &body, const RequestContext &context)>;
+
 struct EndpointOptions {
   std::size_t workers = 8; // threads that run request handlers
   std::size_t senders = 4; // threads that write requests, so callers never wait on discovery
@@ -85,6 +88,11 @@ public:
   // Serves `operation` at `address` (its own or an alias) only, before any handler of
   // on(operation).
   void on(const std::string &address, const std::string &operation, Handler handler) override;
+  // Serves every operation at `address` by handing it on (a node, to the process it started):
+  // the handler starts the call and returns its result to come, and must not block. In a batch,
+  // every relayed call starts before any is waited for, so the processes behind a node work on
+  // their parts at once.
+  void relay(const std::string &address, RelayHandler handler);
   // Serves the requests held since open (EndpointOptions::hold_requests) and those that follow.
   void start_serving();
   // Drops the handlers of `address` and returns once none of them is running any more.

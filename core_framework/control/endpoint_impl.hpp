@@ -136,6 +136,7 @@ struct Endpoint::Impl {
 
   std::mutex state_mutex;
   std::map<std::pair<std::string, std::string>, Handler> handlers; // (address or "", operation)
+  std::map<std::string, RelayHandler> relays;                      // by address
   std::map<std::string, int> running;                              // handlers running, by address
   std::condition_variable handler_done;
   std::map<std::string, Pending> pending;
@@ -158,6 +159,11 @@ struct Endpoint::Impl {
   void fail_calls_to_departed();
   void serve(RequestContext context, Json body);
   CallResult<Json> dispatch(const RequestContext &context, const Json &body);
+  // A call to a relayed address, started: its result to come (none when the address is not
+  // relayed). finish() waits for it; the address counts as running until then.
+  std::optional<std::future<CallResult<Json>>> start_relay(const RequestContext &context,
+                                                           const Json &body);
+  CallResult<Json> finish(const std::string &target, std::future<CallResult<Json>> started);
   CallResult<Json> run_batch(const RequestContext &context, const Json &body);
   std::string route_of(const std::string &target);
   Expected<void> announce(const std::string &as, const std::string &kind, const Json &body);

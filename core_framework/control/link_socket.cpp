@@ -63,9 +63,16 @@ tl::expected<void, std::string> LinkWriter::send(const link::Frame &frame) {
     const ssize_t n = ::send(fd_, wire.data() + sent, wire.size() - sent, MSG_NOSIGNAL);
     if (n < 0 && errno == EINTR)
       continue;
-    if (n < 0)
-      return tl::unexpected(errno == EAGAIN ? std::string("the peer does not read its link")
-                                            : fmt::format("send: {}", std::strerror(errno)));
+    if (n < 0) {
+      const int error = errno;
+      // Part of a frame went: the stream is cut mid-frame and no later frame could be read, so
+      // the link ends here, for both sides.
+      if (sent > 0)
+        ::shutdown(fd_, SHUT_RDWR);
+      return tl::unexpected(error == EAGAIN || error == EWOULDBLOCK
+                                ? std::string("the peer does not read its link")
+                                : fmt::format("send: {}", std::strerror(error)));
+    }
     sent += static_cast<std::size_t>(n);
   }
   return {};
@@ -73,7 +80,7 @@ tl::expected<void, std::string> LinkWriter::send(const link::Frame &frame) {
 
 bool FrameReader::read_from(int fd, std::vector<link::Frame> &frames, std::string &why) {
   char chunk[64 * 1024];
-  const ssize_t n = ::recv(fd, chunk, sizeof(chunk), 0);
+  const ssize_t n = ::recv(fd, chunk, sizeof(chunk), MSG_DONTWAIT);
   if (n < 0 && (errno == EINTR || errno == EAGAIN))
     return true;
   if (n < 0) {

@@ -26,7 +26,8 @@ protocol::link::Reply link_reply(const std::string &id,
 tl::expected<std::pair<process::Fd, process::Fd>, std::string> make_link_pair();
 
 // Writes frames to a link, whole, from any thread. The socket is blocking with a send timeout:
-// a peer that stops reading fails a write after `timeout`, never holds its writer forever.
+// a peer that stops reading fails a write after `timeout`, never holds its writer forever; a
+// frame cut by that ends the link (shutdown), since the stream can no longer be read.
 class LinkWriter {
 public:
   explicit LinkWriter(int fd, std::chrono::milliseconds timeout = std::chrono::seconds(5));
@@ -40,9 +41,9 @@ private:
 // Collects the bytes read from a link and cuts them into frames.
 class FrameReader {
 public:
-  // Reads what the socket has (once; blocking unless the socket is non-blocking) and appends the
-  // whole frames it completes to `frames`. False, with why, at the end of the link (the peer
-  // closed it or died) or on a frame that breaks the protocol; the link is then to be closed.
+  // Reads what the socket has (once, without waiting: call it when poll says it is readable) and
+  // appends the whole frames it completes to `frames`. False, with why, at the end of the link (the
+  // peer closed it or died) or on a frame that breaks the protocol; the link is then to be closed.
   bool read_from(int fd, std::vector<protocol::link::Frame> &frames, std::string &why);
 
 private:

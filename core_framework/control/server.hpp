@@ -30,10 +30,6 @@ struct RequestContext {
 
 using Handler = std::function<CallResult<Json>(const Json &body, const RequestContext &context)>;
 
-// As an operation name: every operation at one address (a node relaying to the process that
-// serves it; the context names the operation).
-inline constexpr std::string_view kAnyOperation = "*";
-
 // In an announcement's body: the endpoint that serves the announced address on its behalf (the
 // node, for a process it started). Whoever follows announcements routes calls to the address
 // there.

@@ -66,12 +66,16 @@ struct ProcessLinks::Impl {
   struct Relayed {
     pid_t pid = 0;
     std::promise<CallResult<Json>> promise;
+    std::chrono::steady_clock::time_point deadline;
   };
   std::map<std::string, Relayed> relayed; // requests under way, by id
   std::uint64_t next_id = 0;
   bool closed = false;
 
-  CallResult<Json> relay(const Json &body, const control::RequestContext &context);
+  // Hands a request on to the process that serves its target; its reply to come.
+  std::future<CallResult<Json>> relay(const Json &body, const control::RequestContext &context);
+  void complete(const std::string &id, pid_t pid, CallResult<Json> result);
+  void expire();
   void poll_loop();
   void read(int fd);
   void take(const std::shared_ptr<LinkedProcess> &process, link::Frame frame);
@@ -81,8 +85,18 @@ struct ProcessLinks::Impl {
   void end(LinkedProcess &process, const std::string &why);
 };
 
-CallResult<Json> ProcessLinks::Impl::relay(const Json &body,
-                                           const control::RequestContext &context) {
+namespace {
+
+std::future<CallResult<Json>> ready(CallResult<Json> result) {
+  std::promise<CallResult<Json>> promise;
+  promise.set_value(std::move(result));
+  return promise.get_future();
+}
+
+} // namespace
+
+std::future<CallResult<Json>> ProcessLinks::Impl::relay(const Json &body,
+                                                        const control::RequestContext &context) {
   std::shared_ptr<LinkedProcess> process;
   std::string id;
   std::future<CallResult<Json>> reply;
@@ -90,14 +104,16 @@ CallResult<Json> ProcessLinks::Impl::relay(const Json &body,
     std::lock_guard lock(mutex);
     auto it = by_address.find(context.target);
     if (closed || it == by_address.end())
-      return call_error(Status::Unavailable, fmt::format("{} is not served here", context.target));
+      return ready(
+          call_error(Status::Unavailable, fmt::format("{} is not served here", context.target)));
     process = it->second;
     if (process->ended)
-      return call_error(Status::Unavailable,
-                        fmt::format("pid {} has exited: {}", process->pid, process->why));
+      return ready(call_error(Status::Unavailable,
+                              fmt::format("pid {} has exited: {}", process->pid, process->why)));
     id = std::to_string(++next_id);
     auto &r = relayed[id];
     r.pid = process->pid;
+    r.deadline = std::chrono::steady_clock::now() + kRelayBound;
     reply = r.promise.get_future();
   }
   const link::Request request{id,
@@ -107,23 +123,45 @@ CallResult<Json> ProcessLinks::Impl::relay(const Json &body,
                               std::chrono::milliseconds(kRelayBound).count(),
                               body};
   if (auto sent = process->writer->send(request); !sent) {
-    std::lock_guard lock(mutex);
-    relayed.erase(id);
-    return call_error(Status::Unavailable, fmt::format("pid {}: {}", process->pid, sent.error()));
+    complete(
+        id, process->pid,
+        call_error(Status::Unavailable, fmt::format("pid {}: {}", process->pid, sent.error())));
   }
-  if (reply.wait_for(kRelayBound) == std::future_status::ready)
-    return reply.get();
+  return reply;
+}
+
+void ProcessLinks::Impl::complete(const std::string &id, pid_t pid, CallResult<Json> result) {
   std::lock_guard lock(mutex);
-  relayed.erase(id);
-  return call_error(Status::Timeout, fmt::format("pid {} did not answer {} in {} s", process->pid,
-                                                 context.operation, kRelayBound.count()));
+  auto it = relayed.find(id);
+  // Only the process asked may answer: a reply to another's request is dropped.
+  if (it == relayed.end() || it->second.pid != pid)
+    return;
+  it->second.promise.set_value(std::move(result));
+  relayed.erase(it);
+}
+
+// Relayed requests past their bound fail (the process lives but does not answer).
+void ProcessLinks::Impl::expire() {
+  const auto now = std::chrono::steady_clock::now();
+  std::lock_guard lock(mutex);
+  for (auto it = relayed.begin(); it != relayed.end();) {
+    if (it->second.deadline > now) {
+      ++it;
+      continue;
+    }
+    it->second.promise.set_value(
+        call_error(Status::Timeout, fmt::format("pid {} did not answer in {} s", it->second.pid,
+                                                kRelayBound.count())));
+    it = relayed.erase(it);
+  }
 }
 
 void ProcessLinks::Impl::poll_loop() {
   constexpr int kEvents = 64;
   epoll_event events[kEvents];
   while (!stopping) {
-    const int n = ::epoll_wait(epoll.get(), events, kEvents, -1);
+    const int n = ::epoll_wait(epoll.get(), events, kEvents, 1000);
+    expire();
     if (n < 0 && errno != EINTR) {
       spdlog::error("process links: epoll_wait: {}", std::strerror(errno));
       return;
@@ -158,13 +196,7 @@ void ProcessLinks::Impl::read(int fd) {
 
 void ProcessLinks::Impl::take(const std::shared_ptr<LinkedProcess> &process, link::Frame frame) {
   if (auto *reply = std::get_if<link::Reply>(&frame)) {
-    std::lock_guard lock(mutex);
-    auto it = relayed.find(reply->id);
-    // Only the process asked may answer: a reply to another's request is dropped.
-    if (it == relayed.end() || it->second.pid != process->pid)
-      return;
-    it->second.promise.set_value(control::reply_result(*reply));
-    relayed.erase(it);
+    complete(reply->id, process->pid, control::reply_result(*reply));
   } else if (auto *request = std::get_if<link::Request>(&frame)) {
     outgoing->post(
         [this, process, r = std::move(*request)]() mutable { make_call(process, std::move(r)); });
@@ -271,7 +303,6 @@ void ProcessLinks::attach(pid_t pid, process::Fd link, std::vector<std::string> 
   auto process = std::make_shared<LinkedProcess>();
   process->pid = pid;
   process->addresses = std::move(addresses);
-  ::fcntl(link.get(), F_SETFL, ::fcntl(link.get(), F_GETFL) | O_NONBLOCK);
   process->writer = std::make_unique<control::LinkWriter>(link.get());
   const int fd = link.get();
   process->fd = std::move(link);
@@ -286,10 +317,9 @@ void ProcessLinks::attach(pid_t pid, process::Fd link, std::vector<std::string> 
   }
   Impl *raw = impl_.get();
   for (const auto &a : process->addresses)
-    impl_->endpoint->on(a, std::string(control::kAnyOperation),
-                        [raw](const Json &body, const control::RequestContext &context) {
-                          return raw->relay(body, context);
-                        });
+    impl_->endpoint->relay(a, [raw](const Json &body, const control::RequestContext &context) {
+      return raw->relay(body, context);
+    });
   epoll_event event{};
   event.events = EPOLLIN;
   event.data.fd = fd;

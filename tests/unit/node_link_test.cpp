@@ -5,6 +5,8 @@
 
 #include <thread>
 
+#include <poll.h>
+
 #include <sys/socket.h>
 
 #include "control/link_socket.hpp"
@@ -28,6 +30,8 @@ struct LinkFakeNode {
   // Blocks until a frame comes (the socket is blocking); fails the test on the link's end.
   link_frames::Frame next() {
     while (frames.empty()) {
+      pollfd readable{fd.get(), POLLIN, 0};
+      REQUIRE(::poll(&readable, 1, 10000) == 1); // a frame comes within 10 s, or the test fails
       std::string why;
       REQUIRE(reader.read_from(fd.get(), frames, why));
     }

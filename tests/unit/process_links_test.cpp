@@ -6,6 +6,8 @@
 
 #include <thread>
 
+#include <poll.h>
+
 #include "control/link_socket.hpp"
 #include "node/process_links.hpp"
 #include "test_domain.hpp"
@@ -30,6 +32,8 @@ struct LinkedFakeProcess {
       : fd(std::move(end)), writer(std::make_unique<control::LinkWriter>(fd.get())) {}
   link_msgs::Frame next() {
     while (in.empty()) {
+      pollfd readable{fd.get(), POLLIN, 0};
+      REQUIRE(::poll(&readable, 1, 10000) == 1); // a frame comes within 10 s, or the test fails
       std::string why;
       REQUIRE(reader.read_from(fd.get(), in, why));
     }
