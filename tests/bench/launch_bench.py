@@ -11,6 +11,10 @@ component hosts (N = 10, 100, 1000), and for each launches and releases the chai
   DDS discovery, about 40 ms);
 - baseline: a plain fork/exec of N processes of the same executable, started at once and waited
   for (they exit at once: no exec parameters), the cost of process creation alone;
+- join (processes only): one bare participant joining the running domain, until it has
+  discovered its daemons (`rsca-bench-raw discovery --participants 1 --existing K`); with the
+  fork/exec baseline it gives issue 20's ratio, `launch ratio N processes on M nodes = R` with
+  R = launch median / (fork/exec median + join median);
 - DDS baseline (processes only): `rsca-bench-raw discovery`, N processes forked at once, each with
   a bare Cyclone DDS participant joined as a component process joins, and the time until each has
   discovered all the others: what launching N component processes costs DDS alone.
@@ -63,6 +67,24 @@ def discovery_baseline(raw, n, env, timeout_ms):
         return {"participants": n, "error": (out.stderr or out.stdout)[:300]}
 
 
+def join_baseline_ms(raw, domain, runs):
+    """The join of one new participant to the running domain (issue 20's baseline): a bare
+    participant, joined as a component process joins, until it has discovered the domain daemon
+    and every node daemon. Median of `runs`, or None when it never settled."""
+    times = []
+    for _ in range(runs):
+        out = subprocess.run([raw, "discovery", "--participants", "1", "--existing",
+                              str(1 + domain.nodes), "--timeout-ms", "10000"], env=domain.env,
+                             capture_output=True, text=True, timeout=70)
+        try:
+            d = json.loads(out.stdout)
+        except ValueError:
+            continue
+        if d.get("settled") == 1:
+            times.append(d["settled_max_ms"])
+    return summary(times) if times else None
+
+
 def host_footprint(domain, app):
     """The component hosts of a running application: how many, components per host, RSS per host
     and their CPU use over 2 s of idling (all hosts together, % of one core)."""
@@ -80,7 +102,7 @@ def host_footprint(domain, app):
             "cpu_percent_idle": 100.0 * ticks / os.sysconf("SC_CLK_TCK") / 2.0}
 
 
-def bench_n(domain, n, hosted, runs, sdr, relay):
+def bench_n(domain, n, hosted, runs, sdr, relay, raw):
     sad, name = generate(n, hosted, sdr)
     domain.cli("install", "--sdrroot", sdr, sad)
     launch_domain, launch_cli, release_cli, base, steps, failures = [], [], [], [], {}, []
@@ -109,7 +131,8 @@ def bench_n(domain, n, hosted, runs, sdr, relay):
             "launch_domain_ms": summary(launch_domain), "launch_cli_ms": summary(launch_cli),
             "release_cli_ms": summary(release_cli), "baseline_fork_exec_ms": summary(base),
             "steps_ms_median": {k: sorted(v)[len(v) // 2] for k, v in steps.items()},
-            "host_footprint": footprint}
+            "host_footprint": footprint,
+            "join_ms": None if hosted else join_baseline_ms(raw, domain, runs)}
 
 
 def main():
@@ -137,7 +160,8 @@ def main():
                 with Domain(rsca, nodes=10) as domain:
                     n_runs = min(runs, 3) if n >= 1000 else runs
                     results.append(bench_n(domain, n, hosted, n_runs, sdr,
-                                           os.path.join(args.bin, "rsca-relay")))
+                                           os.path.join(args.bin, "rsca-relay"),
+                                           os.path.join(args.bin, "rsca-bench-raw")))
             if not hosted:  # with no domain up, so that only the baseline's processes run
                 results[-1]["raw_discovery"] = discovery_baseline(
                     os.path.join(args.bin, "rsca-bench-raw"), n, dds_env(),
@@ -169,6 +193,15 @@ def main():
                     f"within {d.get('timeout_ms', 0)} ms {d.get('error', '')}")
         print(f"DDS baseline at {r['components']} processes: {d['participants']} bare Cyclone "
               f"participants forked at once: {seen}")
+    # Issue 20: R = launch median / (fork/exec median + join median), same run.
+    for r in results:
+        if r.get("join_ms") and "launch_domain_ms" in r:
+            base = r["baseline_fork_exec_ms"]["median"] + r["join_ms"]["median"]
+            print(f"launch ratio {r['components']} processes on {r['nodes']} nodes = "
+                  f"{r['launch_domain_ms']['median'] / base:.2f} (launch "
+                  f"{r['launch_domain_ms']['median']:.0f} ms, fork/exec "
+                  f"{r['baseline_fork_exec_ms']['median']:.0f} ms, join of one participant "
+                  f"{r['join_ms']['median']:.0f} ms)")
     for a, b in zip(results, results[1:]):
         if a["kind"] != b["kind"] or "launch_domain_ms" not in a or "launch_domain_ms" not in b:
             continue

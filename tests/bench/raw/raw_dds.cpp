@@ -13,7 +13,7 @@
 //   rsca-bench-raw echo --in TOPIC --out TOPIC --qos JSON [--wake waitset|listener] (until SIGTERM)
 //   rsca-bench-raw pub --topic TOPIC --qos JSON --subscribers N --output FILE [schedule...]
 //   rsca-bench-raw sub --topic TOPIC --qos JSON --capacity N --output FILE   (until SIGTERM)
-//   rsca-bench-raw discovery --participants N --timeout-ms T
+//   rsca-bench-raw discovery --participants N --timeout-ms T [--existing K]
 //
 // Times, payloads and result files: tests/bench/bench_common.hpp.
 #include <fcntl.h>
@@ -373,7 +373,8 @@ int sub(const std::string &topic, const std::string &qos, std::uint64_t capacity
 
 // One participant of `discovery`, in a process of its own, joined as a component process joins
 // (the project's configuration with the component lease): it writes on `report` when it has seen
-// all `participants` (itself included), the nanoseconds since `started`, then waits for SIGTERM.
+// `participants` of them (itself included, and those already there before it: --existing), the
+// nanoseconds since `started`, then waits for SIGTERM.
 [[noreturn]] void discovery_member(std::size_t participants, std::uint64_t started, int report) {
   auto participant =
       rsca::dds::Participant::create(rsca::dds::DdsSettings::from_environment().for_component());
@@ -429,7 +430,7 @@ std::vector<std::uint64_t> read_reports(int from, std::size_t expected, std::uin
 
 // The raw baseline of launching N component processes: N processes forked at once, each with a
 // DDS participant; how long until each has discovered all the others.
-int discovery(std::size_t participants, std::uint64_t timeout_ms) {
+int discovery(std::size_t participants, std::size_t existing, std::uint64_t timeout_ms) {
   int report[2];
   if (pipe2(report, O_CLOEXEC) != 0)
     die("cannot make a pipe");
@@ -439,7 +440,7 @@ int discovery(std::size_t participants, std::uint64_t timeout_ms) {
     const pid_t pid = fork();
     if (pid == 0) {
       close(report[0]);
-      discovery_member(participants, started, report[1]);
+      discovery_member(participants + existing, started, report[1]);
     }
     if (pid < 0)
       break;
@@ -567,6 +568,10 @@ int main(int argc, char **argv) {
       "discovery", "N participant processes at once; when each has discovered all the others");
   discovery_cmd->add_option("--participants", participants)->check(CLI::Range(1, 1000));
   discovery_cmd->add_option("--timeout-ms", discovery_timeout_ms, "Stop waiting after");
+  std::size_t existing = 0;
+  discovery_cmd->add_option("--existing", existing,
+                            "Participants already running (a domain's daemons) to discover too: "
+                            "with --participants 1, the join of one new participant");
   CLI11_PARSE(app, argc, argv);
 
   struct sigaction action {};
@@ -585,6 +590,6 @@ int main(int argc, char **argv) {
   if (*sizes_cmd)
     return sizes();
   if (*discovery_cmd)
-    return discovery(participants, discovery_timeout_ms);
+    return discovery(participants, existing, discovery_timeout_ms);
   return 2;
 }
