@@ -141,58 +141,6 @@ void Endpoint::Impl::take_requests() {
   }
 }
 
-std::optional<std::future<CallResult<Json>>>
-Endpoint::Impl::start_relay(const RequestContext &context, const Json &body) {
-  RelayHandler relay;
-  {
-    std::lock_guard lock(state_mutex);
-    auto it = relays.find(context.target);
-    if (it == relays.end())
-      return std::nullopt;
-    relay = it->second;
-    ++running[context.target];
-  }
-  return relay(body, context);
-}
-
-CallResult<Json> Endpoint::Impl::finish(const std::string &target,
-                                        std::future<CallResult<Json>> started) {
-  CallResult<Json> result = started.get();
-  {
-    std::lock_guard lock(state_mutex);
-    if (--running[target] == 0)
-      running.erase(target);
-  }
-  handler_done.notify_all();
-  return result;
-}
-
-// Runs the handler for the request's address and operation. stop_serving waits for it.
-CallResult<Json> Endpoint::Impl::dispatch(const RequestContext &context, const Json &body) {
-  if (auto started = start_relay(context, body))
-    return finish(context.target, std::move(*started));
-  Handler handler;
-  {
-    std::lock_guard lock(state_mutex);
-    auto it = handlers.find({context.target, context.operation});
-    if (it == handlers.end())
-      it = handlers.find({std::string(), context.operation});
-    if (it == handlers.end())
-      return call_error(Status::BadRequest, fmt::format("{} does not serve operation \"{}\"",
-                                                        context.target, context.operation));
-    handler = it->second;
-    ++running[context.target];
-  }
-  CallResult<Json> result = run_handler(handler, body, context);
-  {
-    std::lock_guard lock(state_mutex);
-    if (--running[context.target] == 0)
-      running.erase(context.target);
-  }
-  handler_done.notify_all();
-  return result;
-}
-
 // The calls of one batch, a result each: the relayed ones all started first, the others run one
 // after another meanwhile, then the relayed ones waited for.
 CallResult<Json> Endpoint::Impl::run_batch(const RequestContext &context, const Json &body) {
@@ -206,18 +154,19 @@ CallResult<Json> Endpoint::Impl::run_batch(const RequestContext &context, const 
     RequestContext item{context.id, context.sender, c.value("operation", ""), c.value("target", ""),
                         context.received};
     bodies.push_back(c.value("body", Json::object()));
-    started.push_back(item.operation == kBatch ? std::nullopt : start_relay(item, bodies.back()));
+    started.push_back(item.operation == kBatch ? std::nullopt
+                                               : served.start_relay(item, bodies.back()));
     items.push_back(std::move(item));
   }
   Json results = Json::array();
   for (std::size_t i = 0; i < items.size(); ++i) {
     if (started[i]) {
-      results.push_back(reply_json(finish(items[i].target, std::move(*started[i]))));
+      results.push_back(reply_json(served.finish(items[i].target, std::move(*started[i]))));
       continue;
     }
     results.push_back(reply_json(items[i].operation == kBatch
                                      ? call_error(Status::BadRequest, "batches do not nest")
-                                     : dispatch(items[i], bodies[i])));
+                                     : served.dispatch(items[i], bodies[i])));
   }
   return Json{{"results", std::move(results)}};
 }
@@ -226,7 +175,7 @@ void Endpoint::Impl::serve(RequestContext context, Json body) {
   CallResult<Json> result =
       body.is_discarded() ? call_error(Status::BadRequest, "the request body is not valid JSON")
       : context.operation == kBatch ? run_batch(context, body)
-                                    : dispatch(context, body);
+                                    : served.dispatch(context, body);
   const std::string reply_body = result ? result->dump() : protocol::error_body(result.error());
   const std::string error = result ? std::string() : result.error().message;
   rsca_ctl_Reply reply{};
@@ -328,18 +277,15 @@ const std::string &Endpoint::address() const {
 }
 
 void Endpoint::on(const std::string &operation, Handler handler) {
-  std::lock_guard lock(impl_->state_mutex);
-  impl_->handlers[{std::string(), operation}] = std::move(handler);
+  impl_->served.on(std::string(), operation, std::move(handler));
 }
 
 void Endpoint::on(const std::string &address, const std::string &operation, Handler handler) {
-  std::lock_guard lock(impl_->state_mutex);
-  impl_->handlers[{address, operation}] = std::move(handler);
+  impl_->served.on(address, operation, std::move(handler));
 }
 
 void Endpoint::relay(const std::string &address, RelayHandler handler) {
-  std::lock_guard lock(impl_->state_mutex);
-  impl_->relays[address] = std::move(handler);
+  impl_->served.relay(address, std::move(handler));
 }
 
 void Endpoint::start_serving() {
@@ -357,10 +303,7 @@ void Endpoint::stop_serving() {
 }
 
 void Endpoint::stop_serving(const std::string &address) {
-  std::unique_lock lock(impl_->state_mutex);
-  std::erase_if(impl_->handlers, [&](const auto &entry) { return entry.first.first == address; });
-  impl_->relays.erase(address);
-  impl_->handler_done.wait(lock, [&] { return !impl_->running.contains(address); });
+  impl_->served.drop(address);
 }
 
 void Endpoint::prepare(const std::string &target) {

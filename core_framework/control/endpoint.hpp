@@ -23,6 +23,7 @@
 
 #include "common/diagnostic.hpp"
 #include "control/caller.hpp"
+#include "control/handler_table.hpp"
 #include "control/server.hpp"
 #include "dds/participant.hpp"
 #include "protocol/status.hpp"

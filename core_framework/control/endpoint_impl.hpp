@@ -19,6 +19,7 @@
 #include <fmt/format.h>
 
 #include "control/endpoint.hpp"
+#include "control/handler_table.hpp"
 #include "control/partition_writers.hpp"
 #include "control/worker_pool.hpp"
 #include "dds/entity.hpp"
@@ -85,18 +86,6 @@ inline CallResult<Json> result_of(const Json &reply) {
   return failed;
 }
 
-// Runs a handler. A request is untrusted: a handler that reads a field of the wrong type (JSON's
-// type errors) answers BadRequest instead of ending the process.
-inline CallResult<Json> run_handler(const Handler &handler, const Json &body,
-                                    const RequestContext &context) {
-  try {
-    return handler(body, context);
-  } catch (const Json::exception &e) {
-    return call_error(Status::BadRequest,
-                      fmt::format("malformed \"{}\" request: {}", context.operation, e.what()));
-  }
-}
-
 inline Json parse_body(const char *text) {
   if (text == nullptr || *text == '\0')
     return Json::object();
@@ -135,10 +124,7 @@ struct Endpoint::Impl {
   Clock::time_point departures_checked;      // receive thread only
 
   std::mutex state_mutex;
-  std::map<std::pair<std::string, std::string>, Handler> handlers; // (address or "", operation)
-  std::map<std::string, RelayHandler> relays;                      // by address
-  std::map<std::string, int> running;                              // handlers running, by address
-  std::condition_variable handler_done;
+  HandlerTable served;
   std::map<std::string, Pending> pending;
   std::uint64_t next_id = 0;
 
@@ -158,12 +144,7 @@ struct Endpoint::Impl {
   void expire_calls();
   void fail_calls_to_departed();
   void serve(RequestContext context, Json body);
-  CallResult<Json> dispatch(const RequestContext &context, const Json &body);
-  // A call to a relayed address, started: its result to come (none when the address is not
-  // relayed). finish() waits for it; the address counts as running until then.
-  std::optional<std::future<CallResult<Json>>> start_relay(const RequestContext &context,
-                                                           const Json &body);
-  CallResult<Json> finish(const std::string &target, std::future<CallResult<Json>> started);
+
   CallResult<Json> run_batch(const RequestContext &context, const Json &body);
   std::string route_of(const std::string &target);
   Expected<void> announce(const std::string &as, const std::string &kind, const Json &body);

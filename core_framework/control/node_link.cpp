@@ -17,6 +17,7 @@
 #include <spdlog/spdlog.h>
 #include <sys/eventfd.h>
 
+#include "control/handler_table.hpp"
 #include "control/link_socket.hpp"
 #include "control/worker_pool.hpp"
 
@@ -34,10 +35,9 @@ struct NodeLink::Impl {
   std::thread reader;
   std::atomic<bool> stopping{false};
 
+  HandlerTable served;
+
   std::mutex mutex; // guards what follows
-  std::condition_variable handler_done;
-  std::map<std::pair<std::string, std::string>, Handler> handlers; // (address, operation)
-  std::map<std::string, int> running;                              // handlers under way
   struct Pending {
     std::promise<CallResult<Json>> promise;
     Clock::time_point deadline;
@@ -49,7 +49,6 @@ struct NodeLink::Impl {
   void read_loop();
   void take(link::Frame frame);
   void serve(link::Request request);
-  CallResult<Json> dispatch(const RequestContext &context, const Json &body);
   void complete(const std::string &id, CallResult<Json> result);
   void fail_all(const std::string &why);
   void expire();
@@ -97,39 +96,10 @@ void NodeLink::Impl::serve(link::Request request) {
                          Clock::now()};
   if (context.target.empty())
     context.target = address;
-  const auto result = dispatch(context, request.body);
+  const auto result = served.dispatch(context, request.body);
   if (auto sent = writer->send(link_reply(request.id, result)); !sent)
     spdlog::warn("{}: reply to {} for {} failed: {}", address, request.sender, request.operation,
                  sent.error());
-}
-
-CallResult<Json> NodeLink::Impl::dispatch(const RequestContext &context, const Json &body) {
-  Handler handler;
-  {
-    std::lock_guard lock(mutex);
-    auto it = handlers.find({context.target, context.operation});
-    if (it == handlers.end())
-      it = handlers.find({std::string(), context.operation});
-    if (it == handlers.end())
-      return call_error(Status::BadRequest, fmt::format("{} does not serve operation \"{}\"",
-                                                        context.target, context.operation));
-    handler = it->second;
-    ++running[context.target];
-  }
-  CallResult<Json> result = [&]() -> CallResult<Json> {
-    try {
-      return handler(body, context);
-    } catch (const std::exception &e) {
-      return call_error(Status::Failed, e.what());
-    }
-  }();
-  {
-    std::lock_guard lock(mutex);
-    if (--running[context.target] == 0)
-      running.erase(context.target);
-  }
-  handler_done.notify_all();
-  return result;
 }
 
 void NodeLink::Impl::complete(const std::string &id, CallResult<Json> result) {
@@ -222,19 +192,15 @@ const std::string &NodeLink::address() const {
 }
 
 void NodeLink::on(const std::string &operation, Handler handler) {
-  std::lock_guard lock(impl_->mutex);
-  impl_->handlers[{std::string(), operation}] = std::move(handler);
+  impl_->served.on(std::string(), operation, std::move(handler));
 }
 
 void NodeLink::on(const std::string &address, const std::string &operation, Handler handler) {
-  std::lock_guard lock(impl_->mutex);
-  impl_->handlers[{address, operation}] = std::move(handler);
+  impl_->served.on(address, operation, std::move(handler));
 }
 
 void NodeLink::stop_serving(const std::string &address) {
-  std::unique_lock lock(impl_->mutex);
-  std::erase_if(impl_->handlers, [&](const auto &entry) { return entry.first.first == address; });
-  impl_->handler_done.wait(lock, [&] { return !impl_->running.contains(address); });
+  impl_->served.drop(address);
 }
 
 std::future<CallResult<Json>> NodeLink::call(const std::string &target,

@@ -5,45 +5,20 @@
 
 #include <thread>
 
-#include <poll.h>
-
 #include <sys/socket.h>
 
 #include "control/link_socket.hpp"
 #include "control/node_link.hpp"
+#include "link_peer.hpp"
 
 using namespace rsca;
 namespace link_frames = rsca::protocol::link;
 
 namespace {
 
-// The test's side of the link: writes frames and reads them whole.
-struct LinkFakeNode {
-  process::Fd fd;
-  std::unique_ptr<control::LinkWriter> writer;
-  control::FrameReader reader;
-  std::vector<link_frames::Frame> frames;
-
-  explicit LinkFakeNode(process::Fd end) : fd(std::move(end)) {
-    writer = std::make_unique<control::LinkWriter>(fd.get());
-  }
-  // Blocks until a frame comes (the socket is blocking); fails the test on the link's end.
-  link_frames::Frame next() {
-    while (frames.empty()) {
-      pollfd readable{fd.get(), POLLIN, 0};
-      REQUIRE(::poll(&readable, 1, 10000) == 1); // a frame comes within 10 s, or the test fails
-      std::string why;
-      REQUIRE(reader.read_from(fd.get(), frames, why));
-    }
-    auto f = std::move(frames.front());
-    frames.erase(frames.begin());
-    return f;
-  }
-};
-
 struct LinkEnds {
   std::unique_ptr<control::NodeLink> link;
-  std::unique_ptr<LinkFakeNode> node;
+  std::unique_ptr<test::LinkPeer> node;
 };
 
 LinkEnds make_link_ends(const std::string &address) {
@@ -51,7 +26,7 @@ LinkEnds make_link_ends(const std::string &address) {
   REQUIRE(pair.has_value());
   auto link = control::NodeLink::open(std::move(pair->second), address);
   REQUIRE(link.has_value());
-  return {std::move(*link), std::make_unique<LinkFakeNode>(std::move(pair->first))};
+  return {std::move(*link), std::make_unique<test::LinkPeer>(std::move(pair->first))};
 }
 
 } // namespace

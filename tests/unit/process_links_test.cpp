@@ -6,9 +6,8 @@
 
 #include <thread>
 
-#include <poll.h>
-
 #include "control/link_socket.hpp"
+#include "link_peer.hpp"
 #include "node/process_links.hpp"
 #include "test_domain.hpp"
 
@@ -21,28 +20,6 @@ namespace {
 constexpr const char *kLinkedChild = "t/component/app.1.1/C_1";
 constexpr const char *kLinkingNode = "t/node/n1";
 
-// The process's side of a link: frames out, frames in.
-struct LinkedFakeProcess {
-  process::Fd fd;
-  std::unique_ptr<control::LinkWriter> writer;
-  control::FrameReader reader;
-  std::vector<link_msgs::Frame> in;
-
-  explicit LinkedFakeProcess(process::Fd end)
-      : fd(std::move(end)), writer(std::make_unique<control::LinkWriter>(fd.get())) {}
-  link_msgs::Frame next() {
-    while (in.empty()) {
-      pollfd readable{fd.get(), POLLIN, 0};
-      REQUIRE(::poll(&readable, 1, 10000) == 1); // a frame comes within 10 s, or the test fails
-      std::string why;
-      REQUIRE(reader.read_from(fd.get(), in, why));
-    }
-    auto f = std::move(in.front());
-    in.erase(in.begin());
-    return f;
-  }
-};
-
 // A node endpoint with its links, a process linked to it, and a caller that follows
 // announcements (so it learns the way to the process's address, as the domain does).
 struct LinksRig {
@@ -50,7 +27,7 @@ struct LinksRig {
   std::unique_ptr<control::Endpoint> node;
   std::unique_ptr<node::ProcessLinks> links;
   std::unique_ptr<control::Endpoint> caller;
-  std::unique_ptr<LinkedFakeProcess> process;
+  std::unique_ptr<test::LinkPeer> process;
   std::vector<control::AnnouncementEvent> heard;
   std::mutex heard_mutex;
 
@@ -72,7 +49,7 @@ struct LinksRig {
     auto pair = control::make_link_pair();
     REQUIRE(pair.has_value());
     links->attach(4242, std::move(pair->first), {kLinkedChild});
-    process = std::make_unique<LinkedFakeProcess>(std::move(pair->second));
+    process = std::make_unique<test::LinkPeer>(std::move(pair->second));
   }
   ~LinksRig() {
     links->close();
