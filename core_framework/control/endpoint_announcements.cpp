@@ -84,6 +84,9 @@ void Endpoint::Impl::withdraw(const std::string &as) {
   a.kind = const_cast<char *>("");
   a.body = const_cast<char *>("");
   dds_dispose(announcement_writer.get(), &a);
+  // And let go of the instance: a node announces every component it relays on its one writer,
+  // whose disposed instances Cyclone would otherwise keep for the node's whole life.
+  dds_unregister_instance(announcement_writer.get(), &a);
 }
 
 Expected<void> Endpoint::announce(const std::string &kind, const Json &body) {
