@@ -288,6 +288,10 @@ void Endpoint::relay(const std::string &address, RelayHandler handler) {
   impl_->served.relay(address, std::move(handler));
 }
 
+void Endpoint::stop_relaying(const std::string &address) {
+  impl_->served.drop_relay(address);
+}
+
 void Endpoint::start_serving() {
   dds_set_status_mask(impl_->request_reader.get(), DDS_DATA_AVAILABLE_STATUS);
   impl_->serving = true;

@@ -94,6 +94,8 @@ public:
   // every relayed call starts before any is waited for, so the processes behind a node work on
   // their parts at once.
   void relay(const std::string &address, RelayHandler handler);
+  // No more relays to `address`; calls under way are not waited for (they end on their own).
+  void stop_relaying(const std::string &address);
   // Serves the requests held since open (EndpointOptions::hold_requests) and those that follow.
   void start_serving();
   // Drops the handlers of `address` and returns once none of them is running any more.

@@ -21,6 +21,11 @@ void HandlerTable::drop(const std::string &address) {
   done_.wait(lock, [&] { return !running_.contains(address); });
 }
 
+void HandlerTable::drop_relay(const std::string &address) {
+  std::lock_guard lock(mutex_);
+  relays_.erase(address);
+}
+
 void HandlerTable::done(const std::string &target) {
   {
     std::lock_guard lock(mutex_);

@@ -27,6 +27,9 @@ public:
   void relay(const std::string &address, RelayHandler handler);
   // Drops the handlers and the relay of `address` and returns once none of them runs any more.
   void drop(const std::string &address);
+  // Drops the relay of `address` and returns at once: relayed calls under way end on their own
+  // (their process is gone), and waiting here could wait on the very thread that reports it.
+  void drop_relay(const std::string &address);
 
   // Runs the handler for the call's address and operation (a relay, when the address has one);
   // "bad request" when there is none. A handler that throws on a malformed body (JSON's type

@@ -345,8 +345,10 @@ void ProcessLinks::detach(pid_t pid) {
       impl_->by_address.erase(a);
     impl_->end(*process, "the process has exited");
   }
+  // Not waited for: detach runs on the GPP's reaper thread, which a handler of the same batch
+  // (a node.terminate) may be waiting on; the relays under way have failed already.
   for (const auto &a : process->addresses)
-    impl_->endpoint->stop_serving(a); // waits for its relays, which have failed
+    impl_->endpoint->stop_relaying(a);
 }
 
 void ProcessLinks::close() {
