@@ -272,7 +272,9 @@ void ProcessLinks::Impl::end(LinkedProcess &process, const std::string &why) {
   for (const auto &address : process.announced)
     endpoint->withdraw(address);
   process.announced.clear();
-  process.fd.reset();
+  // The descriptor stays open until the last reference to the process goes: a relay or a call
+  // of the process still under way writes to it by number, and a number closed here could be
+  // reused by the next process's link, which would then receive another's frames.
 }
 
 ProcessLinks::ProcessLinks(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
