@@ -163,21 +163,29 @@ CallResult<protocol::Empty> Host::op_connect(const op::ConnectRequest &r, const 
   if (c().state() == State::Released)
     return released();
   const bool local = r.local.value_or(false); // the other end is in this process
-  // In-host connections need no DDS: the process joins DDS at its first connection that does.
+  if (r.shared_memory.value_or(false) && !r.ring)
+    return control::call_error(Status::BadRequest,
+                               "a same-host connection needs the ring its node makes; was the "
+                               "request relayed by the component's node?");
+  std::optional<RingRef> ring;
+  if (r.ring && !local)
+    ring = RingRef{r.ring->offset, r.ring->slot};
+  // In-host and same-host connections need no DDS: the process joins DDS at its first
+  // connection that does.
   std::shared_ptr<dds::Participant> participant;
-  if (!local) {
+  if (!local && !ring) {
     auto joined = participants_->get();
     if (!joined)
       return control::call_error(Status::Failed, joined.error().to_string());
     participant = std::move(*joined);
   }
   if (auto ok = port->connect(participant ? participant->get() : 0, loop_.get(), r.connection,
-                              topic, qos->get(), std::move(filter), local);
+                              topic, qos->get(), std::move(filter), local, ring);
       !ok)
     return control::call_error(Status::Failed, ok.error());
   watch_connections();
   log().info("port {}: connection {} on {}topic \"{}\"{}", r.port, r.connection,
-             local ? "in-host " : "", topic,
+             local ? "in-host " : (ring ? "same-host " : ""), topic,
              filter_text.empty() ? "" : fmt::format(" with filter \"{}\"", filter_text));
   return Empty{};
 }
@@ -258,6 +266,8 @@ CallResult<op::StatusReply> Host::op_status(const Empty &, const Context &) {
       connection.filtered = s.filtered;
       connection.deadline_missed = s.deadline_missed;
       connection.in_host = s.in_host;
+      if (s.same_host)
+        connection.same_host = true;
       status.connections.push_back(std::move(connection));
     }
     reply.ports.push_back(std::move(status));

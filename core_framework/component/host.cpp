@@ -14,6 +14,7 @@
 #include "control/operation.hpp"
 #include "protocol/addresses.hpp"
 #include "protocol/domain_ops.hpp"
+#include "shm/process_arena.hpp"
 
 namespace rsca::component::detail {
 
@@ -150,7 +151,9 @@ Expected<void> Host::open(std::shared_ptr<ParticipantSource> participants,
     endpoint = std::move(*own);
   }
   endpoint_ = std::move(endpoint);
-  if (!c().ports_.empty())
+  // A process with its host's arena connects to its host's processes through shared memory: it
+  // joins DDS only if a connection to another host asks for it, when it is made.
+  if (!c().ports_.empty() && shm::ProcessArena::inherited() == nullptr)
     participants_->join_in_background();
   serve_operations();
   // The domain calls next (initialize): the way back to it is made before it asks.

@@ -8,11 +8,14 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
-#include <nlohmann/json.hpp>
-
+#include "component/filter_fields.hpp"
+#include "component/liveliness_ticker.hpp"
 #include "component/local_topics.hpp"
+#include "component/port_record.hpp"
 #include "component/port_wire.hpp"
 #include "component/receive_loop.hpp"
+#include "shm/process_arena.hpp"
+#include "shm/ring.hpp"
 
 namespace rsca::component {
 
@@ -41,7 +44,18 @@ struct DataConnection {
   std::uint32_t deadline_periods_reported = 0; // provides: of the current gap (receive thread)
   bool watched = false; // a reader with a deadline or a liveliness lease: problems to look for
 
+  // Same-host: the ring's writer or reader; the deadline as in-host. Lost writers already
+  // reported (provides, receive thread).
+  std::optional<shm::RingWriter> ring_writer;
+  std::optional<shm::RingReader> ring_reader;
+  std::uint32_t writers_lost_reported = 0;
+  std::chrono::nanoseconds lease{0}; // a reader's liveliness lease (0: none)
+  bool liveliness_lost = false;      // reported, and not alive again since (receive thread)
+  bool ticking = false;              // the writer's liveliness is asserted by the ticker
+
   ~DataConnection() {
+    if (ticking)
+      LivelinessTicker::instance().remove(&*ring_writer);
     if (loop != nullptr && entity)
       loop->detach(entity.get());
     if (local && inbox)
@@ -51,6 +65,9 @@ struct DataConnection {
   }
 
   bool in_host() const { return local != nullptr; }
+  bool same_host() const { return ring_writer || ring_reader; }
+  // Its ends count deadlines themselves, as DDS would (no DDS entity does it for them).
+  bool own_deadline() const { return in_host() || same_host(); }
 };
 
 } // namespace detail
@@ -60,77 +77,6 @@ namespace {
 using detail::DataConnection;
 
 constexpr std::uint32_t kTakeBatch = 32;
-
-// ---- the fields a content filter sees, per port type ------------------------------------------
-
-std::optional<FilterValue> json_field(const nlohmann::json &value) {
-  if (value.is_number())
-    return value.get<double>();
-  if (value.is_string())
-    return value.get<std::string>();
-  if (value.is_boolean())
-    return value.get<bool>();
-  return std::nullopt;
-}
-
-// A member path ("a.b") inside a JSON value.
-std::optional<FilterValue> json_path(const nlohmann::json &value, std::string_view path) {
-  const nlohmann::json *at = &value;
-  while (!path.empty()) {
-    const auto dot = path.find('.');
-    const std::string name(path.substr(0, dot));
-    if (!at->is_object() || !at->contains(name))
-      return std::nullopt;
-    at = &at->at(name);
-    path = dot == std::string_view::npos ? std::string_view() : path.substr(dot + 1);
-  }
-  return json_field(*at);
-}
-
-// id, source, timestamp_ns, value (and value.member); any other name is the event's value when
-// the event bears that id ("range < 10" on an event {id: range, value: 5}), else a member of it.
-std::optional<FilterValue> field_of(const port::PropertyEvent &e, std::string_view field) {
-  if (field == "id")
-    return e.id;
-  if (field == "source")
-    return e.source;
-  if (field == "timestamp_ns")
-    return static_cast<double>(e.timestamp_ns);
-  const auto value = nlohmann::json::parse(e.value, nullptr, false);
-  if (value.is_discarded())
-    return std::nullopt;
-  if (field == "value" || field == e.id)
-    return json_field(value);
-  if (field.starts_with("value."))
-    return json_path(value, field.substr(6));
-  return json_path(value, field);
-}
-
-std::optional<FilterValue> field_of(const port::Command &c, std::string_view field) {
-  if (field == "name")
-    return c.name;
-  if (field == "source")
-    return c.source;
-  if (field == "text")
-    return c.text;
-  if (field == "timestamp_ns")
-    return static_cast<double>(c.timestamp_ns);
-  return std::nullopt;
-}
-
-std::optional<FilterValue> field_of(const port::Samples &s, std::string_view field) {
-  if (field == "stream_id")
-    return s.stream_id;
-  if (field == "sample_rate")
-    return s.sample_rate;
-  if (field == "complex")
-    return s.complex;
-  if (field == "end_of_stream")
-    return s.end_of_stream;
-  if (field == "timestamp_ns")
-    return static_cast<double>(s.timestamp_ns);
-  return std::nullopt;
-}
 
 Expected<std::unique_ptr<DataConnection>>
 open_writer(dds_entity_t participant, std::unique_ptr<DataConnection> c, const dds_qos_t *qos) {
@@ -178,16 +124,27 @@ std::chrono::nanoseconds requested_deadline(const dds_qos_t *qos) {
   return std::chrono::nanoseconds{deadline};
 }
 
-// Whether a reader with this QoS can have problems to report (take_problems).
-bool has_problems_to_watch(const dds_qos_t *qos) {
+// The liveliness lease a connection asks for (0: none), and whether it is automatic.
+std::pair<std::chrono::nanoseconds, bool> liveliness_lease(const dds_qos_t *qos) {
   dds_liveliness_kind_t kind = DDS_LIVELINESS_AUTOMATIC;
   dds_duration_t lease = DDS_INFINITY;
   if (qos != nullptr)
     dds_qget_liveliness(qos, &kind, &lease);
-  return requested_deadline(qos).count() > 0 || lease != DDS_INFINITY;
+  if (lease == DDS_INFINITY)
+    return {std::chrono::nanoseconds{0}, false};
+  return {std::chrono::nanoseconds{lease}, kind == DDS_LIVELINESS_AUTOMATIC};
+}
+
+// Whether a reader with this QoS can have problems to report (take_problems).
+bool has_problems_to_watch(const dds_qos_t *qos) {
+  return requested_deadline(qos).count() > 0 || liveliness_lease(qos).first.count() > 0;
 }
 
 std::int32_t matched_count(const DataConnection &c, profile::PortDirection direction) {
+  if (c.ring_writer)
+    return c.ring_writer->readers();
+  if (c.ring_reader)
+    return c.ring_reader->writers();
   if (c.in_host())
     return direction == profile::PortDirection::Uses ? c.local->readers() : c.local->writers();
   const dds_entity_t entity = c.entity.get();
@@ -240,13 +197,32 @@ std::uint32_t local_deadline_misses(DataConnection &c) {
   return missed;
 }
 
+// A same-host reader's lost liveliness not reported yet: writers whose process ended while
+// connected (the node counts them in the ring), and a lease that passed since a writer was last
+// alive (once per such gap, as DDS counts a writer going from alive to not alive).
+std::uint32_t lost_writers(DataConnection &c) {
+  if (!c.ring_reader)
+    return 0;
+  const std::uint32_t lost = c.ring_reader->writers_lost();
+  std::uint32_t change = lost - c.writers_lost_reported;
+  c.writers_lost_reported = lost;
+  const std::int64_t alive = c.ring_reader->alive_ns();
+  if (c.lease.count() <= 0 || alive == 0)
+    return change;
+  const bool expired = steady_ns() - alive > c.lease.count();
+  if (expired && !c.liveliness_lost)
+    ++change;
+  c.liveliness_lost = expired;
+  return change;
+}
+
 // How often the writer (uses) or the reader's writers (provides) missed the connection's deadline.
 std::uint32_t deadline_misses(const DataConnection &c, profile::PortDirection direction) {
-  if (c.in_host() && direction == profile::PortDirection::Uses) // and the current gap
+  if (c.own_deadline() && direction == profile::PortDirection::Uses) // and the current gap
     return c.deadline_missed.load(std::memory_order_relaxed) +
            periods_between(c.last_sample_ns.load(std::memory_order_relaxed), steady_ns(),
                            c.deadline);
-  if (c.in_host())
+  if (c.own_deadline())
     return c.deadline_missed.load(std::memory_order_relaxed);
   const dds_entity_t entity = c.entity.get();
   if (direction == profile::PortDirection::Uses) {
@@ -274,13 +250,14 @@ std::size_t PortBase::connection_count() const {
 Expected<void> PortBase::connect(dds_entity_t participant, detail::ReceiveLoop *loop,
                                  const std::string &connection, const std::string &topic,
                                  const dds_qos_t *qos, std::optional<ContentFilter> filter,
-                                 bool local) {
+                                 bool local, std::optional<RingRef> ring) {
   auto c = std::make_unique<DataConnection>();
   c->topic_name = topic;
   c->filter = std::move(filter);
   c->watched = direction_ == profile::PortDirection::Provides && has_problems_to_watch(qos);
-  if (local) {
-    auto opened = open_local(loop, std::move(c), qos);
+  if (local || ring) {
+    auto opened = local ? open_local(loop, std::move(c), qos)
+                        : open_same_host(loop, std::move(c), qos, *ring);
     if (!opened)
       return tl::unexpected(opened.error());
     std::unique_lock lock(mutex_);
@@ -322,6 +299,38 @@ Expected<std::unique_ptr<DataConnection>> PortBase::open_local(detail::ReceiveLo
   return c;
 }
 
+Expected<std::unique_ptr<DataConnection>>
+PortBase::open_same_host(detail::ReceiveLoop *loop, std::unique_ptr<DataConnection> c,
+                         const dds_qos_t *qos, const RingRef &ring) const {
+  auto *arena = shm::ProcessArena::inherited();
+  if (arena == nullptr)
+    return make_error({"port", 0, 0}, "port",
+                      "a same-host connection, but this process has no host arena from its node");
+  c->deadline = requested_deadline(qos);
+  if (direction_ == profile::PortDirection::Uses) {
+    auto writer = shm::RingWriter::open(arena->arena(), ring.offset);
+    if (!writer)
+      return make_error({"port", 0, 0}, "port", writer.error());
+    c->ring_writer.emplace(std::move(*writer));
+    if (auto [lease, automatic] = liveliness_lease(qos); automatic) {
+      detail::LivelinessTicker::instance().add(&*c->ring_writer, lease);
+      c->ticking = true;
+    }
+    return c;
+  }
+  if (loop == nullptr || !loop->doorbell())
+    return make_error({"port", 0, 0}, "port", "no receive loop in the host's arena to ring");
+  const auto depth = static_cast<std::uint32_t>(history_depth(qos));
+  auto reader =
+      shm::RingReader::open(arena->arena(), ring.offset, ring.slot, *loop->doorbell(), depth);
+  if (!reader)
+    return make_error({"port", 0, 0}, "port", reader.error());
+  c->ring_reader.emplace(std::move(*reader));
+  c->writers_lost_reported = c->ring_reader->writers_lost();
+  c->lease = liveliness_lease(qos).first;
+  return c;
+}
+
 bool PortBase::disconnect(const std::string &connection) {
   std::unique_lock lock(mutex_);
   return connections_.erase(connection) > 0;
@@ -338,7 +347,8 @@ std::vector<ConnectionStatus> PortBase::status() const {
   out.reserve(connections_.size());
   for (const auto &[id, c] : connections_)
     out.push_back({id, c->topic_name, matched_count(*c, direction_), c->samples.load(),
-                   c->filtered.load(), deadline_misses(*c, direction_), c->in_host()});
+                   c->filtered.load(), deadline_misses(*c, direction_), c->in_host(),
+                   c->same_host()});
   return out;
 }
 
@@ -358,9 +368,11 @@ std::vector<ConnectionProblem> PortBase::take_problems() {
   constexpr std::uint32_t kProblems =
       DDS_REQUESTED_DEADLINE_MISSED_STATUS | DDS_LIVELINESS_CHANGED_STATUS;
   for (const auto &[id, c] : connections_) {
-    if (c->in_host()) {
+    if (c->own_deadline()) {
       if (auto missed = local_deadline_misses(*c); missed > 0)
         out.push_back({id, "deadline missed", missed});
+      if (auto lost = lost_writers(*c); lost > 0)
+        out.push_back({id, "liveliness lost", lost});
       continue;
     }
     std::uint32_t changed = 0;
@@ -392,29 +404,41 @@ void PortBase::quiesce() {
   std::unique_lock lock(mutex_);
 }
 
-WriteResult PortBase::write_wire(const void *sample,
-                                 const std::function<std::shared_ptr<const void>()> &copy) {
+template <typename T>
+WriteResult PortBase::write_all(const T &value) {
   std::shared_lock lock(mutex_);
   std::size_t written = 0;
   std::string error;
-  std::shared_ptr<const void> shared; // one copy for every in-host reader
+  auto failed = [&](const std::string &id, const std::string &why) {
+    if (error.empty())
+      error = fmt::format("port {}: writing to connection {} failed: {}", name_, id, why);
+  };
+  std::optional<typename port::wire::Traits<T>::C> wire; // made for the first DDS connection
+  std::shared_ptr<const void> shared;                    // one copy for every in-host reader
   for (const auto &[id, c] : connections_) {
     if (c->in_host()) {
       if (!shared)
-        shared = copy();
+        shared = std::make_shared<const T>(value);
       c->local->publish(shared);
+    } else if (c->ring_writer) {
+      auto ok = c->ring_writer->write(port::record::size_of(value), [&value](std::byte *at) {
+        port::record::Writer w(at);
+        port::record::write(value, w);
+      });
+      if (!ok) {
+        failed(id, ok.error());
+        continue;
+      }
+    } else {
+      if (!wire)
+        wire = port::wire::to_wire(value);
+      if (const dds_return_t rc = dds_write(c->entity.get(), &*wire); rc < 0) {
+        failed(id, dds_strretcode(rc));
+        continue;
+      }
+    }
+    if (c->own_deadline())
       note_local_write(*c);
-      c->samples.fetch_add(1, std::memory_order_relaxed);
-      ++written;
-      continue;
-    }
-    const dds_return_t rc = dds_write(c->entity.get(), sample);
-    if (rc < 0) {
-      if (error.empty())
-        error = fmt::format("port {}: writing to connection {} failed: {}", name_, id,
-                            dds_strretcode(rc));
-      continue;
-    }
     c->samples.fetch_add(1, std::memory_order_relaxed);
     ++written;
   }
@@ -425,8 +449,7 @@ WriteResult PortBase::write_wire(const void *sample,
 
 template <typename T>
 WriteResult UsesPort<T>::write(const T &value) {
-  const auto sample = port::wire::to_wire(value);
-  return write_wire(&sample, [&value] { return std::make_shared<const T>(value); });
+  return write_all(value);
 }
 
 template <typename T>
@@ -435,6 +458,8 @@ void ProvidesPort<T>::take_all(bool deliver) {
   for (const auto &[id, c] : connections_) {
     if (c->in_host())
       take_local(*c, deliver);
+    else if (c->ring_reader)
+      take_same_host(*c, deliver);
     else
       take_dds(*c, deliver);
   }
@@ -481,8 +506,27 @@ void ProvidesPort<T>::take_local(DataConnection &c, bool deliver) {
 }
 
 template <typename T>
+void ProvidesPort<T>::take_same_host(DataConnection &c, bool deliver) {
+  const std::size_t arrived = c.ring_reader->take(
+      [this](const std::byte *at, std::size_t bytes) {
+        port::record::Reader r(at, bytes);
+        return port::record::read(r, scratch_);
+      },
+      [this, &c, deliver] {
+        c.samples.fetch_add(1, std::memory_order_relaxed);
+        if (deliver && callback_)
+          this->deliver(c, scratch_);
+      });
+  if (arrived == 0)
+    return;
+  c.last_sample_ns.store(steady_ns(), std::memory_order_relaxed);
+  c.deadline_periods_reported = 0;
+}
+
+template <typename T>
 void ProvidesPort<T>::deliver(DataConnection &c, const T &value) {
-  if (c.filter && !c.filter->matches([&value](std::string_view f) { return field_of(value, f); })) {
+  if (c.filter &&
+      !c.filter->matches([&value](std::string_view f) { return detail::field_of(value, f); })) {
     c.filtered.fetch_add(1, std::memory_order_relaxed);
     return;
   }

@@ -2,7 +2,9 @@
 // connections, made and removed by the domain (component.connect/disconnect). A connection is a
 // DDS writer (uses) or reader (provides) on the topic the domain names, with the QoS it gives;
 // between two components of one component host it is an in-host connection instead, which
-// bypasses DDS (component/local_topics.hpp) with the same API and QoS semantics.
+// bypasses DDS (component/local_topics.hpp), and between two processes of one host it is a
+// same-host connection, a ring in the host's shared memory that the node made (shm/ring.hpp),
+// each with the same API and QoS semantics.
 // Writing to an unconnected uses port does nothing; with several connections a write goes to
 // each. A provides port's callback runs on the component's receive thread.
 #pragma once
@@ -39,6 +41,14 @@ struct ConnectionStatus {
   std::uint64_t filtered = 0;        // provides: received but not delivered (the content filter)
   std::uint32_t deadline_missed = 0; // the connection's deadline, missed (offered or requested)
   bool in_host = false;              // both ends in one process: no DDS entities
+  bool same_host = false;            // both ends on one host: a ring in shared memory
+};
+
+// A same-host connection's ring, as the node gave it: where it is in the host's arena, and a
+// reader's slot in it.
+struct RingRef {
+  std::uint64_t offset = 0;
+  std::uint32_t slot = 0;
 };
 
 // A QoS problem of a provides port's connection since it was last reported: the writer missed
@@ -66,11 +76,12 @@ public:
 
   // For the runtime. `connect` replaces a connection of the same id. A provides port's reader
   // is attached to `loop`, which must outlive the connection. `local`: the other end is in this
-  // process, and the connection bypasses DDS.
+  // process, and the connection bypasses DDS; `ring`: it is on this host, and the connection
+  // uses that ring (`participant` is not used by either).
   Expected<void> connect(dds_entity_t participant, detail::ReceiveLoop *loop,
                          const std::string &connection, const std::string &topic,
                          const dds_qos_t *qos, std::optional<ContentFilter> filter = std::nullopt,
-                         bool local = false);
+                         bool local = false, std::optional<RingRef> ring = std::nullopt);
   bool disconnect(const std::string &connection);
   void disconnect_all();
   std::vector<ConnectionStatus> status() const;
@@ -89,10 +100,10 @@ public:
   void quiesce();
 
 protected:
-  // Writes `sample` (the wire form) to every DDS connection, and what `copy` makes (once, when
-  // the port has an in-host connection) to every in-host one.
-  WriteResult write_wire(const void *sample,
-                         const std::function<std::shared_ptr<const void>()> &copy);
+  // Writes `value` to every connection: its wire form to DDS, a record to each same-host ring,
+  // and one shared copy (made when the port has an in-host connection) to every in-host one.
+  template <typename T>
+  WriteResult write_all(const T &value);
 
   mutable std::shared_mutex mutex_; // shared: writing, taking; exclusive: (dis)connecting
   std::map<std::string, std::unique_ptr<detail::DataConnection>> connections_;
@@ -101,6 +112,9 @@ private:
   Expected<std::unique_ptr<detail::DataConnection>>
   open_local(detail::ReceiveLoop *loop, std::unique_ptr<detail::DataConnection> c,
              const dds_qos_t *qos) const;
+  Expected<std::unique_ptr<detail::DataConnection>>
+  open_same_host(detail::ReceiveLoop *loop, std::unique_ptr<detail::DataConnection> c,
+                 const dds_qos_t *qos, const RingRef &ring) const;
 
   std::string name_;
   profile::PortDirection direction_;
@@ -131,6 +145,7 @@ public:
 private:
   void take_dds(detail::DataConnection &c, bool deliver);
   void take_local(detail::DataConnection &c, bool deliver);
+  void take_same_host(detail::DataConnection &c, bool deliver);
   // Hands `value` to the callback unless the connection's filter drops it.
   void deliver(detail::DataConnection &c, const T &value);
 

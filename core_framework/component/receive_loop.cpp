@@ -1,12 +1,11 @@
 #include "component/receive_loop.hpp"
 
-#include <linux/futex.h>
 #include <sched.h>
-#include <sys/syscall.h>
-#include <unistd.h>
 
 #include <chrono>
 #include <cstdlib>
+
+#include "shm/process_arena.hpp"
 
 namespace rsca::component::detail {
 namespace {
@@ -40,11 +39,18 @@ Expected<std::unique_ptr<ReceiveLoop>> ReceiveLoop::start(std::function<void()> 
 ReceiveLoop::ReceiveLoop(std::function<void()> poll)
     : listener_(dds_create_listener(this)), poll_(std::move(poll)) {
   dds_lset_data_available(listener_, &ReceiveLoop::on_data_available);
+  if (auto *arena = shm::ProcessArena::inherited())
+    if (auto *bell = arena->allocate_doorbell()) {
+      bell_ = bell;
+      doorbell_offset_ = arena->arena().offset_of(bell);
+    }
 }
 
 ReceiveLoop::~ReceiveLoop() {
   stop();
   dds_delete_listener(listener_);
+  if (doorbell_offset_)
+    shm::ProcessArena::inherited()->release_doorbell(bell_);
 }
 
 void ReceiveLoop::stop() {
@@ -74,59 +80,48 @@ void ReceiveLoop::on_data_available(dds_entity_t, void *loop) {
   static_cast<const ReceiveLoop *>(loop)->wake();
 }
 
-// The flag first, then a futex wake only if the thread sleeps (or is about to): sequentially
-// consistent, so either the sleeper sees the flag before it waits or the waker sees the sleeper.
 void ReceiveLoop::wake() const {
-  woken_.store(1);
-  if (sleeping_.load() != 0)
-    ::syscall(SYS_futex, &woken_, FUTEX_WAKE_PRIVATE, 1, nullptr, nullptr, 0);
+  shm::ring(*bell_, shm::kWakeData, doorbell_offset_.has_value());
 }
 
-bool ReceiveLoop::take_wake() const {
-  return woken_.exchange(0) != 0;
+std::uint32_t ReceiveLoop::take_wake() const {
+  return shm::take(*bell_);
 }
 
 void ReceiveLoop::sleep_until_woken(int timeout_ms) const {
-  sleeping_.store(1);
-  if (woken_.load() == 0) {
-    timespec timeout{timeout_ms / 1000, (timeout_ms % 1000) * 1'000'000L};
-    // Returns at once if woken_ is no longer 0 (the wake came in between).
-    ::syscall(SYS_futex, &woken_, FUTEX_WAIT_PRIVATE, 0, timeout_ms < 0 ? nullptr : &timeout,
-              nullptr, 0);
-  }
-  sleeping_.store(0);
+  shm::sleep(*bell_, timeout_ms, doorbell_offset_.has_value());
 }
 
 void ReceiveLoop::wake_in_host() const {
-  in_host_data_.store(true, std::memory_order_release);
-  wake();
+  shm::ring(*bell_, shm::kWakeNearData, doorbell_offset_.has_value());
 }
 
-// After in-host data, the thread looks for more for spin_time() before it sleeps: a reply in an
-// in-host ping-pong or the next sample of a burst then finds it awake. Waking a sleeping thread
-// costs 20-40 us on a virtual machine whose other CPU has gone idle; looking costs a read of the
-// flag. Not after DDS data: there the spinning threads of many subscribers would take the CPU
-// Cyclone needs to deliver (measured: fan-out to 10 processes lost half its rate).
-bool ReceiveLoop::spin_for_wake() const {
+// After in-host or same-host data, the thread looks for more for spin_time() before it sleeps: a
+// reply in an in-host ping-pong or the next sample of a burst then finds it awake. Waking a
+// sleeping thread costs 20-40 us on a virtual machine whose other CPU has gone idle; looking costs
+// a read of the flag. Not after DDS data: there the spinning threads of many subscribers would take
+// the CPU Cyclone needs to deliver (measured: fan-out to 10 processes lost half its rate).
+std::uint32_t ReceiveLoop::spin_for_wake() const {
   const auto until = std::chrono::steady_clock::now() + spin_time();
   while (std::chrono::steady_clock::now() < until) {
-    if (take_wake())
-      return true;
+    if (auto why = take_wake(); why != 0)
+      return why;
     // Whatever else is runnable on this CPU goes first: Cyclone's receive thread, which must run
     // before a reply over DDS can arrive, or the other end of an in-host ping-pong.
     sched_yield();
   }
-  return false;
+  return 0;
 }
 
 void ReceiveLoop::run() {
-  bool spin = false; // the last round had in-host data
+  std::uint32_t why = 0; // what woke the last round
   while (!stopping_.load()) {
-    if (!(spin && spin_for_wake()) && !take_wake()) {
+    const bool spin = (why & shm::kWakeNearData) != 0;
+    why = spin ? spin_for_wake() : take_wake();
+    if (why == 0) {
       sleep_until_woken(watching_.load() ? kWakeIntervalMs : -1);
-      take_wake();
+      why = take_wake();
     }
-    spin = in_host_data_.exchange(false, std::memory_order_acq_rel);
     if (stopping_.load())
       return;
     poll_();

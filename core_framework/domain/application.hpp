@@ -35,6 +35,8 @@ struct ComponentInstance {
   ComponentState state = ComponentState::Allocated;
   std::uint32_t start_order = 0;
   bool assembly_controller = false;
+  // The node that relays to its process (which that node started); empty when none does.
+  std::string relaying_node() const { return via != host ? via : std::string(); }
 };
 
 // One end of a connection: a port of a component of the application, or of a device (which

@@ -97,7 +97,8 @@ std::size_t ApplicationFactory::disconnect_devices(const Application &app) {
                         .connection = end_key(ci, *end),
                         .host = {},
                         .peers = 1,
-                        .what = fmt::format("{} ({})", ci.id, end->name())});
+                        .what = fmt::format("{} ({})", ci.id, end->name()),
+                        .node = {}});
   for (const auto &failed : Wiring(*services_.endpoint, services_.call_timeout).disconnect(ends))
     spdlog::warn("application {}: a device end was not disconnected: {}", app.name, failed);
   return ends.size();

@@ -91,7 +91,8 @@ void ConnectionManager::stop() {
 namespace {
 
 WireEnd wire_end(const RuntimeConnection &c, const ResolvedEnd &end, const PortRef &ref) {
-  return {end.address, end.port, c.id, end.host, 1, fmt::format("{} ({})", c.id, ref.to_string())};
+  return {end.address, end.port, c.id, end.host, 1, fmt::format("{} ({})", c.id, ref.to_string()),
+          end.via};
 }
 
 } // namespace
@@ -140,7 +141,7 @@ void ConnectionManager::unwire(const RuntimeConnection &c,
                                const std::vector<const ResolvedEnd *> &ends) {
   std::vector<WireEnd> wire_ends;
   for (const auto *end : ends)
-    wire_ends.push_back({end->address, end->port, c.id, end->host, 1, end->address});
+    wire_ends.push_back({end->address, end->port, c.id, end->host, 1, end->address, end->via});
   for (const auto &failed : Wiring(*endpoint_, timeout_).disconnect(wire_ends))
     spdlog::warn("runtime connection {}: an end was not disconnected: {}", c.id, failed);
 }

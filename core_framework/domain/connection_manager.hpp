@@ -44,6 +44,7 @@ struct ResolvedEnd {
   std::string port; // the owner's port (an external port's is the component's)
   std::string repid;
   std::string host; // the component host that serves the owner, when it is hosted
+  std::string via;  // the node that relays to the owner, when a node started its process
 };
 
 struct RuntimeConnection {

@@ -39,7 +39,8 @@ Json end_state(const StatusOf &status_of, const std::string &address, const std:
                   {"samples", c.samples.value_or(0)},
                   {"filtered", c.filtered.value_or(0)},
                   {"deadline_missed", c.deadline_missed.value_or(0)},
-                  {"in_host", c.in_host.value_or(false)}};
+                  {"in_host", c.in_host.value_or(false)},
+                  {"same_host", c.same_host.value_or(false)}};
     }
   }
   return nullptr;
@@ -314,7 +315,8 @@ DomainManager::Impl::resolve_component_end(const PortRef &ref, profile::PortDire
   if (definition == nullptr)
     return control::call_error(Status::NotFound, fmt::format("{} is not a {} port", ref.to_string(),
                                                              profile::to_string(direction)));
-  return ResolvedEnd{instance->address, port, definition->repid, instance->host};
+  return ResolvedEnd{instance->address, port, definition->repid, instance->host,
+                     instance->relaying_node()};
 }
 
 CallResult<ResolvedEnd> DomainManager::Impl::resolve_device_end(const PortRef &ref,
@@ -330,7 +332,7 @@ CallResult<ResolvedEnd> DomainManager::Impl::resolve_device_end(const PortRef &r
                                fmt::format("node {} has no device {}", node, ref.owner));
   for (const auto &p : device->ports)
     if (p.name == ref.port && p.direction == wanted)
-      return ResolvedEnd{device->address, ref.port, p.repid, ""};
+      return ResolvedEnd{device->address, ref.port, p.repid, "", ""};
   return control::call_error(Status::NotFound,
                              fmt::format("{} is not a {} port", ref.to_string(), wanted));
 }

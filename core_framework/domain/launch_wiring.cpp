@@ -89,8 +89,13 @@ Wire ApplicationFactory::Launch::wire_of(const ConnectionInstance &ci) const {
   w.filter = ci.filter;
   auto end_of = [&](const ConnectionEnd &end, int peers, std::string what) {
     const auto *component = end.component.empty() ? nullptr : component_of(end.component);
-    return WireEnd{end.address, end.port,       end_key(ci, end), component ? component->host : "",
-                   peers,       std::move(what)};
+    return WireEnd{end.address,
+                   end.port,
+                   end_key(ci, end),
+                   component ? component->host : "",
+                   peers,
+                   std::move(what),
+                   component ? component->relaying_node() : ""};
   };
   if (ci.is_interface()) {
     w.interface_target = ci.provides.address;

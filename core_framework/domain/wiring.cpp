@@ -33,6 +33,8 @@ protocol::component::ConnectRequest connect_request(const Wire &wire, const Wire
   const bool reader = std::string_view(direction) == "provides";
   request.filter = reader ? wire.filter : "";
   request.local = wire.in_one_host();
+  if (wire.on_one_node())
+    request.shared_memory = true;
   return request;
 }
 

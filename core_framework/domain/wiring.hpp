@@ -26,6 +26,7 @@ struct WireEnd {
   std::string host;       // the component host that serves the owner, when it is hosted
   int peers = 1;          // the ends on the other side it must match (0: none to wait for)
   std::string what;       // for messages: "sad_1 (Producer_1.out)"
+  std::string node;       // the node that relays to the owner, a process it started; or empty
 };
 
 struct Wire {
@@ -43,6 +44,12 @@ struct Wire {
   // Both ends are components of one component host: the connection bypasses DDS.
   bool in_one_host() const {
     return uses && provides && !uses->host.empty() && uses->host == provides->host;
+  }
+  // Both ends are processes one node started, in two processes: the connection goes through
+  // that node's shared memory (node/host_data.hpp), not DDS.
+  bool on_one_node() const {
+    return uses && provides && !uses->node.empty() && uses->node == provides->node &&
+           !in_one_host();
   }
 };
 

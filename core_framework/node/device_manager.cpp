@@ -55,6 +55,7 @@ struct DeviceManager::Impl {
   NodeOptions options;
   std::shared_ptr<dds::Participant> participant;
   std::unique_ptr<control::Endpoint> endpoint;
+  std::unique_ptr<HostData> host_data; // outlives the links, which use it
   std::unique_ptr<ProcessLinks> links; // relays through the endpoint
   std::shared_ptr<const profile::DeviceConfiguration> dcd;
   profile::ResolvedNode node;
@@ -97,7 +98,8 @@ Expected<void> DeviceManager::Impl::start_devices(const DeviceRegistry &registry
                             options.log_dir,
                             participant->settings(),
                             [this](const auto &report) { report_exit(report); },
-                            links.get()};
+                            links.get(),
+                            host_data.get()};
       auto device = (*factory)(context);
       if (!device)
         return tl::unexpected(device.error());
@@ -175,11 +177,16 @@ DeviceManager::Impl::terminate(const op::TerminateRequest &request) const {
 
 op::StatusReply DeviceManager::Impl::status() const {
   auto a = announcement();
-  op::StatusReply status{std::move(a.node), a.pid, std::move(a.host), std::move(a.devices), {}};
+  op::StatusReply status{std::move(a.node), a.pid, std::move(a.host), std::move(a.devices), {}, {}};
   for (const auto &d : devices)
     if (d.executable() != nullptr)
       for (auto &p : d.executable()->processes())
         status.processes.push_back(std::move(p));
+  if (host_data) {
+    const auto held = host_data->counts();
+    status.shared_memory =
+        op::SharedMemoryStatus{held.rings, held.ends, held.pages, held.bytes_in_use};
+  }
   return status;
 }
 
@@ -233,7 +240,13 @@ DeviceManager::create(std::shared_ptr<dds::Participant> participant, NodeOptions
   if (!endpoint)
     return tl::unexpected(endpoint.error());
   impl->endpoint = std::move(*endpoint);
-  auto links = ProcessLinks::start(*impl->endpoint);
+  // Without shared memory the node still works: its processes then connect over DDS.
+  if (auto data = HostData::create(); data)
+    impl->host_data = std::move(*data);
+  else
+    spdlog::warn("no shared memory for this host's data ({}): same-host connections use DDS",
+                 data.error().to_string());
+  auto links = ProcessLinks::start(*impl->endpoint, impl->host_data.get());
   if (!links)
     return tl::unexpected(links.error());
   impl->links = std::move(*links);

@@ -40,6 +40,9 @@ struct DeviceContext {
   // The node's links to the processes it starts (node/process_links.hpp): a started process
   // gets one, and its control goes through the node. Null: processes join DDS on their own.
   ProcessLinks *links = nullptr;
+  // The host's shared memory (node/host_data.hpp): a started process maps its arena. Null: its
+  // connections to other processes of this host go over DDS.
+  HostData *host_data = nullptr;
 };
 
 class LogicalDevice {

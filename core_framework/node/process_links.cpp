@@ -4,11 +4,13 @@
 #include <atomic>
 #include <cerrno>
 #include <cstring>
+#include <functional>
 #include <future>
 #include <map>
 #include <mutex>
 #include <set>
 #include <thread>
+#include <vector>
 
 #include <fcntl.h>
 #include <fmt/format.h>
@@ -19,6 +21,7 @@
 #include "control/link_socket.hpp"
 #include "control/worker_pool.hpp"
 #include "protocol/addresses.hpp"
+#include "protocol/component_ops.hpp"
 
 namespace rsca::node {
 
@@ -53,6 +56,7 @@ struct LinkedProcess {
 
 struct ProcessLinks::Impl {
   control::Endpoint *endpoint = nullptr;
+  HostData *host_data = nullptr;
   process::Fd epoll;
   process::Fd wake;
   std::thread thread;
@@ -67,6 +71,7 @@ struct ProcessLinks::Impl {
     pid_t pid = 0;
     std::promise<CallResult<Json>> promise;
     std::chrono::steady_clock::time_point deadline;
+    std::function<void(bool ok)> after; // runs with the reply's outcome, outside the lock
   };
   std::map<std::string, Relayed> relayed; // requests under way, by id
   std::uint64_t next_id = 0;
@@ -74,6 +79,10 @@ struct ProcessLinks::Impl {
 
   // Hands a request on to the process that serves its target; its reply to come.
   std::future<CallResult<Json>> relay(const Json &body, const control::RequestContext &context);
+  // What the host's data makes of a relayed request on its way (a connect's ring), and what it
+  // does once the reply is known.
+  CallResult<Json> prepare(pid_t pid, const Json &body, const control::RequestContext &context,
+                           std::function<void(bool ok)> &after);
   void complete(const std::string &id, pid_t pid, CallResult<Json> result);
   void expire();
   void poll_loop();
@@ -110,10 +119,18 @@ std::future<CallResult<Json>> ProcessLinks::Impl::relay(const Json &body,
     if (process->ended)
       return ready(call_error(Status::Unavailable,
                               fmt::format("pid {} has exited: {}", process->pid, process->why)));
+  }
+  std::function<void(bool ok)> after;
+  auto prepared = prepare(process->pid, body, context, after);
+  if (!prepared)
+    return ready(tl::unexpected(prepared.error()));
+  {
+    std::lock_guard lock(mutex);
     id = std::to_string(++next_id);
     auto &r = relayed[id];
     r.pid = process->pid;
     r.deadline = std::chrono::steady_clock::now() + kRelayBound;
+    r.after = std::move(after);
     reply = r.promise.get_future();
   }
   const link::Request request{id,
@@ -121,7 +138,7 @@ std::future<CallResult<Json>> ProcessLinks::Impl::relay(const Json &body,
                               context.operation,
                               context.sender,
                               std::chrono::milliseconds(kRelayBound).count(),
-                              body};
+                              std::move(*prepared)};
   if (auto sent = process->writer->send(request); !sent) {
     complete(
         id, process->pid,
@@ -130,30 +147,67 @@ std::future<CallResult<Json>> ProcessLinks::Impl::relay(const Json &body,
   return reply;
 }
 
+CallResult<Json> ProcessLinks::Impl::prepare(pid_t pid, const Json &body,
+                                             const control::RequestContext &context,
+                                             std::function<void(bool ok)> &after) {
+  namespace op = protocol::component;
+  const bool connect = context.operation == op::Connect::name;
+  if (host_data == nullptr || !(connect || context.operation == op::Disconnect::name) ||
+      !body.is_object())
+    return body;
+  const std::string port = body.value("port", std::string());
+  const std::string connection = body.value("connection", std::string());
+  // The end goes once the process has let go of it (a disconnect), or if it never took it.
+  after = [data = host_data, pid, target = context.target, port, connection, connect](bool ok) {
+    if (!connect || !ok)
+      data->disconnect(pid, target, port, connection);
+  };
+  if (!connect)
+    return body;
+  auto with_ring = host_data->connect(pid, context.target, body);
+  if (!with_ring)
+    return call_error(Status::Failed, fmt::format("{}: {}", context.target, with_ring.error()));
+  return std::move(*with_ring);
+}
+
 void ProcessLinks::Impl::complete(const std::string &id, pid_t pid, CallResult<Json> result) {
-  std::lock_guard lock(mutex);
-  auto it = relayed.find(id);
-  // Only the process asked may answer: a reply to another's request is dropped.
-  if (it == relayed.end() || it->second.pid != pid)
-    return;
-  it->second.promise.set_value(std::move(result));
-  relayed.erase(it);
+  std::function<void(bool ok)> after;
+  const bool ok = result.has_value();
+  {
+    std::lock_guard lock(mutex);
+    auto it = relayed.find(id);
+    // Only the process asked may answer: a reply to another's request is dropped.
+    if (it == relayed.end() || it->second.pid != pid)
+      return;
+    after = std::move(it->second.after);
+    it->second.promise.set_value(std::move(result));
+    relayed.erase(it);
+  }
+  if (after)
+    after(ok);
 }
 
 // Relayed requests past their bound fail (the process lives but does not answer).
 void ProcessLinks::Impl::expire() {
   const auto now = std::chrono::steady_clock::now();
-  std::lock_guard lock(mutex);
-  for (auto it = relayed.begin(); it != relayed.end();) {
-    if (it->second.deadline > now) {
-      ++it;
-      continue;
+  std::vector<std::function<void(bool)>> afters;
+  {
+    std::lock_guard lock(mutex);
+    for (auto it = relayed.begin(); it != relayed.end();) {
+      if (it->second.deadline > now) {
+        ++it;
+        continue;
+      }
+      it->second.promise.set_value(
+          call_error(Status::Timeout, fmt::format("pid {} did not answer in {} s", it->second.pid,
+                                                  kRelayBound.count())));
+      if (it->second.after)
+        afters.push_back(std::move(it->second.after));
+      it = relayed.erase(it);
     }
-    it->second.promise.set_value(
-        call_error(Status::Timeout, fmt::format("pid {} did not answer in {} s", it->second.pid,
-                                                kRelayBound.count())));
-    it = relayed.erase(it);
   }
+  for (auto &after : afters)
+    after(false);
 }
 
 void ProcessLinks::Impl::poll_loop() {
@@ -279,9 +333,11 @@ void ProcessLinks::Impl::end(LinkedProcess &process, const std::string &why) {
 
 ProcessLinks::ProcessLinks(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 
-Expected<std::unique_ptr<ProcessLinks>> ProcessLinks::start(control::Endpoint &endpoint) {
+Expected<std::unique_ptr<ProcessLinks>> ProcessLinks::start(control::Endpoint &endpoint,
+                                                            HostData *host_data) {
   auto impl = std::make_unique<Impl>();
   impl->endpoint = &endpoint;
+  impl->host_data = host_data;
   impl->epoll = process::Fd(::epoll_create1(EPOLL_CLOEXEC));
   impl->wake = process::Fd(::eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK));
   if (!impl->epoll || !impl->wake)
@@ -347,6 +403,8 @@ void ProcessLinks::detach(pid_t pid) {
       impl_->by_address.erase(a);
     impl_->end(*process, "the process has exited");
   }
+  if (impl_->host_data != nullptr)
+    impl_->host_data->forget(pid);
   // Not waited for: detach runs on the GPP's reaper thread, which a handler of the same batch
   // (a node.terminate) may be waiting on; the relays under way have failed already.
   for (const auto &a : process->addresses)

@@ -2,6 +2,8 @@
 // its host's agent for control. It serves each process's control addresses on the node's own
 // endpoint and relays their requests over the link, makes the process's calls on DDS for it,
 // and publishes its announcements. A process's death is seen at once as the end of its link.
+// A relayed connect that asks for shared memory gets its ring from the host's data
+// (node/host_data.hpp) on the way, and every end of a ring is let go when its process ends.
 #pragma once
 
 #include <memory>
@@ -12,14 +14,17 @@
 
 #include "common/diagnostic.hpp"
 #include "control/endpoint.hpp"
+#include "node/host_data.hpp"
 #include "process/fd.hpp"
 
 namespace rsca::node {
 
 class ProcessLinks {
 public:
-  // Relays through `endpoint`, which must outlive close().
-  static Expected<std::unique_ptr<ProcessLinks>> start(control::Endpoint &endpoint);
+  // Relays through `endpoint`, which must outlive close(); rings from `host_data` (may be null:
+  // no same-host connections), which must outlive this.
+  static Expected<std::unique_ptr<ProcessLinks>> start(control::Endpoint &endpoint,
+                                                       HostData *host_data = nullptr);
   ~ProcessLinks();
   ProcessLinks(const ProcessLinks &) = delete;
   ProcessLinks &operator=(const ProcessLinks &) = delete;

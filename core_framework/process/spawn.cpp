@@ -97,6 +97,9 @@ Expected<Fd> open_log(const Command &command) {
   return log;
 }
 
+// Above the numbers a child is given descriptors as (Command::inherit).
+constexpr int kFirstCopiedFd = 64;
+
 class SpawnActions {
 public:
   SpawnActions() { ::posix_spawn_file_actions_init(&actions_); }
@@ -124,7 +127,8 @@ private:
 // stdin from /dev/null, stdout and stderr to the log, the working directory, the one descriptor
 // the command hands over, and no other descriptor of this process, close-on-exec or not. Returns 0
 // or an errno value.
-int prepare_files(SpawnActions &actions, const Command &command, int log_fd) {
+int prepare_files(SpawnActions &actions, const Command &command, int log_fd,
+                  const std::vector<Fd> &inherited) {
   int rc =
       ::posix_spawn_file_actions_addopen(actions.get(), STDIN_FILENO, "/dev/null", O_RDONLY, 0);
   if (rc == 0 && log_fd >= 0) {
@@ -137,10 +141,10 @@ int prepare_files(SpawnActions &actions, const Command &command, int log_fd) {
     rc = ::posix_spawn_file_actions_addchdir_np(actions.get(), command.working_dir.c_str());
   }
   int first_closed = STDERR_FILENO + 1;
-  if (rc == 0 && command.inherit) {
-    rc =
-        ::posix_spawn_file_actions_adddup2(actions.get(), command.inherit->fd, command.inherit->as);
-    first_closed = command.inherit->as + 1;
+  for (std::size_t i = 0; rc == 0 && i < command.inherit.size(); ++i) {
+    rc = ::posix_spawn_file_actions_adddup2(actions.get(), inherited[i].get(),
+                                            command.inherit[i].as);
+    first_closed = std::max(first_closed, command.inherit[i].as + 1);
   }
   if (rc == 0) {
     rc = ::posix_spawn_file_actions_addclosefrom_np(actions.get(), first_closed);
@@ -232,7 +236,16 @@ std::vector<char *> c_strings(std::vector<std::string> &strings) {
 Expected<pid_t> start(const Command &command, Group group, int log_fd) {
   SpawnActions actions;
   SpawnAttributes attributes;
-  int rc = prepare_files(actions, command, log_fd);
+  // Each inherited descriptor is first copied above every number it is given as, so that giving
+  // one its number cannot overwrite another not given yet.
+  std::vector<Fd> inherited;
+  for (const auto &i : command.inherit) {
+    inherited.emplace_back(::fcntl(i.fd, F_DUPFD_CLOEXEC, kFirstCopiedFd));
+    if (!inherited.back())
+      return spawn_error(command, fmt::format("cannot hand descriptor {} to {}: {}", i.fd,
+                                              command.program.string(), errno_text(errno)));
+  }
+  int rc = prepare_files(actions, command, log_fd, inherited);
   if (rc == 0) {
     rc = prepare_attributes(attributes, group);
   }

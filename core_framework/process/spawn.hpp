@@ -54,13 +54,14 @@ struct Command {
   // stdout and stderr are appended to this file, its directories created if missing. Empty:
   // the child shares this process's stdout and stderr. stdin is always /dev/null.
   std::filesystem::path log_file{};
-  // One descriptor of this process the child gets, as descriptor `as` (above stderr): the node
-  // link (protocol/node_link.hpp). Every descriptor above it is closed in the child.
+  // Descriptors of this process the child gets, each as descriptor `as` (above stderr): the node
+  // link (protocol/node_link.hpp), the host's arena (shm/arena.hpp). Every other descriptor is
+  // closed in the child.
   struct Inherited {
     int fd = -1;
     int as = 3;
   };
-  std::optional<Inherited> inherit{};
+  std::vector<Inherited> inherit{};
 };
 
 // A started process. Not reaped by its destructor: whoever started it reaps it, or leaves it to

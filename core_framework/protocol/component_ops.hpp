@@ -13,6 +13,16 @@
 
 namespace rsca::protocol::component {
 
+// A same-host connection's ring in the host's arena (shm/ring.hpp), which the node that relays
+// the request makes and names: its offset, and a reader's slot in it.
+struct Ring {
+  std::uint64_t offset = 0;
+  std::uint32_t slot = 0; // a provides port's
+  static constexpr auto fields() {
+    return std::tuple{required("offset", &Ring::offset), optional("slot", &Ring::slot)};
+  }
+};
+
 // The end of a connection this component's port is to be: its topic (a DDS connection) or its
 // target (a uses port of a control interface, which calls that component's control address).
 struct ConnectRequest {
@@ -26,13 +36,24 @@ struct ConnectRequest {
   std::optional<bool> local;         // both ends are in this process: no DDS
   std::optional<std::string> target; // a control interface's component address
   std::optional<std::string> via;    // the endpoint that serves `target` (its node or host)
+  // Both ends are processes of one node, which relays the request (the domain says so): the node
+  // then makes the topic's ring and adds `ring`, and the connection goes through it, not DDS.
+  std::optional<bool> shared_memory;
+  std::optional<Ring> ring;
   static constexpr auto fields() {
     using R = ConnectRequest;
-    return std::tuple{required("connection", &R::connection), required("port", &R::port),
-                      required("direction", &R::direction),   optional("repid", &R::repid),
-                      optional("topic", &R::topic),           optional("qos", &R::qos),
-                      optional("filter", &R::filter),         optional("local", &R::local),
-                      optional("target", &R::target),         optional("via", &R::via)};
+    return std::tuple{required("connection", &R::connection),
+                      required("port", &R::port),
+                      required("direction", &R::direction),
+                      optional("repid", &R::repid),
+                      optional("topic", &R::topic),
+                      optional("qos", &R::qos),
+                      optional("filter", &R::filter),
+                      optional("local", &R::local),
+                      optional("target", &R::target),
+                      optional("via", &R::via),
+                      optional("shared_memory", &R::shared_memory),
+                      optional("ring", &R::ring)};
   }
 };
 
@@ -73,19 +94,17 @@ struct ConnectionStatus {
   std::optional<std::uint64_t> filtered;
   std::optional<std::uint64_t> deadline_missed;
   std::optional<bool> in_host;
+  std::optional<bool> same_host;
   std::optional<std::string> target; // a control interface's connection: whom it calls
   std::optional<std::uint64_t> calls;
   static constexpr auto fields() {
     using R = ConnectionStatus;
-    return std::tuple{required("connection", &R::connection),
-                      optional("topic", &R::topic),
-                      optional("matched", &R::matched),
-                      optional("samples", &R::samples),
-                      optional("filtered", &R::filtered),
-                      optional("deadline_missed", &R::deadline_missed),
-                      optional("in_host", &R::in_host),
-                      optional("target", &R::target),
-                      optional("calls", &R::calls)};
+    return std::tuple{
+        required("connection", &R::connection), optional("topic", &R::topic),
+        optional("matched", &R::matched),       optional("samples", &R::samples),
+        optional("filtered", &R::filtered),     optional("deadline_missed", &R::deadline_missed),
+        optional("in_host", &R::in_host),       optional("same_host", &R::same_host),
+        optional("target", &R::target),         optional("calls", &R::calls)};
   }
 };
 

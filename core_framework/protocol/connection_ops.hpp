@@ -143,8 +143,9 @@ struct CreateReply : ConnectionView {
 };
 
 // One connection in connection.list, with each end's live state as its owner reports it
-// ({"matched", "samples", "filtered", "deadline_missed", "in_host"}, or {"calls"} for a caller
-// of a supported interface), null when the end shows none: JSON, so that null stays null.
+// ({"matched", "samples", "filtered", "deadline_missed", "in_host", "same_host"}, or {"calls"}
+// for a caller of a supported interface), null when the end shows none: JSON, so that null stays
+// null.
 struct ListedConnection : ConnectionView {
   std::string application;                // "(runtime)" for the operator's
   std::optional<std::string> filter;      // an application's connection

@@ -116,17 +116,32 @@ struct NodeAnnouncement {
   }
 };
 
+// What the node's shared memory for its host's data holds (node/host_data.hpp).
+struct SharedMemoryStatus {
+  std::uint64_t rings = 0; // one per same-host topic
+  std::uint64_t ends = 0;  // connections' ends on them
+  std::uint64_t pages = 0; // processes' pages of doorbells
+  std::uint64_t bytes = 0; // of the arena, in use
+  static constexpr auto fields() {
+    using R = SharedMemoryStatus;
+    return std::tuple{required("rings", &R::rings), required("ends", &R::ends),
+                      required("pages", &R::pages), required("bytes", &R::bytes)};
+  }
+};
+
 struct StatusReply {
   std::string node;
   std::int64_t pid = 0;
   std::string host;
   std::vector<DeviceRecord> devices;
   std::vector<ProcessRecord> processes;
+  std::optional<SharedMemoryStatus> shared_memory; // none: the node has no shared memory
   static constexpr auto fields() {
     using R = StatusReply;
-    return std::tuple{required("node", &R::node), required("pid", &R::pid),
-                      required("host", &R::host), required("devices", &R::devices),
-                      required("processes", &R::processes)};
+    return std::tuple{
+        required("node", &R::node),           required("pid", &R::pid),
+        required("host", &R::host),           required("devices", &R::devices),
+        required("processes", &R::processes), optional("shared_memory", &R::shared_memory)};
   }
 };
 

@@ -9,6 +9,7 @@
 #include "control/link_socket.hpp"
 #include "host_info.hpp"
 #include "protocol/exec_params.hpp"
+#include "shm/arena.hpp"
 
 namespace rsca::gpp {
 
@@ -89,14 +90,29 @@ GppDevice::execute(const protocol::node::ExecuteRequest &r) {
     if (!pair)
       return control::call_error(Status::Failed, fmt::format("{}: {}", context_.id, pair.error()));
     link = std::move(*pair);
-    request.inherit = process::Command::Inherited{link->second.get(), protocol::link::kNodeLinkFd};
+    request.inherit.push_back({link->second.get(), protocol::link::kNodeLinkFd});
     request.env.emplace_back(protocol::link::kNodeLinkVariable,
                              std::to_string(protocol::link::kNodeLinkFd));
   }
+  // Its same-host connections go through the host's shared memory (node/host_data.hpp): it maps
+  // the arena, and gets a page of it for its doorbells.
+  std::optional<std::uint64_t> page;
+  if (context_.host_data != nullptr && link) {
+    if (auto reserved = context_.host_data->reserve_page()) {
+      page = reserved->first;
+      request.inherit.push_back({context_.host_data->arena_fd(), shm::kArenaFd});
+      request.env.emplace_back(shm::kArenaVariable, reserved->second);
+    }
+  }
   auto pid = launcher_.execute(request);
-  if (!pid)
+  if (!pid) {
+    if (page)
+      context_.host_data->release_page(*page);
     return control::call_error(Status::Failed,
                                fmt::format("{}: {}", context_.id, pid.error().to_string()));
+  }
+  if (page)
+    context_.host_data->adopt(*pid, *page);
   auto addresses = protocol::control_addresses(request.args);
   if (link) {
     link->second.reset(); // the child's end is the child's alone

@@ -104,6 +104,12 @@ public:
     return client_->call_sync("rsca/domain", op, std::move(body), timeout);
   }
 
+  // Calls node `index` (from 1) of the project's shipped nodes.
+  rsca::control::CallResult<Json> call_node(int index, const std::string &op,
+                                            Json body = Json::object()) {
+    return client_->call_sync(fmt::format("rsca/node/node{}", index), op, std::move(body), 5s);
+  }
+
   // Runs the CLI against this domain; returns its exit code and output.
   std::pair<int, std::string> cli(const std::vector<std::string> &args) {
     const fs::path out = run_ / "cli.out";
@@ -160,15 +166,20 @@ public:
     REQUIRE(nodes.has_value());
     // Waited for: a process gone from /proc (a zombie) is listed until the node's reaper has
     // reaped it, which a slow host (TSan: hostile_test's SIGKILLed orphans) shows.
+    // Its shared memory too: no ring, no end of one, no process's page (freed as the process
+    // is reaped).
     for (const auto &node : nodes->at("nodes")) {
-      Json processes;
+      Json processes, shared;
       const bool reaped = wait_for([&] {
         auto status = client_->call_sync(node.at("address"), "node.status", Json::object(), 5s);
         REQUIRE(status.has_value());
         processes = status->at("processes");
-        return processes.empty();
+        shared = status->value("shared_memory", Json::object());
+        return processes.empty() && shared.value("rings", 0) == 0 && shared.value("ends", 0) == 0 &&
+               shared.value("pages", 0) == 0;
       });
-      INFO(node.at("address") << " still lists " << processes.dump());
+      INFO(node.at("address") << " still lists " << processes.dump() << ", shared memory "
+                              << shared.dump());
       CHECK(reaped);
     }
   }

@@ -63,10 +63,9 @@ TEST_CASE("a component process with no data ports has no UDP socket: its node se
   // Supervisor_1 has only a uses port of a control interface; Producer_1 has data ports.
   const Json app = domain.create("Supervised");
   const long supervisor = component_named(app, "Supervisor_1").at("pid").get<long>();
-  const long producer = component_named(app, "Producer_1").at("pid").get<long>();
-  // The component with data ports joins DDS (in the background, as it starts): the test can see
-  // UDP sockets at all, so the count below is not zero for want of seeing them.
-  REQUIRE(TestDomain::wait_for([&] { return udp_sockets_of(producer) > 0; }));
+  // The nodes are on DDS: the test can see UDP sockets at all, so the count below is not zero for
+  // want of seeing them.
+  REQUIRE(udp_sockets_of(domain.node_pid(1)) > 0);
   CHECK(udp_sockets_of(supervisor) == 0);
   // Controlled all the same: its node relays (query, and the supervisor's own calls to the
   // producer's address through the nodes, which its start made).
@@ -78,4 +77,41 @@ TEST_CASE("a component process with no data ports has no UDP socket: its node se
   CHECK(udp_sockets_of(supervisor) == 0);
   REQUIRE(domain.call("app.release", Json{{"app", "Supervised"}}).has_value());
   domain.require_clean(pids_of(app));
+}
+
+TEST_CASE("two component processes of one node connect through its shared memory, with no UDP "
+          "socket of their own",
+          "[integration][node-agent]") {
+  TestDomain domain(1);
+  auto [rc, out] = domain.cli(
+      {"launch",
+       (kSource / "profiles/dom/waveforms/ProducerConsumer/ProducerConsumer.sad.xml").string()});
+  INFO(out);
+  REQUIRE(rc == 0);
+  auto app = domain.call("app.show", Json{{"app", "ProducerConsumer"}});
+  REQUIRE(app.has_value());
+  const auto pids = pids_of(*app);
+  REQUIRE(pids.size() == 2);
+  // Samples flow, end to end, over the node's ring.
+  Json samples;
+  REQUIRE(TestDomain::wait_for([&] {
+    auto list = domain.call("connection.list", Json{{"app", "ProducerConsumer"}});
+    REQUIRE(list.has_value());
+    samples = list->at("connections").at(0);
+    return samples.at("provides_state").value("samples", 0) > 3;
+  }));
+  INFO(samples.dump());
+  CHECK(samples.at("uses_state").value("same_host", false));
+  CHECK(samples.at("provides_state").value("same_host", false));
+  CHECK(samples.at("uses_state").value("matched", 0) == 1);
+  CHECK(samples.at("provides_state").value("matched", 0) == 1);
+  REQUIRE(udp_sockets_of(domain.node_pid(1)) > 0);
+  for (long pid : pids)
+    CHECK(udp_sockets_of(pid) == 0);
+  auto status = domain.call_node(1, "node.status");
+  REQUIRE(status.has_value());
+  CHECK(status->at("shared_memory").at("rings") == 1);
+  CHECK(status->at("shared_memory").at("ends") == 2);
+  REQUIRE(domain.call("app.release", Json{{"app", "ProducerConsumer"}}).has_value());
+  domain.require_clean(pids); // with the node's shared memory empty again
 }

@@ -47,7 +47,12 @@ TEST_CASE("protocol: a connect request round-trips, its empty optionals left out
 }
 
 TEST_CASE("protocol: nested messages round-trip", "[protocol]") {
-  protocol::node::StatusReply status{"node1", 42, "robot", {}, {{7, "app/C_1", "/tmp/c.log"}}};
+  protocol::node::StatusReply status{"node1",
+                                     42,
+                                     "robot",
+                                     {},
+                                     {{7, "app/C_1", "/tmp/c.log"}},
+                                     protocol::node::SharedMemoryStatus{1, 2, 3, 4096}};
   protocol::node::DeviceRecord gpp{
       "node1:GPP_1",  "GPP_1",        "GPP",          "gpp", Json{{"os_name", "Linux"}},
       Json::object(), Json::object(), Json::object(), "",    {}};
@@ -60,6 +65,9 @@ TEST_CASE("protocol: nested messages round-trip", "[protocol]") {
   REQUIRE(back.devices.size() == 2);
   CHECK(back.devices[0].properties.at("os_name") == "Linux");
   CHECK(back.devices[1].ports.at(0).repid == "IDL:Range:1.0");
+  REQUIRE(back.shared_memory.has_value());
+  CHECK(back.shared_memory->ends == 2);
+  CHECK(back.shared_memory->bytes == 4096);
   REQUIRE(back.processes.size() == 1);
   CHECK(back.processes[0].pid == 7);
 }

@@ -68,8 +68,9 @@ private:
   }
 };
 
-WireEnd end_at(std::string address, std::string port, std::string host = "") {
-  return {address, port, "c1", std::move(host), 1, address + "." + port};
+WireEnd end_at(std::string address, std::string port, std::string host = "",
+               std::string node = "") {
+  return {address, port, "c1", std::move(host), 1, address + "." + port, std::move(node)};
 }
 
 Wire topic_wire(WireEnd uses, WireEnd provides) {
@@ -112,6 +113,33 @@ TEST_CASE("wiring: both ends in one component host take the in-host path", "[wir
               .has_value());
   for (const auto &r : fake.requests<rsca::protocol::component::Connect>())
     CHECK(r.local == false);
+}
+
+TEST_CASE("wiring: two processes of one node take its shared memory, others DDS", "[wiring]") {
+  using rsca::protocol::component::Connect;
+  auto wire = [](std::string uses_host, std::string uses_node, std::string provides_host,
+                 std::string provides_node) {
+    FakeComponents fake;
+    std::vector<WireEnd> made;
+    REQUIRE(Wiring(fake, std::chrono::milliseconds(100))
+                .connect({topic_wire(end_at("a", "out", uses_host, uses_node),
+                                     end_at("b", "in", provides_host, provides_node))},
+                         made)
+                .has_value());
+    return fake.requests<Connect>();
+  };
+  for (const auto &r : wire("", "node1", "", "node1")) {
+    CHECK(r.shared_memory == true);
+    CHECK(r.local == false);
+  }
+  for (const auto &r : wire("", "node1", "", "node2"))
+    CHECK_FALSE(r.shared_memory.has_value());
+  for (const auto &r : wire("", "node1", "", "")) // a device of the node, or an unrelayed process
+    CHECK_FALSE(r.shared_memory.has_value());
+  for (const auto &r : wire("host1", "node1", "host1", "node1")) { // one process: in-host
+    CHECK(r.local == true);
+    CHECK_FALSE(r.shared_memory.has_value());
+  }
 }
 
 TEST_CASE("wiring: a failed writer leaves the reader made, for its caller to undo", "[wiring]") {

@@ -85,7 +85,9 @@ std::string end_state(const Json &state) {
   return fmt::format("{} matched, {} samples{}{}", state.value("matched", 0),
                      state.value("samples", 0),
                      missed == 0 ? "" : fmt::format(", {} deadlines missed", missed),
-                     state.value("in_host", false) ? " (in-host)" : "");
+                     state.value("in_host", false)     ? " (in-host)"
+                     : state.value("same_host", false) ? " (same-host, shared memory)"
+                                                       : "");
 }
 
 void print_connections(const connection_ops::ListReply &r) {

@@ -1,0 +1,91 @@
+// The node's shared memory for its host's data: the part of the host agent that iceoryx gives to
+// RouDi. The node makes the arena (shm/arena.hpp) its processes inherit, gives each a page for
+// the doorbells of its receive threads, and makes a ring (shm/ring.hpp) per same-host topic at
+// the first `component.connect` that asks for one; it counts each end, and frees the ring when
+// its last end goes: disconnected, failed to connect, or its process ended. A writer whose
+// process ended without disconnecting is counted as lost: its readers see lost liveliness.
+//
+// Only the node allocates and counts; the processes use what it gave them (the offsets in the
+// relayed request). It is called from the relay (node/process_links.cpp), hence its own lock.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <tuple>
+
+#include <sys/types.h>
+#include <tl/expected.hpp>
+
+#include <nlohmann/json.hpp>
+
+#include "common/diagnostic.hpp"
+#include "shm/arena.hpp"
+#include "shm/ring.hpp"
+
+namespace rsca::node {
+
+class HostData {
+public:
+  // 1 GiB of address space; memory is taken only as rings and pages are used.
+  static constexpr std::size_t kArenaBytes = std::size_t{1} << 30;
+  static constexpr std::size_t kPageBytes = 64 * 1024; // a process's doorbells: 1024
+
+  static Expected<std::unique_ptr<HostData>> create(std::size_t bytes = kArenaBytes);
+
+  int arena_fd() const { return arena_.fd(); }
+  // A page for a process about to start, and the value of shm::kArenaVariable that tells it
+  // (the arena at shm::kArenaFd); adopt() binds it to the process once it runs.
+  std::optional<std::pair<std::uint64_t, std::string>> reserve_page();
+  void adopt(pid_t pid, std::uint64_t page);
+  void release_page(std::uint64_t page);
+
+  // A relayed component.connect to `target` (served by process `pid`): when it asks for shared
+  // memory, the topic's ring, made or found, with this end counted, and the request to hand on
+  // (with `ring`); else the request as it is. An error says why the node cannot.
+  tl::expected<nlohmann::json, std::string> connect(pid_t pid, const std::string &target,
+                                                    const nlohmann::json &request);
+  // The end goes: disconnected, or its connect failed. Nothing if it has none.
+  void disconnect(pid_t pid, const std::string &target, const std::string &port,
+                  const std::string &connection);
+  // The process ended: its page and its ends go.
+  void forget(pid_t pid);
+
+  struct Counts {
+    std::size_t rings = 0;
+    std::size_t ends = 0;
+    std::size_t pages = 0;
+    std::size_t bytes_in_use = 0;
+  };
+  Counts counts() const;
+
+private:
+  struct Ring {
+    std::uint64_t offset = 0;
+    shm::RingOwner owner;
+    std::size_t ends = 0;
+  };
+  struct End {
+    std::string topic;
+    bool writer = false;
+    std::uint32_t slot = 0;
+  };
+  // (pid, target, port, connection)
+  using EndKey = std::tuple<pid_t, std::string, std::string, std::string>;
+
+  explicit HostData(shm::Arena arena);
+  tl::expected<Ring *, std::string> ring_of_locked(const std::string &topic);
+  void release_end_locked(std::map<EndKey, End>::iterator end, bool lost);
+
+  shm::Arena arena_;
+  mutable std::mutex mutex_; // guards what follows
+  shm::ArenaAllocator allocator_;
+  std::map<std::string, Ring> rings_; // by topic
+  std::map<EndKey, End> ends_;
+  std::map<pid_t, std::uint64_t> pages_;
+};
+
+} // namespace rsca::node

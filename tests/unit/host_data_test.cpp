@@ -1,0 +1,86 @@
+// The node's shared memory for its host's data (node/host_data.hpp): a ring per same-host topic
+// made at the first connect that asks for one, each end counted, everything freed when the ends
+// go, and a process's end let go when it ends.
+#include <catch2/catch.hpp>
+
+#include "node/host_data.hpp"
+#include "protocol/codec.hpp"
+#include "protocol/component_ops.hpp"
+
+using namespace rsca;
+using nlohmann::json;
+
+namespace {
+
+json same_host_connect(const std::string &direction, const std::string &port,
+                       const std::string &topic = "rsca/d/app/c1") {
+  return json{{"connection", "c1"}, {"port", port},         {"direction", direction},
+              {"topic", topic},     {"repid", "IDL:T:1.0"}, {"shared_memory", true}};
+}
+
+protocol::component::Ring ring_in(const json &request) {
+  REQUIRE(request.contains("ring"));
+  return protocol::decode<protocol::component::Ring>(request.at("ring")).value();
+}
+
+} // namespace
+
+TEST_CASE("host data: two ends of a topic share one ring; it goes with its last end",
+          "[host-data]") {
+  auto data = node::HostData::create(64 << 20).value();
+  const auto writer = data->connect(100, "a", same_host_connect("uses", "out"));
+  REQUIRE(writer.has_value());
+  const auto reader = data->connect(200, "b", same_host_connect("provides", "in"));
+  REQUIRE(reader.has_value());
+  CHECK(ring_in(*writer).offset == ring_in(*reader).offset);
+  CHECK(data->counts().rings == 1);
+  CHECK(data->counts().ends == 2);
+  // Made again, the writer's end replaces its old one.
+  REQUIRE(data->connect(100, "a", same_host_connect("uses", "out")).has_value());
+  CHECK(data->counts().ends == 2);
+  data->disconnect(100, "a", "out", "c1");
+  CHECK(data->counts().rings == 1);
+  data->disconnect(200, "b", "in", "c1");
+  CHECK(data->counts().rings == 0);
+  CHECK(data->counts().ends == 0);
+  CHECK(data->counts().bytes_in_use == 0);
+}
+
+TEST_CASE("host data: a request that does not ask for shared memory is handed on as it is",
+          "[host-data]") {
+  auto data = node::HostData::create(64 << 20).value();
+  json request = same_host_connect("uses", "out");
+  request.erase("shared_memory");
+  const auto relayed = data->connect(100, "a", request);
+  REQUIRE(relayed.has_value());
+  CHECK(*relayed == request);
+  CHECK(data->counts().rings == 0);
+  json no_topic = same_host_connect("uses", "out");
+  no_topic.erase("topic");
+  CHECK_FALSE(data->connect(100, "a", no_topic).has_value());
+}
+
+TEST_CASE("host data: a process that ends lets go of its page and its ends; its readers see a "
+          "lost writer",
+          "[host-data]") {
+  auto data = node::HostData::create(64 << 20).value();
+  auto page = data->reserve_page();
+  REQUIRE(page.has_value());
+  CHECK(page->second.starts_with("4:"));
+  data->adopt(100, page->first);
+  CHECK(data->counts().pages == 1);
+  REQUIRE(data->connect(100, "a", same_host_connect("uses", "out")).has_value());
+  const auto reader = data->connect(200, "b", same_host_connect("provides", "in"));
+  REQUIRE(reader.has_value());
+  data->forget(100);
+  CHECK(data->counts().pages == 0);
+  CHECK(data->counts().ends == 1);
+  // The reader's view of the ring: no writer left, one lost.
+  const auto mapped = shm::Arena::map(process::Fd(::dup(data->arena_fd()))).value();
+  auto ring = shm::detail::RingView::open(mapped, ring_in(*reader).offset).value();
+  CHECK(ring.header->writers.load() == 0);
+  CHECK(ring.header->writers_lost.load() == 1);
+  data->forget(200);
+  CHECK(data->counts().rings == 0);
+  CHECK(data->counts().bytes_in_use == 0);
+}

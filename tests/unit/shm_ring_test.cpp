@@ -1,0 +1,242 @@
+// The host's shared memory for same-host data (shm/): the arena's allocator, a topic's ring with
+// its writers, readers, depths and overruns, its doorbells, and a ring between two processes.
+#include <catch2/catch.hpp>
+
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "component/port_record.hpp"
+#include "shm/arena.hpp"
+#include "shm/doorbell.hpp"
+#include "shm/ring.hpp"
+
+using namespace rsca;
+
+namespace {
+
+// A record of one 64-bit number, for ring tests.
+tl::expected<void, std::string> write_number(shm::RingWriter &writer, std::uint64_t n) {
+  return writer.write(sizeof(n), [n](std::byte *at) { std::memcpy(at, &n, sizeof(n)); });
+}
+
+std::vector<std::uint64_t> take_numbers(shm::RingReader &reader) {
+  std::vector<std::uint64_t> out;
+  std::uint64_t n = 0;
+  reader.take(
+      [&n](const std::byte *at, std::size_t bytes) {
+        if (bytes != sizeof(n))
+          return false;
+        std::memcpy(&n, at, sizeof(n));
+        return true;
+      },
+      [&] { out.push_back(n); });
+  return out;
+}
+
+struct RingFixture {
+  shm::Arena arena = shm::Arena::create(8 << 20).value();
+  shm::ArenaAllocator allocator{arena.size()};
+  std::uint64_t bell_at = allocator.allocate(sizeof(shm::Doorbell)).value();
+  shm::Doorbell *bell = new (arena.at(bell_at, sizeof(shm::Doorbell))) shm::Doorbell();
+
+  std::pair<shm::RingOwner, std::uint64_t> make(shm::RingLimits limits = {}) {
+    const auto at = allocator.allocate(shm::ring_bytes(limits)).value();
+    return {shm::RingOwner::create(arena, at, limits).value(), at};
+  }
+  shm::RingReader reader(shm::RingOwner &owner, std::uint64_t at, std::uint32_t depth = 0) {
+    const auto slot = owner.claim_reader().value();
+    return shm::RingReader::open(arena, at, slot, bell_at, depth).value();
+  }
+};
+
+} // namespace
+
+TEST_CASE("shm: the arena's allocator gives aligned blocks, merges what is freed, and fills",
+          "[shm]") {
+  shm::ArenaAllocator allocator(4096);
+  const auto a = allocator.allocate(100).value();
+  const auto b = allocator.allocate(100).value();
+  CHECK(a % shm::ArenaAllocator::kAlign == 0);
+  CHECK(b % shm::ArenaAllocator::kAlign == 0);
+  CHECK(b >= a + 100);
+  CHECK(allocator.in_use() == 256);
+  CHECK_FALSE(allocator.allocate(4096).has_value());
+  allocator.release(a);
+  allocator.release(b);
+  CHECK(allocator.in_use() == 0);
+  CHECK(allocator.allocate(4096).has_value()); // merged back into one block
+}
+
+TEST_CASE("shm: an arena grant reads back, and a malformed one is refused", "[shm]") {
+  const shm::ArenaGrant grant{4, 65536, 4096};
+  const auto back = shm::ArenaGrant::parse(grant.to_string());
+  REQUIRE(back.has_value());
+  CHECK(back->page == 65536);
+  CHECK(back->page_bytes == 4096);
+  CHECK_FALSE(shm::ArenaGrant::parse("4:65536").has_value());
+  CHECK_FALSE(shm::ArenaGrant::parse("4:1:2:3").has_value());
+  CHECK_FALSE(shm::ArenaGrant::parse("x").has_value());
+}
+
+TEST_CASE("shm: a ring delivers in order what is written after its reader opened, and rings it",
+          "[shm]") {
+  RingFixture f;
+  auto [owner, at] = f.make();
+  auto writer = shm::RingWriter::open(f.arena, at).value();
+  owner.add_writer();
+  REQUIRE(write_number(writer, 99)); // before the reader: not seen
+  auto reader = f.reader(owner, at);
+  CHECK(writer.readers() == 1);
+  CHECK(reader.writers() == 1);
+  for (std::uint64_t i = 0; i < 10; ++i)
+    REQUIRE(write_number(writer, i));
+  CHECK((shm::take(*f.bell) & shm::kWakeNearData) != 0);
+  const auto got = take_numbers(reader);
+  REQUIRE(got.size() == 10);
+  for (std::uint64_t i = 0; i < 10; ++i)
+    CHECK(got[i] == i);
+  CHECK(reader.dropped() == 0);
+  CHECK(take_numbers(reader).empty());
+}
+
+TEST_CASE("shm: a reader of depth n takes the newest n and counts the rest dropped", "[shm]") {
+  RingFixture f;
+  auto [owner, at] = f.make();
+  auto writer = shm::RingWriter::open(f.arena, at).value();
+  auto reader = f.reader(owner, at, /*depth=*/2);
+  for (std::uint64_t i = 0; i < 5; ++i)
+    REQUIRE(write_number(writer, i));
+  CHECK(take_numbers(reader) == std::vector<std::uint64_t>{3, 4});
+  CHECK(reader.dropped() == 3);
+}
+
+TEST_CASE("shm: a writer never waits: a reader that fell behind loses the oldest, never a torn "
+          "one",
+          "[shm]") {
+  RingFixture f;
+  auto [owner, at] = f.make({4096, 16});
+  auto writer = shm::RingWriter::open(f.arena, at).value();
+  auto reader = f.reader(owner, at);
+  for (std::uint64_t i = 0; i < 100; ++i)
+    REQUIRE(write_number(writer, i));
+  const auto got = take_numbers(reader);
+  REQUIRE_FALSE(got.empty());
+  CHECK(got.size() <= 16);
+  CHECK(got.back() == 99);
+  for (std::size_t i = 1; i < got.size(); ++i)
+    CHECK(got[i] == got[i - 1] + 1);
+  CHECK(reader.dropped() + got.size() == 100);
+  // A record larger than half the ring is refused, and nothing is published.
+  CHECK_FALSE(writer.write(4096, [](std::byte *) {}).has_value());
+  CHECK(take_numbers(reader).empty());
+}
+
+TEST_CASE("shm: a ring has at most kMaxRingReaders readers; a slot released is claimed again",
+          "[shm]") {
+  RingFixture f;
+  auto [owner, at] = f.make();
+  std::vector<std::uint32_t> slots;
+  for (std::uint32_t i = 0; i < shm::kMaxRingReaders; ++i)
+    slots.push_back(owner.claim_reader().value());
+  CHECK_FALSE(owner.claim_reader().has_value());
+  owner.release_reader(slots[7]);
+  CHECK(owner.claim_reader() == slots[7]);
+  // A reader opens only the slot claimed for it.
+  owner.release_reader(slots[3]);
+  CHECK_FALSE(shm::RingReader::open(f.arena, at, slots[3], f.bell_at, 0).has_value());
+  CHECK_FALSE(shm::RingReader::open(f.arena, at + 64, 0, f.bell_at, 0).has_value());
+}
+
+TEST_CASE("shm: a writer's process that ends is counted lost, and liveliness is its last write",
+          "[shm]") {
+  RingFixture f;
+  auto [owner, at] = f.make();
+  auto writer = shm::RingWriter::open(f.arena, at).value();
+  auto reader = f.reader(owner, at);
+  owner.add_writer();
+  CHECK(reader.alive_ns() == 0);
+  REQUIRE(write_number(writer, 1));
+  const auto first = reader.alive_ns();
+  CHECK(first > 0);
+  writer.assert_alive();
+  CHECK(reader.alive_ns() >= first);
+  owner.remove_writer(/*lost=*/true);
+  CHECK(reader.writers() == 0);
+  CHECK(reader.writers_lost() == 1);
+}
+
+TEST_CASE("shm: a ring carries records between two processes, the reader asleep on its doorbell",
+          "[shm]") {
+  RingFixture f;
+  auto [owner, at] = f.make({1 << 16, 1024});
+  auto reader = f.reader(owner, at);
+  constexpr std::uint64_t kRecords = 20000;
+  const pid_t child = ::fork();
+  REQUIRE(child >= 0);
+  if (child == 0) {
+    // The child maps the arena anew, from its descriptor, as a process its node started would.
+    auto mapped = shm::Arena::map(rsca::process::Fd(::dup(f.arena.fd())));
+    if (!mapped)
+      ::_exit(2);
+    auto writer = shm::RingWriter::open(*mapped, at);
+    if (!writer)
+      ::_exit(3);
+    for (std::uint64_t i = 0; i < kRecords; ++i)
+      if (!write_number(*writer, i))
+        ::_exit(4);
+    ::_exit(0);
+  }
+  std::vector<std::uint64_t> got;
+  while (got.size() + reader.dropped() < kRecords) {
+    shm::sleep(*f.bell, 1000, /*shared=*/true);
+    shm::take(*f.bell);
+    for (auto n : take_numbers(reader))
+      got.push_back(n);
+  }
+  int status = 0;
+  REQUIRE(::waitpid(child, &status, 0) == child);
+  CHECK(WIFEXITED(status));
+  CHECK(WEXITSTATUS(status) == 0);
+  REQUIRE_FALSE(got.empty());
+  CHECK(got.back() == kRecords - 1);
+  for (std::size_t i = 1; i < got.size(); ++i)
+    REQUIRE(got[i] > got[i - 1]);
+}
+
+TEST_CASE("shm: port values round-trip as ring records; a short record is refused", "[shm]") {
+  port::Samples s;
+  s.timestamp_ns = 12;
+  s.sequence = 3;
+  s.stream_id = "lidar";
+  s.sample_rate = 10.5;
+  s.complex = true;
+  s.samples = {1.0, -2.5, 3.25};
+  std::vector<std::byte> buffer(port::record::size_of(s));
+  port::record::Writer w(buffer.data());
+  port::record::write(s, w);
+  port::Samples back;
+  port::record::Reader r(buffer.data(), buffer.size());
+  REQUIRE(port::record::read(r, back));
+  CHECK(back.stream_id == "lidar");
+  CHECK(back.complex);
+  CHECK_FALSE(back.end_of_stream);
+  CHECK(back.samples == s.samples);
+  CHECK(back.sample_rate == 10.5);
+  port::record::Reader short_one(buffer.data(), buffer.size() - 1);
+  CHECK_FALSE(port::record::read(short_one, back));
+
+  port::Command c{1, 2, "me", "go", {0.5}, "now"};
+  std::vector<std::byte> command(port::record::size_of(c));
+  port::record::Writer cw(command.data());
+  port::record::write(c, cw);
+  port::Command cback;
+  port::record::Reader cr(command.data(), command.size());
+  REQUIRE(port::record::read(cr, cback));
+  CHECK(cback.name == "go");
+  CHECK(cback.args == c.args);
+  CHECK(cback.text == "now");
+}
