@@ -11,11 +11,13 @@ configuration (it joins the DDS domain of the daemons the way every rsca process
 Payloads are 64 bytes serialized; times are CLOCK_MONOTONIC (tests/bench/bench_common.hpp).
 
 latency: strict ping-pong between BenchPing_1 and BenchEcho_1 (uses port -> provides port,
-  both ways), and between `rsca-bench-raw ping` and `rsca-bench-raw echo`, once woken by a waitset
+  both ways) placed on two nodes (over DDS) and on one node (through its shared memory), between
+  `rsca-bench-iceoryx ping` and `echo` (raw iceoryx 2.0.3, woken by its WaitSet; the same-host
+  baseline), and between `rsca-bench-raw ping` and `rsca-bench-raw echo`, once woken by a waitset
   (the baseline of the ratio lines) and once by a listener as rsca's receive loop is; each raw
   pair in one session, as the two components are in their node's (docs/architecture.md says why
   that matters). Rounds of 2000 warm-up round trips (not measured) and 2000 measured ones
-  (--quick: 1000), 6 rounds of each side (--quick: 3), each round running the sides in another
+  (--quick: 1000), 5 rounds of each side (--quick: 3), each round running the sides in another
   order so that a change of the machine's load falls on all alike. Median, p99 (and more) of the round
   trip and the CPU time both processes spend per round trip; the output ends with the ratio lines.
 fanout: BenchPublisher_1 publishes on the event channel BenchFanOut to N BenchSubscriber_i
@@ -45,21 +47,23 @@ import tempfile
 
 from local_domain import Domain
 from port_bench_fanout import Schedule, analyse_fanout, fanout_raw, fanout_rsca
-from port_bench_helpers import (FANOUT_LEASE_MS, SDRROOT, SIDES, LatencyRaw, LatencyRsca,
-                                busy_note, host_state, latency_stats, lease_env, ratio, raw_sizes)
+from port_bench_helpers import (FANOUT_LEASE_MS, SDRROOT, SIDES, LatencyIceoryx, LatencyRaw,
+                                LatencyRsca, busy_note, host_state, latency_stats, lease_env, ratio,
+                                raw_sizes)
 
 
 def bench_latency(args):
     # Each round runs the sides in another order, so that a change of the machine's load during
-    # the run falls on all alike and none always follows the same other: all six orders, or
-    # (--quick) three in which each side comes first once.
-    orders = list(itertools.permutations(SIDES))
+    # the run falls on all alike and none always follows the same other: each side first once (its
+    # rotations), or (--quick) three of them.
+    orders = [SIDES[i:] + SIDES[:i] for i in range(len(SIDES))]
     if args.quick:
-        orders = orders[::2]
+        orders = orders[:3]
     rounds = len(orders)
     count, warmup = (1000, 2000) if args.quick else (2000, 2000)  # per round
     rsca = os.path.join(args.bin, "rsca")
     raw = os.path.join(args.bin, "rsca-bench-raw")
+    iceoryx = os.path.join(args.bin, "rsca-bench-iceoryx")
     work = tempfile.mkdtemp(prefix="rsca-portbench-")
     lease = lease_env(args.lease_ms)
     rtts = {name: array.array("Q") for name in SIDES}
@@ -70,6 +74,11 @@ def bench_latency(args):
             sizes = raw_sizes(raw, domain.env)
             sides = {"rsca": LatencyRsca(domain, work, count, warmup)}
             closing.callback(sides["rsca"].close)
+            sides["rsca_same_host"] = LatencyRsca(domain, work, count, warmup, same_host=True)
+            closing.callback(sides["rsca_same_host"].close)
+            sides["iceoryx"] = LatencyIceoryx(iceoryx, work, count, warmup,
+                                              sizes["ping_sample_bytes"])
+            closing.callback(sides["iceoryx"].close)
             for name, wake in (("raw", "waitset"), ("raw_listener", "listener")):
                 sides[name] = LatencyRaw(domain, raw, work, sides["rsca"].qos, count, warmup,
                                          wake)
@@ -93,6 +102,9 @@ def bench_latency(args):
     results["ratio_p99"] = ratio(r["p99_us"], w["p99_us"])
     results["ratio_p50_listener"] = ratio(r["p50_us"], wl["p50_us"])
     results["ratio_p99_listener"] = ratio(r["p99_us"], wl["p99_us"])
+    sh, ix = results["rsca_same_host"], results["iceoryx"]
+    results["ratio_same_host_p50"] = ratio(sh["p50_us"], w["p50_us"])
+    results["ratio_same_host_iceoryx_p50"] = ratio(sh["p50_us"], ix["p50_us"])
     with open(args.out, "w") as f:
         json.dump(results, f, indent=2)
 
@@ -102,20 +114,24 @@ def bench_latency(args):
           f"as the components are in their node's; QoS {qos['reliability']}, "
           f"{qos['durability']}, {qos['history']} {qos.get('depth', '')}.")
     print()
-    print("| round trip | rsca (uses -> provides port) | raw Cyclone DDS (waitset) | rsca/raw "
-          "| raw, rsca's wake (listener) | rsca/that |")
-    print("| --- | --- | --- | --- | --- | --- |")
+    print("| round trip | rsca, two nodes (DDS) | raw Cyclone DDS (waitset) | rsca/raw "
+          "| raw, rsca's wake (listener) | rsca/that | rsca, one node (shared memory) "
+          "| same-host/raw | raw iceoryx (waitset) | same-host/iceoryx |")
+    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
     rows = [("min_us", "min"), ("p50_us", "p50"), ("p90_us", "p90"), ("p99_us", "p99"),
             ("p999_us", "p99.9"), ("max_us", "max"), ("mean_us", "mean"),
             ("cpu_us_per_round_trip", "CPU per round trip (both processes)")]
     for key, label in rows:
         print(f"| {label} | {r[key]:.1f} us | {w[key]:.1f} us | {ratio(r[key], w[key]):.2f} "
-              f"| {wl[key]:.1f} us | {ratio(r[key], wl[key]):.2f} |")
+              f"| {wl[key]:.1f} us | {ratio(r[key], wl[key]):.2f} | {sh[key]:.1f} us "
+              f"| {ratio(sh[key], w[key]):.2f} | {ix[key]:.1f} us | {ratio(sh[key], ix[key]):.2f} |")
     print()
     print(f"ratio rsca/raw-listener p50 = {results['ratio_p50_listener']:.2f}")
     print(f"ratio rsca/raw-listener p99 = {results['ratio_p99_listener']:.2f}")
     print(f"ratio rsca/raw p50 = {results['ratio_p50']:.2f}")
     print(f"ratio rsca/raw p99 = {results['ratio_p99']:.2f}")
+    print(f"ratio same-host rsca/raw p50 = {results['ratio_same_host_p50']:.2f}")
+    print(f"ratio same-host rsca/iceoryx p50 = {results['ratio_same_host_iceoryx_p50']:.2f}")
     return 0
 
 
@@ -125,6 +141,7 @@ def bench_fanout(args):
               else [1, 10] if args.quick else [1, 10, 50, 100])
     rsca = os.path.join(args.bin, "rsca")
     raw = os.path.join(args.bin, "rsca-bench-raw")
+    iceoryx = os.path.join(args.bin, "rsca-bench-iceoryx")
     work = tempfile.mkdtemp(prefix="rsca-portbench-")
     results = {"schedule": vars(schedule), "subscribers": {}}
     try:

@@ -123,35 +123,108 @@ def cpu_us(pid):
 
 class LatencyRsca:
     """BenchPing_1 and BenchEcho_1 launched once (not started); each round configures the ping's
-    output, starts the application, waits for the file and stops it."""
+    output, starts the application, waits for the file and stops it. `same_host`: both on one
+    node (placement "pack"), connected through its shared memory; else on two nodes ("spread"),
+    over DDS. Which one the domain made is checked, not assumed."""
 
-    def __init__(self, domain, work, count, warmup):
+    def __init__(self, domain, work, count, warmup, same_host=False):
         self.domain, self.work, self.count, self.warmup = domain, work, count, warmup
+        self.name = "latency-same-host" if same_host else "latency"
         sad = os.path.join(SDRROOT, "dom/waveforms/BenchPortLatency/BenchPortLatency.sad.xml")
-        domain.cli("install", sad)
-        reply, _ = domain.cli("launch", "BenchPortLatency", "--name", "latency", "--no-start")
+        domain.cli("install", sad, check=False)  # once for both sides
+        reply, _ = domain.cli("launch", "BenchPortLatency", "--name", self.name, "--no-start",
+                              "--strategy", "pack" if same_host else "spread")
         self.pids = {c["id"]: c["pid"] for c in reply["components"]}
-        self.qos = connection_qos(domain, "latency")
-        domain.cli("configure", "latency/BenchPing_1", f"count={count}", f"warmup={warmup}")
+        self.qos = connection_qos(domain, self.name)
+        listed, _ = domain.cli("ls", "connections", self.name)
+        made = [c.get("provides_state", {}).get("same_host", False)
+                for c in listed.get("connections", [])]
+        if not made or any(m != same_host for m in made):
+            raise RuntimeError(f"{self.name}: connections are not all "
+                               f"{'same-host' if same_host else 'over DDS'}: {listed}")
+        domain.cli("configure", f"{self.name}/BenchPing_1", f"count={count}", f"warmup={warmup}")
         self.cpu_us = 0.0
         self.round_trips = 0
         self.resent = 0
 
     def run(self, index):
-        output = os.path.join(self.work, f"rsca-rtt-{index}.bin")
-        self.domain.cli("configure", "latency/BenchPing_1", f"output={output}")
+        output = os.path.join(self.work, f"{self.name}-rtt-{index}.bin")
+        self.domain.cli("configure", f"{self.name}/BenchPing_1", f"output={output}")
         before = sum(cpu_us(p) for p in self.pids.values())
-        self.domain.cli("start", "latency")
+        self.domain.cli("start", self.name)
         wait_for_file(output, 8 * self.count, 60 + self.count * 0.01, "BenchPing_1")
         self.cpu_us += sum(cpu_us(p) for p in self.pids.values()) - before
-        props, _ = self.domain.cli("query", "latency/BenchPing_1", "completed", "resent")
-        self.domain.cli("stop", "latency")
+        props, _ = self.domain.cli("query", f"{self.name}/BenchPing_1", "completed", "resent")
+        self.domain.cli("stop", self.name)
         self.round_trips += props["properties"]["completed"]
         self.resent += props["properties"]["resent"]
         return read_u64(output)
 
     def close(self):
-        self.domain.cli("release", "latency", check=False)
+        self.domain.cli("release", self.name, check=False)
+
+
+class LatencyIceoryx:
+    """The raw iceoryx ping-pong (tests/bench/raw/raw_iceoryx.cpp): RouDi and the echo for the
+    whole run, in one session as a node's processes are; each round runs a ping to its end. The
+    payload is the size of the ping's SampleSeq on DDS."""
+
+    def __init__(self, program, work, count, warmup, payload_bytes):
+        self.program, self.work, self.count, self.warmup = program, work, count, warmup
+        self.bytes = str(payload_bytes)
+        self.procs = Processes(shared_session=True)
+        try:
+            self.roudi = self.procs.start([program, "roudi"], dict(os.environ),
+                                          os.path.join(work, "iceoryx-roudi.log"))
+            wait_for_line(self.roudi, "ready", 30, "RouDi")
+            self.echo = self.procs.start([program, "echo", "--bytes", self.bytes],
+                                         dict(os.environ), os.path.join(work, "iceoryx-echo.log"))
+            wait_for_line(self.echo, "ready", 30, "the iceoryx echo")
+        except BaseException:
+            self.procs.close()
+            raise
+        self.cpu_us = 0.0
+        self.round_trips = 0
+        self.resent = 0
+
+    def run(self, index):
+        output = os.path.join(self.work, f"iceoryx-rtt-{index}.bin")
+        echo_before = cpu_us(self.echo.pid)
+        ping = self.procs.start(
+            [self.program, "ping", "--bytes", self.bytes, "--count", str(self.count), "--warmup",
+             str(self.warmup), "--output", output], dict(os.environ),
+            os.path.join(self.work, f"iceoryx-ping-{index}.log"))
+        try:
+            out, _ = ping.communicate(timeout=60 + self.count * 0.01)
+        except subprocess.TimeoutExpired:
+            raise RuntimeError("rsca-bench-iceoryx ping did not finish") from None
+        if ping.returncode != 0:
+            raise RuntimeError(f"rsca-bench-iceoryx ping failed ({ping.returncode}); see "
+                               f"{self.work}")
+        summary_ = json.loads(out)
+        self.cpu_us += summary_["cpu_us"] + cpu_us(self.echo.pid) - echo_before
+        self.round_trips += summary_["completed"]
+        return read_u64(output)
+
+    def close(self):
+        self.procs.close()
+
+
+def wait_for_line(child, line, timeout, what):
+    """Waits until `child`'s stdout (its file) has `line`."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        try:
+            with open(child.stdout_path) as f:
+                if line in f.read().split():
+                    return
+        except FileNotFoundError:
+            pass
+        child.poll()
+        if child.returncode is not None:
+            raise RuntimeError(f"{what} ended ({child.returncode}) before it was ready")
+        time.sleep(0.05)
+    raise RuntimeError(f"{what} was not ready within {timeout} s")
 
 
 class LatencyRaw:
@@ -202,6 +275,7 @@ class LatencyRaw:
         self.procs.close()
 
 
-# The latency benchmark's sides: the rsca components, the raw programs with a waitset (the baseline
-# of the ratio lines), and the raw programs woken the way rsca's receive loop wakes.
-SIDES = ("rsca", "raw", "raw_listener")
+# The latency benchmark's sides: the rsca components on two nodes (over DDS) and on one (through
+# its shared memory), the raw programs with a waitset (the baseline of the ratio lines), the raw
+# programs woken the way rsca's receive loop wakes, and a raw iceoryx ping-pong.
+SIDES = ("rsca", "rsca_same_host", "raw", "raw_listener", "iceoryx")
