@@ -68,6 +68,9 @@ struct Context {
   std::string control_address;            // CONTROL_ADDRESS
   std::shared_ptr<spdlog::logger> logger; // named after the instance
   std::optional<Schedule> schedule;       // periodic components only
+  // A connection of it goes on DDS from its own process (RSCA_DDS): the process joins DDS as
+  // it starts. Else it joins at its first such connection, if any comes.
+  bool joins_dds = false;
 };
 
 namespace detail {

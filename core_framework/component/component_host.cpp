@@ -64,7 +64,8 @@ Context context_of(const ExecParams &p) {
                  p.profile,
                  p.control_address,
                  in_process_logger(p.name_binding),
-                 p.schedule};
+                 p.schedule,
+                 p.dds == protocol::kJoinDds};
 }
 
 // The host's one control presence, serving every component's address too: its link to the node

@@ -152,8 +152,9 @@ Expected<void> Host::open(std::shared_ptr<ParticipantSource> participants,
   }
   endpoint_ = std::move(endpoint);
   // A process with its host's arena connects to its host's processes through shared memory: it
-  // joins DDS only if a connection to another host asks for it, when it is made.
-  if (!c().ports_.empty() && shm::ProcessArena::inherited() == nullptr)
+  // joins DDS early only when the domain said a connection of it will go on DDS, else at the
+  // first such connection, if any comes.
+  if (!c().ports_.empty() && (shm::ProcessArena::inherited() == nullptr || c().context().joins_dds))
     participants_->join_in_background();
   serve_operations();
   // The domain calls next (initialize): the way back to it is made before it asks.

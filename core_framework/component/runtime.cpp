@@ -72,7 +72,8 @@ int run_host(const ExecParams &params, const ExitEvents &events, const Factory &
                   params.profile,
                   params.control_address,
                   logger,
-                  params.schedule};
+                  params.schedule,
+                  params.dds == protocol::kJoinDds};
   if (params.schedule)
     pin_to_cpu(params.schedule->cpu, *logger);
   std::unique_ptr<Component> component;

@@ -18,6 +18,7 @@ using profile::History;
 using profile::Liveliness;
 using profile::Ownership;
 using profile::Reliability;
+using profile::Transport;
 
 constexpr const char *kInfinite = "infinite";
 constexpr dds_duration_t kMaxBlockingTime = DDS_MSECS(100);
@@ -53,6 +54,7 @@ ConnectionQos with_defaults(ConnectionQos qos) {
   qos.lease = qos.lease.value_or(Duration{});
   qos.ownership = qos.ownership.value_or(Ownership::Shared);
   qos.strength = qos.strength.value_or(0);
+  qos.transport = qos.transport.value_or(Transport::Node);
   return qos;
 }
 
@@ -184,6 +186,7 @@ nlohmann::json qos_to_json(const ConnectionQos &given) {
       {"lease_ns", duration_json(*qos.lease)},
       {"ownership", profile::to_string(*qos.ownership)},
       {"strength", *qos.strength},
+      {"transport", profile::to_string(*qos.transport)},
   };
   if (qos.depth)
     json["depth"] = *qos.depth;

@@ -312,6 +312,8 @@ protocol::ExecParams ApplicationFactory::Launch::exec_params(const ComponentInst
     p.library = placement->implementation->code.file.name;
   if (const auto &s = placement->schedule)
     p.schedule = protocol::Schedule{s->cpu, s->priority, s->period, s->budget, s->deadline};
+  if (joins_dds(c))
+    p.dds = protocol::kJoinDds;
   p.others = execparams(c);
   return p;
 }

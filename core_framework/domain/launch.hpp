@@ -100,6 +100,8 @@ private:
   // library its host loads, as the SPD names it (the host resolves it, as a GPP resolves an
   // entry point).
   protocol::ExecParams exec_params(const ComponentInstance &c) const;
+  // Whether a SAD connection of `c` goes on DDS from its own process (launch_wiring.cpp).
+  bool joins_dds(const ComponentInstance &c) const;
 
   static bool is_hosted(const ComponentInstance &c) { return !c.host.empty(); }
 

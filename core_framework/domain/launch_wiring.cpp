@@ -202,3 +202,38 @@ std::string ApplicationFactory::Launch::repid_of(const profile::Connection &c) c
 }
 
 } // namespace rsca::domain
+
+namespace rsca::domain {
+
+// A connection of `c` to another node, to a device or an event channel, or one that asks for
+// direct DDS, goes on DDS from c's own process (docs/architecture.md, "Same-host data"): the
+// process then joins DDS as it starts, so that DDS discovery overlaps the launch's steps before
+// `connect` instead of adding to it. Connections to components of its own node need no DDS.
+bool ApplicationFactory::Launch::joins_dds(const ComponentInstance &c) const {
+  using Kind = profile::EndpointTarget::Kind;
+  for (const auto &conn : request_.profile->sad->connections) {
+    if (conn.provides.kind == profile::ProvidesEnd::Kind::SupportedInterface)
+      continue; // control calls: through the node
+    const auto &uses = conn.uses.target;
+    const auto &provides = conn.provides.target;
+    const bool provides_port = conn.provides.kind == profile::ProvidesEnd::Kind::Port;
+    const bool is_uses = uses.kind == Kind::ComponentInstantiation && uses.refid == c.id;
+    const bool is_provides =
+        provides_port && provides.kind == Kind::ComponentInstantiation && provides.refid == c.id;
+    if (!is_uses && !is_provides)
+      continue;
+    const auto &other = is_uses ? provides : uses;
+    const bool to_component =
+        (is_provides || provides_port) && other.kind == Kind::ComponentInstantiation;
+    const auto *peer = to_component ? component_of(other.refid) : nullptr;
+    if (peer == nullptr || (conn.qos && conn.qos->transport == profile::Transport::Direct))
+      return true;
+    if (!c.host.empty() && peer->host == c.host)
+      continue; // in-host
+    if (peer->node != c.node)
+      return true;
+  }
+  return false;
+}
+
+} // namespace rsca::domain

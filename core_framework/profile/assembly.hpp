@@ -105,12 +105,16 @@ enum class Durability : std::uint8_t { Volatile, TransientLocal, Transient, Pers
 enum class History : std::uint8_t { KeepLast, KeepAll };
 enum class Liveliness : std::uint8_t { Automatic, ManualByParticipant, ManualByTopic };
 enum class Ownership : std::uint8_t { Shared, Exclusive };
+// How a connection between processes travels: through their nodes (shared memory on one host),
+// or on DDS from the components' own participants (a high-rate stream between hosts).
+enum class Transport : std::uint8_t { Node, Direct };
 
 std::string_view to_string(Reliability v);
 std::string_view to_string(Durability v);
 std::string_view to_string(History v);
 std::string_view to_string(Liveliness v);
 std::string_view to_string(Ownership v);
+std::string_view to_string(Transport v);
 
 // RSCA extension: the QoS one connection asks for. Absent fields take the defaults documented in
 // docs/profiles.md.
@@ -126,6 +130,7 @@ struct ConnectionQos {
   std::optional<Duration> lease;
   std::optional<Ownership> ownership;
   std::optional<std::int32_t> strength;
+  std::optional<Transport> transport;
   SourceLocation where;
 };
 

@@ -84,6 +84,8 @@ FieldResult set_qos_attribute(ConnectionQos &qos, std::string_view name, std::st
     return set_enum(qos.ownership, text, std::array{Ownership::Shared, Ownership::Exclusive});
   if (name == "strength")
     return set_integer<std::int32_t>(qos.strength, text, kInt32Min);
+  if (name == "transport")
+    return set_enum(qos.transport, text, std::array{Transport::Node, Transport::Direct});
   return tl::unexpected(std::string("not a QoS attribute"));
 }
 

@@ -16,9 +16,9 @@
 namespace rsca::profile {
 
 // The attribute names, in the schema's order.
-inline constexpr std::array<std::string_view, 11> kQosAttributes{
+inline constexpr std::array<std::string_view, 12> kQosAttributes{
     "reliability",       "durability", "history", "depth",     "deadline", "latencybudget",
-    "transportpriority", "liveliness", "lease",   "ownership", "strength"};
+    "transportpriority", "liveliness", "lease",   "ownership", "strength", "transport"};
 
 bool is_qos_attribute(std::string_view name);
 

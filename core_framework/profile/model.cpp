@@ -225,6 +225,10 @@ std::string_view to_string(Liveliness v) {
   constexpr std::string_view names[] = {"automatic", "manualbyparticipant", "manualbytopic"};
   return names[static_cast<std::size_t>(v)];
 }
+std::string_view to_string(Transport v) {
+  return v == Transport::Direct ? "direct" : "node";
+}
+
 std::string_view to_string(Ownership v) {
   return v == Ownership::Exclusive ? "exclusive" : "shared";
 }

@@ -57,7 +57,7 @@ constexpr std::pair<std::string_view, std::string ExecParams::*> kNamed[] = {
     {kIdentifier, &ExecParams::identifier},    {"NAME_BINDING", &ExecParams::name_binding},
     {"PROFILE_NAME", &ExecParams::profile},    {"DOMAIN_NAME", &ExecParams::domain},
     {"APPLICATION", &ExecParams::application}, {kControlAddress, &ExecParams::control_address},
-    {"LIBRARY", &ExecParams::library},
+    {"LIBRARY", &ExecParams::library},         {"RSCA_DDS", &ExecParams::dds},
 };
 
 } // namespace

@@ -29,6 +29,10 @@ struct Schedule {
   std::chrono::nanoseconds deadline{0};
 };
 
+// RSCA_DDS's value when a connection of the component will go on DDS from its own process (not
+// through its node): the process joins DDS as it starts (component/participant_source.hpp).
+inline constexpr std::string_view kJoinDds = "join";
+
 struct ExecParams {
   std::string identifier;           // COMPONENT_IDENTIFIER (required)
   std::string name_binding;         // NAME_BINDING (the identifier when absent)
@@ -37,6 +41,7 @@ struct ExecParams {
   std::string application;          // APPLICATION
   std::string control_address;      // CONTROL_ADDRESS (required)
   std::string library;              // LIBRARY: a hosted component's, as its SPD names it
+  std::string dds;                  // RSCA_DDS: kJoinDds when a connection of its goes on DDS
   std::optional<Schedule> schedule; // RSCA_CPU, RSCA_PRIORITY, RSCA_PERIOD_NS, ... (admission)
   std::vector<std::pair<std::string, std::string>> others; // execparam properties and the rest
 };

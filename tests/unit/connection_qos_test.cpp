@@ -43,7 +43,8 @@ TEST_CASE("connection QoS: every SAD attribute, as text, means the same to rsca 
                     {"liveliness", "manualbyparticipant"},
                     {"lease", "1.5s"},
                     {"ownership", "exclusive"},
-                    {"strength", "7"}};
+                    {"strength", "7"},
+                    {"transport", "direct"}};
   REQUIRE(sad.size() == profile::kQosAttributes.size());
   ConnectionQos by_sad_parser;
   for (const auto &[name, text] : sad.items()) {
@@ -59,6 +60,7 @@ TEST_CASE("connection QoS: every SAD attribute, as text, means the same to rsca 
   CHECK(wire.at("transportpriority") == -2);
   CHECK(wire.at("depth") == 4);
   CHECK(wire.at("reliability") == "besteffort");
+  CHECK(wire.at("transport") == "direct");
 }
 
 TEST_CASE("connection QoS: the wire's form reads back as it was written", "[connection_qos]") {
@@ -73,6 +75,7 @@ TEST_CASE("connection QoS: values the SAD refuses are refused, quoting an excerp
         "\"deadline\" is 100, not a duration such as 100ms, 1.5s or infinite (units ns, us, ms, "
         "s; at most about 292 years)");
   CHECK(qos_error({{"depth", "0"}}) == "\"depth\" is \"0\", not an integer from 1 to 2147483647");
+  CHECK(qos_error({{"transport", "udp"}}) == "\"transport\" is \"udp\", not one of node, direct");
   CHECK(qos_error({{"depth", "4x"}}) == "\"depth\" is \"4x\", not an integer from 1 to 2147483647");
   CHECK(qos_error({{"deadline", "100ms"}, {"deadline_ns", 5}}) ==
         "give \"deadline\" or \"deadline_ns\", not both");

@@ -45,7 +45,8 @@ TEST_CASE("a connection without QoS gets the documented defaults", "[port_qos]")
                          {"liveliness", "automatic"},
                          {"lease_ns", "infinite"},
                          {"ownership", "shared"},
-                         {"strength", 0}};
+                         {"strength", 0},
+                         {"transport", "node"}};
   CHECK(dds::qos_to_json(ConnectionQos{}) == expected);
   auto parsed = dds::connection_qos_from_json(Json::object());
   REQUIRE(parsed.has_value());

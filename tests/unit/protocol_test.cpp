@@ -432,8 +432,10 @@ TEST_CASE("protocol: exec parameters are read back as they were made", "[protoco
   p.schedule = protocol::Schedule{1, 80, std::chrono::milliseconds(10),
                                   std::chrono::milliseconds(2), std::chrono::milliseconds(10)};
   p.others = {{"rate_hz", "20"}};
+  p.dds = protocol::kJoinDds;
   auto back = parse(protocol::to_args(p));
   REQUIRE(back.has_value());
+  CHECK(back->dds == protocol::kJoinDds);
   CHECK(back->identifier == p.identifier);
   CHECK(back->name_binding == p.name_binding);
   CHECK(back->control_address == p.control_address);

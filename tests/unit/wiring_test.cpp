@@ -136,6 +136,15 @@ TEST_CASE("wiring: two processes of one node take its shared memory, others DDS"
     CHECK_FALSE(r.shared_memory.has_value());
   for (const auto &r : wire("", "node1", "", "")) // a device of the node, or an unrelayed process
     CHECK_FALSE(r.shared_memory.has_value());
+  {
+    FakeComponents fake;
+    std::vector<WireEnd> made;
+    Wire direct = topic_wire(end_at("a", "out", "", "node1"), end_at("b", "in", "", "node1"));
+    direct.qos = Json{{"transport", "direct"}}; // asked for DDS from the processes
+    REQUIRE(Wiring(fake, std::chrono::milliseconds(100)).connect({direct}, made).has_value());
+    for (const auto &r : fake.requests<Connect>())
+      CHECK_FALSE(r.shared_memory.has_value());
+  }
   for (const auto &r : wire("host1", "node1", "host1", "node1")) { // one process: in-host
     CHECK(r.local == true);
     CHECK_FALSE(r.shared_memory.has_value());
