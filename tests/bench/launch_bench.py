@@ -141,6 +141,9 @@ def main():
     parser.add_argument("--bin", required=True)
     parser.add_argument("--out", required=True)
     parser.add_argument("--quick", action="store_true")
+    parser.add_argument("--only", default="",
+                        help="measure only these, e.g. 100p1,500p10 (components, p or h for "
+                             "processes or hosted, nodes)")
     args = parser.parse_args()
     # (components, hosted, nodes): processes on one node connect through its shared memory; on
     # ten, a chain spread over them crosses nodes at every link.
@@ -152,8 +155,11 @@ def main():
     # A domain of its own for each configuration: one whose launches overload the host (its
     # nodes miss their leases) leaves the next one untouched.
     with tempfile.TemporaryDirectory(prefix="rsca-gen-") as sdr:
+        only = [o for o in args.only.split(",") if o]
         for n, hosted, nodes in configs:
             kind = "hosted components" if hosted else "processes"
+            if only and f"{n}{'h' if hosted else 'p'}{nodes}" not in only:
+                continue
             if args.quick and n >= 100 and not hosted and nodes > 1:
                 # Processes over DDS between nodes take long on this machine (docs/measurements.md),
                 # too long for --quick; the DDS baseline below still runs.
