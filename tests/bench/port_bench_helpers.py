@@ -189,25 +189,33 @@ class LatencyIceoryx:
 
     def run(self, index):
         output = os.path.join(self.work, f"iceoryx-rtt-{index}.bin")
-        echo_before = cpu_us(self.echo.pid)
-        ping = self.procs.start(
-            [self.program, "ping", "--bytes", self.bytes, "--count", str(self.count), "--warmup",
-             str(self.warmup), "--output", output], dict(os.environ),
-            os.path.join(self.work, f"iceoryx-ping-{index}.log"))
-        try:
-            out, _ = ping.communicate(timeout=60 + self.count * 0.01)
-        except subprocess.TimeoutExpired:
-            raise RuntimeError("rsca-bench-iceoryx ping did not finish") from None
-        if ping.returncode != 0:
-            raise RuntimeError(f"rsca-bench-iceoryx ping failed ({ping.returncode}); see "
-                               f"{self.work}")
-        summary_ = json.loads(out)
-        self.cpu_us += summary_["cpu_us"] + cpu_us(self.echo.pid) - echo_before
-        self.round_trips += summary_["completed"]
-        return read_u64(output)
+        return run_ping(self, [self.program, "ping", "--bytes", self.bytes, "--count",
+                               str(self.count), "--warmup", str(self.warmup), "--output", output],
+                        dict(os.environ), f"iceoryx-ping-{index}.log", output)
 
     def close(self):
         self.procs.close()
+
+
+def run_ping(side, args, env, log_name, output):
+    """Runs one round's ping of a raw side (`side` has procs, echo, work, count and the totals) to
+    its end; adds its CPU (and the echo's meanwhile) and round trips to the side's totals; the
+    round-trip times it wrote."""
+    echo_before = cpu_us(side.echo.pid)
+    ping = side.procs.start(args, env, os.path.join(side.work, log_name))
+    name = os.path.basename(args[0])
+    try:
+        out, _ = ping.communicate(timeout=60 + side.count * 0.01)
+    except subprocess.TimeoutExpired:
+        raise RuntimeError(f"{name} ping did not finish") from None
+    if ping.returncode != 0:
+        raise RuntimeError(f"{name} ping failed ({ping.returncode}); see {side.work}")
+    summary_ = json.loads(out)
+    # The echo's CPU over the ping's whole life (its start-up included: the echo idles then).
+    side.cpu_us += summary_["cpu_us"] + cpu_us(side.echo.pid) - echo_before
+    side.round_trips += summary_["completed"]
+    side.resent += summary_["resent"]
+    return read_u64(output)
 
 
 def wait_for_line(child, line, timeout, what):
@@ -252,24 +260,10 @@ class LatencyRaw:
 
     def run(self, index):
         output = os.path.join(self.work, f"raw-{self.wake}-rtt-{index}.bin")
-        echo_before = cpu_us(self.echo.pid)
-        ping = self.procs.start(
-            [self.raw, "ping", "--out", self.ping_topic, "--in", self.echo_topic, "--qos",
-             self.qos, "--wake", self.wake, "--count", str(self.count), "--warmup",
-             str(self.warmup), "--output", output], self.domain.env,
-            os.path.join(self.work, f"raw-{self.wake}-ping-{index}.log"))
-        try:
-            out, _ = ping.communicate(timeout=60 + self.count * 0.01)
-        except subprocess.TimeoutExpired:
-            raise RuntimeError("rsca-bench-raw ping did not finish") from None
-        if ping.returncode != 0:
-            raise RuntimeError(f"rsca-bench-raw ping failed ({ping.returncode}); see {self.work}")
-        summary_ = json.loads(out)
-        # The echo's CPU over the ping's whole life (its start-up included: the echo idles then).
-        self.cpu_us += summary_["cpu_us"] + cpu_us(self.echo.pid) - echo_before
-        self.round_trips += summary_["completed"]
-        self.resent += summary_["resent"]
-        return read_u64(output)
+        return run_ping(self, [self.raw, "ping", "--out", self.ping_topic, "--in",
+                               self.echo_topic, "--qos", self.qos, "--wake", self.wake, "--count",
+                               str(self.count), "--warmup", str(self.warmup), "--output", output],
+                        self.domain.env, f"raw-{self.wake}-ping-{index}.log", output)
 
     def close(self):
         self.procs.close()

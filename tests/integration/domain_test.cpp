@@ -271,13 +271,21 @@ TEST_CASE("a writer that stops asserting its liveliness is reported as a domain 
           "[integration][domain][events]") {
   // The connection asks the producer's writer to be alive every 300 ms. A frozen process (here
   // SIGSTOP; in life a hung one) has not exited, so only the connection's liveliness tells.
+  // Both components on one node (the node's ring: the writer's process asserts it) or on two
+  // (DDS: its participant does).
+  const std::string strategy = GENERATE(as<std::string>{}, "pack", "spread");
+  INFO("placement " << strategy);
   TestDomain domain;
   domain.install("Lively");
-  auto [rc, out] = domain.cli({"launch", "Lively"});
+  auto [rc, out] = domain.cli({"launch", "Lively", "--strategy", strategy});
   INFO(out);
   REQUIRE(rc == 0);
   auto app = domain.call("app.show", Json{{"app", "Lively"}});
   REQUIRE(app.has_value());
+  auto listed = domain.call("connection.list", Json{{"app", "Lively"}});
+  REQUIRE(listed.has_value());
+  CHECK(listed->at("connections").at(0).at("provides_state").value("same_host", false) ==
+        (strategy == "pack"));
   long producer = 0;
   for (const auto &c : app->at("components"))
     if (c.at("id") == "Producer_1")

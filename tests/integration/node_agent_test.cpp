@@ -115,3 +115,32 @@ TEST_CASE("two component processes of one node connect through its shared memory
   REQUIRE(domain.call("app.release", Json{{"app", "ProducerConsumer"}}).has_value());
   domain.require_clean(pids); // with the node's shared memory empty again
 }
+
+TEST_CASE("a connection that asks for direct DDS takes it on one node too",
+          "[integration][node-agent]") {
+  TestDomain domain(1);
+  domain.install("DirectPair");
+  auto [rc, out] = domain.cli({"launch", "DirectPair"});
+  INFO(out);
+  REQUIRE(rc == 0);
+  auto app = domain.call("app.show", Json{{"app", "DirectPair"}});
+  REQUIRE(app.has_value());
+  const auto pids = pids_of(*app);
+  Json samples;
+  REQUIRE(TestDomain::wait_for([&] {
+    auto list = domain.call("connection.list", Json{{"app", "DirectPair"}});
+    REQUIRE(list.has_value());
+    samples = list->at("connections").at(0);
+    return samples.at("provides_state").value("samples", 0) > 3;
+  }));
+  INFO(samples.dump());
+  CHECK_FALSE(samples.at("uses_state").value("same_host", true));
+  CHECK_FALSE(samples.at("provides_state").value("same_host", true));
+  for (long pid : pids)
+    CHECK(udp_sockets_of(pid) > 0); // each its own participant
+  auto status = domain.call_node(1, "node.status");
+  REQUIRE(status.has_value());
+  CHECK(status->at("shared_memory").at("rings") == 0);
+  REQUIRE(domain.call("app.release", Json{{"app", "DirectPair"}}).has_value());
+  domain.require_clean(pids);
+}
