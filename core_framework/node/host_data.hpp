@@ -32,7 +32,9 @@ class HostData {
 public:
   // 1 GiB of address space; memory is taken only as rings and pages are used.
   static constexpr std::size_t kArenaBytes = std::size_t{1} << 30;
-  static constexpr std::size_t kPageBytes = 64 * 1024; // a process's doorbells: 1024
+  // A process's doorbells, one per component receive thread: 4096 (a component host of
+  // thousands of components). Memory is taken only as they are used.
+  static constexpr std::size_t kPageBytes = 256 * 1024;
 
   static Expected<std::unique_ptr<HostData>> create(std::size_t bytes = kArenaBytes);
 
