@@ -55,6 +55,18 @@ const Json &component_named(const Json &app, const std::string &id) {
   throw std::logic_error("unreachable");
 }
 
+// The first connection of `app` as connection.list shows it, once samples flow over it.
+Json flowing_connection(TestDomain &domain, const std::string &app) {
+  Json connection;
+  REQUIRE(TestDomain::wait_for([&] {
+    auto list = domain.call("connection.list", Json{{"app", app}});
+    REQUIRE(list.has_value());
+    connection = list->at("connections").at(0);
+    return connection.at("provides_state").value("samples", 0) > 3;
+  }));
+  return connection;
+}
+
 } // namespace
 
 TEST_CASE("a component process with no data ports has no UDP socket: its node serves its control",
@@ -93,13 +105,7 @@ TEST_CASE("two component processes of one node connect through its shared memory
   const auto pids = pids_of(*app);
   REQUIRE(pids.size() == 2);
   // Samples flow, end to end, over the node's ring.
-  Json samples;
-  REQUIRE(TestDomain::wait_for([&] {
-    auto list = domain.call("connection.list", Json{{"app", "ProducerConsumer"}});
-    REQUIRE(list.has_value());
-    samples = list->at("connections").at(0);
-    return samples.at("provides_state").value("samples", 0) > 3;
-  }));
+  const Json samples = flowing_connection(domain, "ProducerConsumer");
   INFO(samples.dump());
   CHECK(samples.at("uses_state").value("same_host", false));
   CHECK(samples.at("provides_state").value("same_host", false));
@@ -126,13 +132,7 @@ TEST_CASE("a connection that asks for direct DDS takes it on one node too",
   auto app = domain.call("app.show", Json{{"app", "DirectPair"}});
   REQUIRE(app.has_value());
   const auto pids = pids_of(*app);
-  Json samples;
-  REQUIRE(TestDomain::wait_for([&] {
-    auto list = domain.call("connection.list", Json{{"app", "DirectPair"}});
-    REQUIRE(list.has_value());
-    samples = list->at("connections").at(0);
-    return samples.at("provides_state").value("samples", 0) > 3;
-  }));
+  const Json samples = flowing_connection(domain, "DirectPair");
   INFO(samples.dump());
   CHECK_FALSE(samples.at("uses_state").value("same_host", true));
   CHECK_FALSE(samples.at("provides_state").value("same_host", true));
