@@ -262,6 +262,10 @@ Expected<void> PortBase::connect(dds_entity_t participant, detail::ReceiveLoop *
       return tl::unexpected(opened.error());
     std::unique_lock lock(mutex_);
     connections_[connection] = std::move(*opened);
+    lock.unlock();
+    // What arrived before the reader's doorbell was rung for it is looked for now.
+    if (ring && loop != nullptr && direction_ == profile::PortDirection::Provides)
+      loop->wake_in_host();
     return {};
   }
   auto created = dds::checked(

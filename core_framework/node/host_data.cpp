@@ -1,6 +1,9 @@
 #include "node/host_data.hpp"
 
+#include <cerrno>
+
 #include <fmt/format.h>
+#include <signal.h>
 #include <spdlog/spdlog.h>
 
 #include "protocol/codec.hpp"
@@ -8,7 +11,7 @@
 
 namespace rsca::node {
 
-namespace op = protocol::component;
+namespace component_op = protocol::component;
 
 HostData::HostData(shm::Arena arena) : arena_(std::move(arena)), allocator_(arena_.size()) {}
 
@@ -30,6 +33,14 @@ std::optional<std::pair<std::uint64_t, std::string>> HostData::reserve_page() {
 
 void HostData::adopt(pid_t pid, std::uint64_t page) {
   std::lock_guard lock(mutex_);
+  // A process that died before it was adopted has been forgotten already: its page goes now.
+  // (Its zombie still answers kill 0 until reaped; a reaped one does not.)
+  if (::kill(pid, 0) != 0 && errno == ESRCH) {
+    allocator_.release(page);
+    return;
+  }
+  if (auto old = pages_.find(pid); old != pages_.end()) // a pid used again
+    allocator_.release(old->second);
   pages_[pid] = page;
 }
 
@@ -57,16 +68,15 @@ tl::expected<HostData::Ring *, std::string> HostData::ring_of_locked(const std::
 
 tl::expected<nlohmann::json, std::string> HostData::connect(pid_t pid, const std::string &target,
                                                             const nlohmann::json &request) {
-  auto r = protocol::decode<op::ConnectRequest>(request);
+  auto r = protocol::decode<component_op::ConnectRequest>(request);
   if (!r || !r->shared_memory.value_or(false))
     return request; // not ours to change: the process answers what is wrong with it
   if (!r->topic || r->topic->empty())
     return tl::unexpected(std::string("a same-host connection needs its topic"));
   const bool writer = r->direction == "uses";
+  const EndKey key{pid, target, r->port, r->connection};
   std::lock_guard lock(mutex_);
-  // A connection made again replaces the one of that id: its end goes first.
-  if (auto old = ends_.find({pid, target, r->port, r->connection}); old != ends_.end())
-    release_end_locked(old, /*lost=*/false);
+  release_locked(pending_, key, /*lost=*/false); // an earlier connect of it never answered
   auto ring = ring_of_locked(*r->topic);
   if (!ring)
     return tl::unexpected(ring.error());
@@ -75,46 +85,80 @@ tl::expected<nlohmann::json, std::string> HostData::connect(pid_t pid, const std
     (*ring)->owner.add_writer();
   } else {
     auto slot = (*ring)->owner.claim_reader();
-    if (!slot)
+    if (!slot) {
+      if ((*ring)->ends == 0)
+        free_ring_locked(*r->topic);
       return tl::unexpected(fmt::format("topic {} has {} same-host readers, the most a ring has",
                                         *r->topic, shm::kMaxRingReaders));
+    }
     end.slot = *slot;
   }
   ++(*ring)->ends;
-  ends_[{pid, target, r->port, r->connection}] = end;
+  pending_[key] = end;
   nlohmann::json relayed = request;
-  relayed["ring"] = protocol::encode_message(op::Ring{(*ring)->offset, end.slot});
+  relayed["ring"] = protocol::encode_message(component_op::Ring{(*ring)->offset, end.slot});
   return relayed;
 }
 
-void HostData::release_end_locked(std::map<EndKey, End>::iterator end, bool lost) {
-  auto ring = rings_.find(end->second.topic);
-  if (ring != rings_.end()) {
-    if (end->second.writer)
-      ring->second.owner.remove_writer(lost);
-    else
-      ring->second.owner.release_reader(end->second.slot);
-    if (--ring->second.ends == 0) {
-      allocator_.release(ring->second.offset);
-      spdlog::debug("host data: the ring of topic {} is freed", ring->first);
-      rings_.erase(ring);
-    }
+void HostData::connected(pid_t pid, const std::string &target, const std::string &port,
+                         const std::string &connection, bool made) {
+  const EndKey key{pid, target, port, connection};
+  std::lock_guard lock(mutex_);
+  auto pending = pending_.find(key);
+  if (!made) {
+    release_locked(pending_, key, /*lost=*/false);
+    return;
   }
-  ends_.erase(end);
+  release_locked(ends_, key, /*lost=*/false); // the one it replaced, if any
+  if (pending == pending_.end())
+    return;
+  ends_[key] = pending->second;
+  pending_.erase(pending);
+}
+
+void HostData::free_ring_locked(const std::string &topic) {
+  auto ring = rings_.find(topic);
+  if (ring == rings_.end())
+    return;
+  allocator_.release(ring->second.offset);
+  spdlog::debug("host data: the ring of topic {} is freed", topic);
+  rings_.erase(ring);
+}
+
+void HostData::release_locked(const End &end, bool lost) {
+  auto ring = rings_.find(end.topic);
+  if (ring == rings_.end())
+    return;
+  if (end.writer)
+    ring->second.owner.remove_writer(lost);
+  else
+    ring->second.owner.release_reader(end.slot);
+  if (--ring->second.ends == 0)
+    free_ring_locked(end.topic);
+}
+
+void HostData::release_locked(std::map<EndKey, End> &ends, const EndKey &key, bool lost) {
+  auto end = ends.find(key);
+  if (end == ends.end())
+    return;
+  release_locked(end->second, lost);
+  ends.erase(end);
 }
 
 void HostData::disconnect(pid_t pid, const std::string &target, const std::string &port,
                           const std::string &connection) {
   std::lock_guard lock(mutex_);
-  if (auto end = ends_.find({pid, target, port, connection}); end != ends_.end())
-    release_end_locked(end, /*lost=*/false);
+  release_locked(ends_, {pid, target, port, connection}, /*lost=*/false);
 }
 
 void HostData::forget(pid_t pid) {
   std::lock_guard lock(mutex_);
-  for (auto it = ends_.lower_bound({pid, "", "", ""});
-       it != ends_.end() && std::get<0>(it->first) == pid;)
-    release_end_locked(it++, /*lost=*/true);
+  for (auto *ends : {&ends_, &pending_})
+    for (auto it = ends->lower_bound({pid, "", "", ""});
+         it != ends->end() && std::get<0>(it->first) == pid;) {
+      release_locked(it->second, /*lost=*/true);
+      it = ends->erase(it);
+    }
   if (auto page = pages_.find(pid); page != pages_.end()) {
     allocator_.release(page->second);
     pages_.erase(page);
@@ -123,7 +167,7 @@ void HostData::forget(pid_t pid) {
 
 HostData::Counts HostData::counts() const {
   std::lock_guard lock(mutex_);
-  return {rings_.size(), ends_.size(), pages_.size(), allocator_.in_use()};
+  return {rings_.size(), ends_.size() + pending_.size(), pages_.size(), allocator_.in_use()};
 }
 
 } // namespace rsca::node

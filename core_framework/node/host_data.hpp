@@ -46,11 +46,17 @@ public:
   void release_page(std::uint64_t page);
 
   // A relayed component.connect to `target` (served by process `pid`): when it asks for shared
-  // memory, the topic's ring, made or found, with this end counted, and the request to hand on
-  // (with `ring`); else the request as it is. An error says why the node cannot.
+  // memory, the topic's ring, made or found, with a new end counted (pending until connected()),
+  // and the request to hand on (with `ring`); else the request as it is. An error says why the
+  // node cannot.
   tl::expected<nlohmann::json, std::string> connect(pid_t pid, const std::string &target,
                                                     const nlohmann::json &request);
-  // The end goes: disconnected, or its connect failed. Nothing if it has none.
+  // The process answered that connect. Made: the end it replaced (a connection made again under
+  // its id) goes, now that the process has let go of it, and the new one is kept. Not made: the
+  // new one goes, and the process keeps the one it had.
+  void connected(pid_t pid, const std::string &target, const std::string &port,
+                 const std::string &connection, bool made);
+  // The end goes: disconnected. Nothing if it has none.
   void disconnect(pid_t pid, const std::string &target, const std::string &port,
                   const std::string &connection);
   // The process ended: its page and its ends go.
@@ -80,13 +86,17 @@ private:
 
   explicit HostData(shm::Arena arena);
   tl::expected<Ring *, std::string> ring_of_locked(const std::string &topic);
-  void release_end_locked(std::map<EndKey, End>::iterator end, bool lost);
+  void release_locked(const End &end, bool lost);
+  void free_ring_locked(const std::string &topic);
+  // Takes the end of `key` out of `ends` and releases it; nothing if there is none.
+  void release_locked(std::map<EndKey, End> &ends, const EndKey &key, bool lost);
 
   shm::Arena arena_;
   mutable std::mutex mutex_; // guards what follows
   shm::ArenaAllocator allocator_;
   std::map<std::string, Ring> rings_; // by topic
-  std::map<EndKey, End> ends_;
+  std::map<EndKey, End> ends_;        // connected
+  std::map<EndKey, End> pending_;     // relayed, not answered yet
   std::map<pid_t, std::uint64_t> pages_;
 };
 

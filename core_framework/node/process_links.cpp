@@ -157,9 +157,12 @@ CallResult<Json> ProcessLinks::Impl::prepare(pid_t pid, const Json &body,
     return body;
   const std::string port = body.value("port", std::string());
   const std::string connection = body.value("connection", std::string());
-  // The end goes once the process has let go of it (a disconnect), or if it never took it.
+  // An end goes once the process has let go of it: the one a connect replaced, a new one the
+  // process refused, a disconnected one.
   after = [data = host_data, pid, target = context.target, port, connection, connect](bool ok) {
-    if (!connect || !ok)
+    if (connect)
+      data->connected(pid, target, port, connection, ok);
+    else
       data->disconnect(pid, target, port, connection);
   };
   if (!connect)
@@ -385,6 +388,10 @@ void ProcessLinks::attach(pid_t pid, process::Fd link, std::vector<std::string> 
 }
 
 void ProcessLinks::detach(pid_t pid) {
+  // Whatever the host's data holds for the process goes, also when it died before it was
+  // attached.
+  if (impl_->host_data != nullptr)
+    impl_->host_data->forget(pid);
   std::shared_ptr<LinkedProcess> process;
   {
     std::lock_guard lock(impl_->mutex);
@@ -403,8 +410,6 @@ void ProcessLinks::detach(pid_t pid) {
       impl_->by_address.erase(a);
     impl_->end(*process, "the process has exited");
   }
-  if (impl_->host_data != nullptr)
-    impl_->host_data->forget(pid);
   // Not waited for: detach runs on the GPP's reaper thread, which a handler of the same batch
   // (a node.terminate) may be waiting on; the relays under way have failed already.
   for (const auto &a : process->addresses)

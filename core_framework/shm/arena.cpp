@@ -71,9 +71,11 @@ std::byte *Arena::at(std::uint64_t offset, std::size_t bytes) const {
   return base_ + offset;
 }
 
+// The first line is never given out: offset 0 means "none" where an offset is stored in the
+// arena (a released reader slot's doorbell).
 ArenaAllocator::ArenaAllocator(std::size_t bytes) {
-  if (bytes >= kAlign)
-    free_[0] = bytes / kAlign * kAlign;
+  if (bytes >= 2 * kAlign)
+    free_[kAlign] = bytes / kAlign * kAlign - kAlign;
 }
 
 std::optional<std::uint64_t> ArenaAllocator::allocate(std::size_t bytes) {

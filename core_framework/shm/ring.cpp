@@ -60,7 +60,7 @@ tl::expected<RingView, std::string> RingView::open(const Arena &arena, std::uint
   if (whole == nullptr)
     return tl::unexpected(fmt::format("the ring at offset {} overruns the host's arena", offset));
   return RingView{header, reinterpret_cast<RecordEntry *>(whole + entries_offset()),
-                  whole + data_offset(header->records)};
+                  whole + data_offset(header->records), header->data_bytes, header->records};
 }
 
 tl::expected<RingOwner, std::string> RingOwner::create(const Arena &arena, std::uint64_t offset,
@@ -134,7 +134,7 @@ tl::expected<RingWriter, std::string> RingWriter::open(const Arena &arena, std::
 
 tl::expected<std::byte *, std::string> RingWriter::reserve(std::size_t bytes) {
   auto &h = *view_.header;
-  const std::uint64_t capacity = h.data_bytes;
+  const std::uint64_t capacity = view_.data_bytes;
   if (bytes > capacity / 2)
     return tl::unexpected(
         fmt::format("a sample of {} bytes does not fit a ring of {} bytes", bytes, capacity));
@@ -148,7 +148,7 @@ tl::expected<std::byte *, std::string> RingWriter::reserve(std::size_t bytes) {
   std::uint64_t oldest = h.oldest.load(std::memory_order_relaxed);
   while (oldest < seq &&
          (view_.entry(oldest).pos.load(std::memory_order_relaxed) + capacity < pos + bytes ||
-          seq - oldest >= h.records))
+          seq - oldest >= view_.records))
     ++oldest;
   h.oldest.store(oldest, std::memory_order_relaxed);
   std::atomic_thread_fence(std::memory_order_release);
@@ -171,6 +171,9 @@ void RingWriter::publish() {
   h.head.store(pos_ + bytes_, std::memory_order_relaxed);
   h.next_seq.store(seq_ + 1, std::memory_order_release);
   pthread_mutex_unlock(&h.write_lock);
+  // Against a reader that becomes active meanwhile (RingReader::open): either it sees this
+  // record's sequence number, or this writer sees it active and rings it.
+  std::atomic_thread_fence(std::memory_order_seq_cst);
   assert_alive(); // a write is a sign of life, as in DDS
   ring_readers();
 }
@@ -182,7 +185,10 @@ void RingWriter::ring_readers() const {
     const auto &slot = h.slots[i];
     if (slot.state.load(std::memory_order_acquire) != detail::kSlotActive)
       continue;
-    if (auto *bell = arena_->object<Doorbell>(slot.doorbell.load(std::memory_order_relaxed)))
+    const std::uint64_t at = slot.doorbell.load(std::memory_order_relaxed);
+    if (at == 0) // released meanwhile (the arena's first bytes are never given out)
+      continue;
+    if (auto *bell = arena_->object<Doorbell>(at))
       ring(*bell, kWakeNearData, /*shared=*/true);
   }
 }
@@ -201,9 +207,11 @@ tl::expected<RingReader, std::string> RingReader::open(const Arena &arena, std::
   if (s.state.load() != detail::kSlotClaimed)
     return tl::unexpected(fmt::format("reader slot {} was not claimed for this reader", slot));
   RingReader reader(*view, slot, depth);
-  reader.cursor_ = view->header->next_seq.load(std::memory_order_acquire);
   s.doorbell.store(doorbell, std::memory_order_relaxed);
-  s.state.store(detail::kSlotActive, std::memory_order_release);
+  s.state.store(detail::kSlotActive, std::memory_order_seq_cst);
+  // After the slot is active (publish() says why the order matters): what is published from
+  // here on either is read from this cursor or rings the doorbell.
+  reader.cursor_ = view->header->next_seq.load(std::memory_order_seq_cst);
   return reader;
 }
 

@@ -67,12 +67,16 @@ struct RingHeader {
 };
 
 // The parts of a ring, found and checked in an arena.
+// Its geometry is copied when it is checked: what another process writes into the header later
+// cannot move a reader or writer outside the ring.
 struct RingView {
   RingHeader *header = nullptr;
   RecordEntry *entries = nullptr;
   std::byte *data = nullptr;
+  std::uint32_t data_bytes = 0;
+  std::uint32_t records = 0;
   static tl::expected<RingView, std::string> open(const Arena &arena, std::uint64_t offset);
-  RecordEntry &entry(std::uint64_t seq) const { return entries[seq & (header->records - 1)]; }
+  RecordEntry &entry(std::uint64_t seq) const { return entries[seq & (records - 1)]; }
 };
 
 } // namespace detail
@@ -174,7 +178,7 @@ private:
 template <typename Decode, typename Deliver>
 std::size_t RingReader::take(Decode &&decode, Deliver &&deliver) {
   const std::uint64_t end = skip_lost();
-  const std::uint32_t capacity = view_.header->data_bytes;
+  const std::uint32_t capacity = view_.data_bytes;
   std::size_t delivered = 0;
   for (; cursor_ < end; ++cursor_) {
     auto &entry = view_.entry(cursor_);

@@ -3,6 +3,9 @@
 // go, and a process's end let go when it ends.
 #include <catch2/catch.hpp>
 
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include "node/host_data.hpp"
 #include "protocol/codec.hpp"
 #include "protocol/component_ops.hpp"
@@ -30,14 +33,26 @@ TEST_CASE("host data: two ends of a topic share one ring; it goes with its last 
   auto data = node::HostData::create(64 << 20).value();
   const auto writer = data->connect(100, "a", same_host_connect("uses", "out"));
   REQUIRE(writer.has_value());
+  data->connected(100, "a", "out", "c1", true);
   const auto reader = data->connect(200, "b", same_host_connect("provides", "in"));
   REQUIRE(reader.has_value());
+  data->connected(200, "b", "in", "c1", true);
   CHECK(ring_in(*writer).offset == ring_in(*reader).offset);
   CHECK(data->counts().rings == 1);
   CHECK(data->counts().ends == 2);
-  // Made again, the writer's end replaces its old one.
-  REQUIRE(data->connect(100, "a", same_host_connect("uses", "out")).has_value());
+  // Made again, the reader gets a slot of its own while the process still reads on the old one;
+  // the old one goes once the process says it made the new connection.
+  const auto again = data->connect(200, "b", same_host_connect("provides", "in"));
+  REQUIRE(again.has_value());
+  CHECK(ring_in(*again).slot != ring_in(*reader).slot);
+  CHECK(data->counts().ends == 3);
+  data->connected(200, "b", "in", "c1", true);
   CHECK(data->counts().ends == 2);
+  // Refused by the process, a connect made again leaves the end it had.
+  REQUIRE(data->connect(100, "a", same_host_connect("uses", "out")).has_value());
+  data->connected(100, "a", "out", "c1", false);
+  CHECK(data->counts().ends == 2);
+  CHECK(data->counts().rings == 1);
   data->disconnect(100, "a", "out", "c1");
   CHECK(data->counts().rings == 1);
   data->disconnect(200, "b", "in", "c1");
@@ -67,12 +82,13 @@ TEST_CASE("host data: a process that ends lets go of its page and its ends; its 
   auto page = data->reserve_page();
   REQUIRE(page.has_value());
   CHECK(page->second.starts_with("4:"));
-  data->adopt(100, page->first);
+  data->adopt(::getpid(), page->first); // a live process
   CHECK(data->counts().pages == 1);
-  REQUIRE(data->connect(100, "a", same_host_connect("uses", "out")).has_value());
+  REQUIRE(data->connect(::getpid(), "a", same_host_connect("uses", "out")).has_value());
+  data->connected(::getpid(), "a", "out", "c1", true);
   const auto reader = data->connect(200, "b", same_host_connect("provides", "in"));
   REQUIRE(reader.has_value());
-  data->forget(100);
+  data->forget(::getpid());
   CHECK(data->counts().pages == 0);
   CHECK(data->counts().ends == 1);
   // The reader's view of the ring: no writer left, one lost.
@@ -80,7 +96,22 @@ TEST_CASE("host data: a process that ends lets go of its page and its ends; its 
   auto ring = shm::detail::RingView::open(mapped, ring_in(*reader).offset).value();
   CHECK(ring.header->writers.load() == 0);
   CHECK(ring.header->writers_lost.load() == 1);
-  data->forget(200);
+  data->forget(200); // its end still pending: it goes too
   CHECK(data->counts().rings == 0);
+  CHECK(data->counts().bytes_in_use == 0);
+}
+
+TEST_CASE("host data: the page of a process that died before it was adopted is not kept",
+          "[host-data]") {
+  auto data = node::HostData::create(64 << 20).value();
+  const pid_t child = ::fork();
+  REQUIRE(child >= 0);
+  if (child == 0)
+    ::_exit(0);
+  REQUIRE(::waitpid(child, nullptr, 0) == child); // reaped: gone
+  auto page = data->reserve_page();
+  REQUIRE(page.has_value());
+  data->adopt(child, page->first);
+  CHECK(data->counts().pages == 0);
   CHECK(data->counts().bytes_in_use == 0);
 }
