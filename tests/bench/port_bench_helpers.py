@@ -164,37 +164,51 @@ class LatencyRsca:
         self.domain.cli("release", self.name, check=False)
 
 
-class LatencyIceoryx:
+class RawPingSide:
+    """What the raw sides share: their processes in one session (as a node's components share
+    the node's), started by `start` (all stopped if one fails), and the totals run_ping adds to."""
+
+    def __init__(self, work, count, warmup):
+        self.work, self.count, self.warmup = work, count, warmup
+        self.procs = Processes(shared_session=True)
+        self.cpu_us = 0.0
+        self.round_trips = 0
+        self.resent = 0
+
+    def start(self, starts):
+        try:
+            starts()
+        except BaseException:
+            self.procs.close()
+            raise
+
+    def close(self):
+        self.procs.close()
+
+
+class LatencyIceoryx(RawPingSide):
     """The raw iceoryx ping-pong (tests/bench/raw/raw_iceoryx.cpp): RouDi and the echo for the
     whole run, in one session as a node's processes are; each round runs a ping to its end. The
     payload is the size of the ping's SampleSeq on DDS."""
 
     def __init__(self, program, work, count, warmup, payload_bytes):
-        self.program, self.work, self.count, self.warmup = program, work, count, warmup
-        self.bytes = str(payload_bytes)
-        self.procs = Processes(shared_session=True)
-        try:
-            self.roudi = self.procs.start([program, "roudi"], dict(os.environ),
-                                          os.path.join(work, "iceoryx-roudi.log"))
-            wait_for_line(self.roudi, "ready", 30, "RouDi")
-            self.echo = self.procs.start([program, "echo", "--bytes", self.bytes],
-                                         dict(os.environ), os.path.join(work, "iceoryx-echo.log"))
-            wait_for_line(self.echo, "ready", 30, "the iceoryx echo")
-        except BaseException:
-            self.procs.close()
-            raise
-        self.cpu_us = 0.0
-        self.round_trips = 0
-        self.resent = 0
+        super().__init__(work, count, warmup)
+        self.program, self.bytes = program, str(payload_bytes)
+        self.start(self._start_roudi_and_echo)
+
+    def _start_roudi_and_echo(self):
+        roudi = self.procs.start([self.program, "roudi"], dict(os.environ),
+                                 os.path.join(self.work, "iceoryx-roudi.log"))
+        wait_for_line(roudi, "ready", 30, "RouDi")
+        self.echo = self.procs.start([self.program, "echo", "--bytes", self.bytes],
+                                     dict(os.environ), os.path.join(self.work, "iceoryx-echo.log"))
+        wait_for_line(self.echo, "ready", 30, "the iceoryx echo")
 
     def run(self, index):
         output = os.path.join(self.work, f"iceoryx-rtt-{index}.bin")
         return run_ping(self, [self.program, "ping", "--bytes", self.bytes, "--count",
                                str(self.count), "--warmup", str(self.warmup), "--output", output],
                         dict(os.environ), f"iceoryx-ping-{index}.log", output)
-
-    def close(self):
-        self.procs.close()
 
 
 def run_ping(side, args, env, log_name, output):
@@ -235,28 +249,24 @@ def wait_for_line(child, line, timeout, what):
     raise RuntimeError(f"{what} was not ready within {timeout} s")
 
 
-class LatencyRaw:
+class LatencyRaw(RawPingSide):
     """`rsca-bench-raw echo` for the whole run; each round runs `rsca-bench-raw ping` to its end.
     The two share a session of their own, as BenchPing_1 and BenchEcho_1 share the session of the
     node that started them (local_domain.Processes says why that matters)."""
 
     def __init__(self, domain, raw, work, qos, count, warmup, wake):
-        self.domain, self.raw, self.work, self.count, self.warmup = domain, raw, work, count, warmup
-        self.wake = wake
-        self.procs = Processes(shared_session=True)
+        super().__init__(work, count, warmup)
+        self.domain, self.raw, self.wake = domain, raw, wake
         self.ping_topic = f"rsca_bench_raw_ping_{wake}_{os.getpid()}"
         self.echo_topic = f"rsca_bench_raw_echo_{wake}_{os.getpid()}"
         self.qos = json.dumps(qos)
-        try:
-            self.echo = self.procs.start(
-                [raw, "echo", "--in", self.ping_topic, "--out", self.echo_topic, "--qos",
-                 self.qos, "--wake", wake], domain.env, os.path.join(work, f"raw-{wake}-echo.log"))
-        except BaseException:
-            self.procs.close()
-            raise
-        self.cpu_us = 0.0
-        self.round_trips = 0
-        self.resent = 0
+        self.start(self._start_echo)
+
+    def _start_echo(self):
+        self.echo = self.procs.start(
+            [self.raw, "echo", "--in", self.ping_topic, "--out", self.echo_topic, "--qos",
+             self.qos, "--wake", self.wake], self.domain.env,
+            os.path.join(self.work, f"raw-{self.wake}-echo.log"))
 
     def run(self, index):
         output = os.path.join(self.work, f"raw-{self.wake}-rtt-{index}.bin")
@@ -264,9 +274,6 @@ class LatencyRaw:
                                self.echo_topic, "--qos", self.qos, "--wake", self.wake, "--count",
                                str(self.count), "--warmup", str(self.warmup), "--output", output],
                         self.domain.env, f"raw-{self.wake}-ping-{index}.log", output)
-
-    def close(self):
-        self.procs.close()
 
 
 # The latency benchmark's sides: the rsca components on two nodes (over DDS) and on one (through
