@@ -6,6 +6,7 @@
 #include <fmt/ranges.h>
 
 #include "common/elapsed.hpp"
+#include "dds/port_qos.hpp"
 #include "domain/factory_calls.hpp"
 #include "protocol/component_ops.hpp"
 
@@ -14,6 +15,12 @@ namespace rsca::domain {
 using namespace detail;
 
 namespace {
+
+// The connection's QoS asks each process to carry it on DDS itself (transport="direct").
+bool asks_direct_dds(const Wire &wire) {
+  const auto qos = dds::connection_qos_from_json(wire.qos);
+  return qos && qos->transport == profile::Transport::Direct;
+}
 
 protocol::component::ConnectRequest connect_request(const Wire &wire, const WireEnd &end,
                                                     const char *direction) {
@@ -33,7 +40,7 @@ protocol::component::ConnectRequest connect_request(const Wire &wire, const Wire
   const bool reader = std::string_view(direction) == "provides";
   request.filter = reader ? wire.filter : "";
   request.local = wire.in_one_host();
-  if (wire.on_one_node())
+  if (wire.on_one_node() && !asks_direct_dds(wire))
     request.shared_memory = true;
   return request;
 }

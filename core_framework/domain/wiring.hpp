@@ -45,12 +45,11 @@ struct Wire {
   bool in_one_host() const {
     return uses && provides && !uses->host.empty() && uses->host == provides->host;
   }
-  // Both ends are processes one node started, in two processes, and the connection does not ask
-  // for direct DDS (its QoS's transport): it goes through that node's shared memory
-  // (node/host_data.hpp).
+  // Both ends are processes one node started, in two processes: unless its QoS asks for direct
+  // DDS, the connection goes through that node's shared memory (node/host_data.hpp).
   bool on_one_node() const {
     return uses && provides && !uses->node.empty() && uses->node == provides->node &&
-           !in_one_host() && !(qos.is_object() && qos.value("transport", "node") == "direct");
+           !in_one_host();
   }
 };
 

@@ -6,9 +6,6 @@
 #include <signal.h>
 #include <spdlog/spdlog.h>
 
-#include "protocol/codec.hpp"
-#include "protocol/component_ops.hpp"
-
 namespace rsca::node {
 
 namespace component_op = protocol::component;
@@ -66,38 +63,33 @@ tl::expected<HostData::Ring *, std::string> HostData::ring_of_locked(const std::
   return &rings_.emplace(topic, Ring{*offset, *owner, 0}).first->second;
 }
 
-tl::expected<nlohmann::json, std::string> HostData::connect(pid_t pid, const std::string &target,
-                                                            const nlohmann::json &request) {
-  auto r = protocol::decode<component_op::ConnectRequest>(request);
-  if (!r || !r->shared_memory.value_or(false))
-    return request; // not ours to change: the process answers what is wrong with it
-  if (!r->topic || r->topic->empty())
+tl::expected<component_op::Ring, std::string>
+HostData::connect(pid_t pid, const std::string &target, const component_op::ConnectRequest &r) {
+  if (!r.topic || r.topic->empty())
     return tl::unexpected(std::string("a same-host connection needs its topic"));
-  const bool writer = r->direction == "uses";
-  const EndKey key{pid, target, r->port, r->connection};
+  const bool writer = r.direction == "uses";
+  const EndKey key{pid, target, r.port, r.connection};
   std::lock_guard lock(mutex_);
   release_locked(pending_, key, /*lost=*/false); // an earlier connect of it never answered
-  auto ring = ring_of_locked(*r->topic);
+  auto ring = ring_of_locked(*r.topic);
   if (!ring)
     return tl::unexpected(ring.error());
-  End end{*r->topic, writer, 0};
+  End end{*r.topic, writer, 0};
   if (writer) {
     (*ring)->owner.add_writer();
   } else {
     auto slot = (*ring)->owner.claim_reader();
     if (!slot) {
       if ((*ring)->ends == 0)
-        free_ring_locked(*r->topic);
+        free_ring_locked(*r.topic);
       return tl::unexpected(fmt::format("topic {} has {} same-host readers, the most a ring has",
-                                        *r->topic, shm::kMaxRingReaders));
+                                        *r.topic, shm::kMaxRingReaders));
     }
     end.slot = *slot;
   }
   ++(*ring)->ends;
   pending_[key] = end;
-  nlohmann::json relayed = request;
-  relayed["ring"] = protocol::encode_message(component_op::Ring{(*ring)->offset, end.slot});
-  return relayed;
+  return component_op::Ring{(*ring)->offset, end.slot};
 }
 
 void HostData::connected(pid_t pid, const std::string &target, const std::string &port,

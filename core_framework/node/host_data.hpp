@@ -20,9 +20,8 @@
 #include <sys/types.h>
 #include <tl/expected.hpp>
 
-#include <nlohmann/json.hpp>
-
 #include "common/diagnostic.hpp"
+#include "protocol/component_ops.hpp"
 #include "shm/arena.hpp"
 #include "shm/ring.hpp"
 
@@ -45,12 +44,11 @@ public:
   void adopt(pid_t pid, std::uint64_t page);
   void release_page(std::uint64_t page);
 
-  // A relayed component.connect to `target` (served by process `pid`): when it asks for shared
-  // memory, the topic's ring, made or found, with a new end counted (pending until connected()),
-  // and the request to hand on (with `ring`); else the request as it is. An error says why the
-  // node cannot.
-  tl::expected<nlohmann::json, std::string> connect(pid_t pid, const std::string &target,
-                                                    const nlohmann::json &request);
+  // A relayed component.connect to `target` (served by process `pid`) that asks for shared
+  // memory: the topic's ring, made or found, with a new end counted (pending until connected()),
+  // for the request to carry. An error says why the node cannot.
+  tl::expected<protocol::component::Ring, std::string>
+  connect(pid_t pid, const std::string &target, const protocol::component::ConnectRequest &r);
   // The process answered that connect. Made: the end it replaced (a connection made again under
   // its id) goes, now that the process has let go of it, and the new one is kept. Not made: the
   // new one goes, and the process keeps the one it had.

@@ -151,26 +151,34 @@ CallResult<Json> ProcessLinks::Impl::prepare(pid_t pid, const Json &body,
                                              const control::RequestContext &context,
                                              std::function<void(bool ok)> &after) {
   namespace op = protocol::component;
-  const bool connect = context.operation == op::Connect::name;
-  if (host_data == nullptr || !(connect || context.operation == op::Disconnect::name) ||
-      !body.is_object())
+  if (host_data == nullptr)
     return body;
-  const std::string port = body.value("port", std::string());
-  const std::string connection = body.value("connection", std::string());
   // An end goes once the process has let go of it: the one a connect replaced, a new one the
-  // process refused, a disconnected one.
-  after = [data = host_data, pid, target = context.target, port, connection, connect](bool ok) {
-    if (connect)
-      data->connected(pid, target, port, connection, ok);
-    else
-      data->disconnect(pid, target, port, connection);
-  };
-  if (!connect)
+  // process refused, a disconnected one. A request that does not decode is handed on as it is:
+  // the process says what is wrong with it.
+  if (context.operation == op::Disconnect::name) {
+    if (auto r = protocol::decode<op::DisconnectRequest>(body))
+      after = [data = host_data, pid, target = context.target, r = *r](bool) {
+        data->disconnect(pid, target, r.port, r.connection);
+      };
     return body;
-  auto with_ring = host_data->connect(pid, context.target, body);
-  if (!with_ring)
-    return call_error(Status::Failed, fmt::format("{}: {}", context.target, with_ring.error()));
-  return std::move(*with_ring);
+  }
+  if (context.operation != op::Connect::name)
+    return body;
+  auto r = protocol::decode<op::ConnectRequest>(body);
+  if (!r)
+    return body;
+  after = [data = host_data, pid, target = context.target, port = r->port,
+           connection = r->connection](bool ok) {
+    data->connected(pid, target, port, connection, ok);
+  };
+  if (!r->shared_memory.value_or(false))
+    return body;
+  auto ring = host_data->connect(pid, context.target, *r);
+  if (!ring)
+    return call_error(Status::Failed, fmt::format("{}: {}", context.target, ring.error()));
+  r->ring = *ring;
+  return protocol::encode_message(*r);
 }
 
 void ProcessLinks::Impl::complete(const std::string &id, pid_t pid, CallResult<Json> result) {

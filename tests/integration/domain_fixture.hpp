@@ -110,6 +110,19 @@ public:
     return client_->call_sync(fmt::format("rsca/node/node{}", index), op, std::move(body), 5s);
   }
 
+  // Launches a SAD the project ships (profiles/dom/waveforms/<app>/<app>.sad.xml) with the CLI;
+  // the application as app.show gives it.
+  Json launch_shipped(const std::string &app) {
+    auto [rc, out] =
+        cli({"launch",
+             (kSource / fmt::format("profiles/dom/waveforms/{0}/{0}.sad.xml", app)).string()});
+    INFO(out);
+    REQUIRE(rc == 0);
+    auto shown = call("app.show", Json{{"app", app}});
+    REQUIRE(shown.has_value());
+    return *shown;
+  }
+
   // Runs the CLI against this domain; returns its exit code and output.
   std::pair<int, std::string> cli(const std::vector<std::string> &args) {
     const fs::path out = run_ / "cli.out";

@@ -39,22 +39,16 @@ int nice_of(long pid) {
 TEST_CASE("ProducerConsumer: install, launch, data flows, configure, query, stop, release",
           "[integration][domain]") {
   TestDomain domain;
-  auto [rc, out] = domain.cli(
-      {"launch",
-       (kSource / "profiles/dom/waveforms/ProducerConsumer/ProducerConsumer.sad.xml").string()});
-  INFO(out);
-  REQUIRE(rc == 0);
-  auto app = domain.call("app.show", Json{{"app", "ProducerConsumer"}});
-  REQUIRE(app.has_value());
-  CHECK(app->at("state") == "running");
-  REQUIRE(app->at("components").size() == 2);
-  const auto pids = pids_of(*app);
+  const Json app = domain.launch_shipped("ProducerConsumer");
+  CHECK(app.at("state") == "running");
+  REQUIRE(app.at("components").size() == 2);
+  const auto pids = pids_of(app);
   for (long pid : pids)
     CHECK(process_exists(pid));
 
   // Producer_1 is periodic (20 ms): admission gave it a CPU and a priority, and its process runs
   // on that CPU only.
-  for (const auto &c : app->at("components")) {
+  for (const auto &c : app.at("components")) {
     if (c.at("id") != "Producer_1")
       continue;
     REQUIRE(c.contains("schedule"));

@@ -95,14 +95,7 @@ TEST_CASE("two component processes of one node connect through its shared memory
           "socket of their own",
           "[integration][node-agent]") {
   TestDomain domain(1);
-  auto [rc, out] = domain.cli(
-      {"launch",
-       (kSource / "profiles/dom/waveforms/ProducerConsumer/ProducerConsumer.sad.xml").string()});
-  INFO(out);
-  REQUIRE(rc == 0);
-  auto app = domain.call("app.show", Json{{"app", "ProducerConsumer"}});
-  REQUIRE(app.has_value());
-  const auto pids = pids_of(*app);
+  const auto pids = pids_of(domain.launch_shipped("ProducerConsumer"));
   REQUIRE(pids.size() == 2);
   // Samples flow, end to end, over the node's ring.
   const Json samples = flowing_connection(domain, "ProducerConsumer");

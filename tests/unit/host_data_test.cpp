@@ -7,23 +7,22 @@
 #include <unistd.h>
 
 #include "node/host_data.hpp"
-#include "protocol/codec.hpp"
 #include "protocol/component_ops.hpp"
 
 using namespace rsca;
-using nlohmann::json;
 
 namespace {
 
-json same_host_connect(const std::string &direction, const std::string &port,
-                       const std::string &topic = "rsca/d/app/c1") {
-  return json{{"connection", "c1"}, {"port", port},         {"direction", direction},
-              {"topic", topic},     {"repid", "IDL:T:1.0"}, {"shared_memory", true}};
-}
-
-protocol::component::Ring ring_in(const json &request) {
-  REQUIRE(request.contains("ring"));
-  return protocol::decode<protocol::component::Ring>(request.at("ring")).value();
+protocol::component::ConnectRequest same_host_connect(const std::string &direction,
+                                                      const std::string &port) {
+  protocol::component::ConnectRequest r;
+  r.connection = "c1";
+  r.port = port;
+  r.direction = direction;
+  r.repid = "IDL:T:1.0";
+  r.topic = "rsca/d/app/c1";
+  r.shared_memory = true;
+  return r;
 }
 
 } // namespace
@@ -37,14 +36,14 @@ TEST_CASE("host data: two ends of a topic share one ring; it goes with its last 
   const auto reader = data->connect(200, "b", same_host_connect("provides", "in"));
   REQUIRE(reader.has_value());
   data->connected(200, "b", "in", "c1", true);
-  CHECK(ring_in(*writer).offset == ring_in(*reader).offset);
+  CHECK(writer->offset == reader->offset);
   CHECK(data->counts().rings == 1);
   CHECK(data->counts().ends == 2);
   // Made again, the reader gets a slot of its own while the process still reads on the old one;
   // the old one goes once the process says it made the new connection.
   const auto again = data->connect(200, "b", same_host_connect("provides", "in"));
   REQUIRE(again.has_value());
-  CHECK(ring_in(*again).slot != ring_in(*reader).slot);
+  CHECK(again->slot != reader->slot);
   CHECK(data->counts().ends == 3);
   data->connected(200, "b", "in", "c1", true);
   CHECK(data->counts().ends == 2);
@@ -61,18 +60,16 @@ TEST_CASE("host data: two ends of a topic share one ring; it goes with its last 
   CHECK(data->counts().bytes_in_use == 0);
 }
 
-TEST_CASE("host data: a request that does not ask for shared memory is handed on as it is",
+TEST_CASE("host data: a same-host connect without its topic is refused, holding nothing",
           "[host-data]") {
   auto data = node::HostData::create(64 << 20).value();
-  json request = same_host_connect("uses", "out");
-  request.erase("shared_memory");
-  const auto relayed = data->connect(100, "a", request);
-  REQUIRE(relayed.has_value());
-  CHECK(*relayed == request);
+  auto no_topic = same_host_connect("uses", "out");
+  no_topic.topic.reset();
+  const auto refused = data->connect(100, "a", no_topic);
+  REQUIRE_FALSE(refused.has_value());
+  CHECK(refused.error() == "a same-host connection needs its topic");
   CHECK(data->counts().rings == 0);
-  json no_topic = same_host_connect("uses", "out");
-  no_topic.erase("topic");
-  CHECK_FALSE(data->connect(100, "a", no_topic).has_value());
+  CHECK(data->counts().ends == 0);
 }
 
 TEST_CASE("host data: a process that ends lets go of its page and its ends; its readers see a "
@@ -93,7 +90,7 @@ TEST_CASE("host data: a process that ends lets go of its page and its ends; its 
   CHECK(data->counts().ends == 1);
   // The reader's view of the ring: no writer left, one lost.
   const auto mapped = shm::Arena::map(process::Fd(::dup(data->arena_fd()))).value();
-  auto ring = shm::detail::RingView::open(mapped, ring_in(*reader).offset).value();
+  auto ring = shm::detail::RingView::open(mapped, reader->offset).value();
   CHECK(ring.header->writers.load() == 0);
   CHECK(ring.header->writers_lost.load() == 1);
   data->forget(200); // its end still pending: it goes too

@@ -79,28 +79,45 @@ bool publish(iox::popo::UntypedPublisher &publisher, std::size_t bytes) {
   return true;
 }
 
-int run_echo(std::size_t bytes) {
-  iox::runtime::PoshRuntime::initRuntime("rsca-bench-iceoryx-echo");
-  iox::popo::UntypedPublisher publisher(service("pong"));
-  iox::popo::UntypedSubscriber subscriber(service("ping"));
+// The process's iceoryx runtime, registered with RouDi: first, before any port.
+bool init_runtime(const char *name) {
+  iox::runtime::PoshRuntime::initRuntime(iox::RuntimeName_t(iox::cxx::TruncateToCapacity, name));
+  return true;
+}
+
+// One side of the ping-pong: this process's iceoryx runtime, what it sends on `out`, and what it
+// waits for on `in`.
+struct Side {
+  Side(const char *runtime, const char *out, const char *in)
+      : initialized(init_runtime(runtime)), publisher(service(out)), subscriber(service(in)) {
+    attached = !waitset.attachState(subscriber, iox::popo::SubscriberState::HAS_DATA).has_error();
+  }
+  bool initialized;
+  iox::popo::UntypedPublisher publisher;
+  iox::popo::UntypedSubscriber subscriber;
   iox::popo::WaitSet<> waitset;
-  if (waitset.attachState(subscriber, iox::popo::SubscriberState::HAS_DATA).has_error())
+  bool attached = false;
+};
+
+int run_echo(std::size_t bytes) {
+  Side side("rsca-bench-iceoryx-echo", "pong", "ping");
+  if (!side.attached)
     return 1;
   std::puts("ready");
   std::fflush(stdout);
   while (!stopping)
-    if (take_one(subscriber, waitset, std::chrono::milliseconds(200)))
-      publish(publisher, bytes);
+    if (take_one(side.subscriber, side.waitset, std::chrono::milliseconds(200)))
+      publish(side.publisher, bytes);
   return 0;
 }
 
 int run_ping(std::size_t bytes, int count, int warmup, const std::string &output) {
-  iox::runtime::PoshRuntime::initRuntime("rsca-bench-iceoryx-ping");
-  iox::popo::UntypedPublisher publisher(service("ping"));
-  iox::popo::UntypedSubscriber subscriber(service("pong"));
-  iox::popo::WaitSet<> waitset;
-  if (waitset.attachState(subscriber, iox::popo::SubscriberState::HAS_DATA).has_error())
+  Side side("rsca-bench-iceoryx-ping", "ping", "pong");
+  if (!side.attached)
     return 1;
+  auto &publisher = side.publisher;
+  auto &subscriber = side.subscriber;
+  auto &waitset = side.waitset;
   // Until the echo answers: both have matched.
   while (!stopping) {
     publish(publisher, bytes);
