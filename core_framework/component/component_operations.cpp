@@ -169,7 +169,7 @@ CallResult<protocol::Empty> Host::op_connect(const op::ConnectRequest &r, const 
                                "request relayed by the component's node?");
   std::optional<RingRef> ring;
   if (r.ring && !local)
-    ring = RingRef{r.ring->offset, r.ring->slot};
+    ring = RingRef{r.ring->offset, r.ring->slot, r.relay.value_or(false)};
   // In-host and same-host connections need no DDS: the process joins DDS at its first
   // connection that does.
   std::shared_ptr<dds::Participant> participant;
@@ -185,7 +185,7 @@ CallResult<protocol::Empty> Host::op_connect(const op::ConnectRequest &r, const 
     return control::call_error(Status::Failed, ok.error());
   watch_connections();
   log().info("port {}: connection {} on {}topic \"{}\"{}", r.port, r.connection,
-             local ? "in-host " : (ring ? "same-host " : ""), topic,
+             local ? "in-host " : (ring ? (ring->relayed ? "relayed " : "same-host ") : ""), topic,
              filter_text.empty() ? "" : fmt::format(" with filter \"{}\"", filter_text));
   return Empty{};
 }
@@ -268,6 +268,8 @@ CallResult<op::StatusReply> Host::op_status(const Empty &, const Context &) {
       connection.in_host = s.in_host;
       if (s.same_host)
         connection.same_host = true;
+      if (s.relayed)
+        connection.relayed = true;
       status.connections.push_back(std::move(connection));
     }
     reply.ports.push_back(std::move(status));

@@ -52,6 +52,7 @@ struct DataConnection {
   std::chrono::nanoseconds lease{0}; // a reader's liveliness lease (0: none)
   bool liveliness_lost = false;      // reported, and not alive again since (receive thread)
   bool ticking = false;              // the writer's liveliness is asserted by the ticker
+  bool relayed = false;              // the node relays the ring to and from other hosts
 
   ~DataConnection() {
     if (ticking)
@@ -209,7 +210,8 @@ std::uint32_t lost_writers(DataConnection &c) {
   const std::int64_t alive = c.ring_reader->alive_ns();
   if (c.lease.count() <= 0 || alive == 0)
     return change;
-  const bool expired = steady_ns() - alive > c.lease.count();
+  // A writer on another host is alive while its node's relay says so (DDS liveliness).
+  const bool expired = steady_ns() - alive > c.lease.count() && c.ring_reader->remote_alive() == 0;
   if (expired && !c.liveliness_lost)
     ++change;
   c.liveliness_lost = expired;
@@ -311,6 +313,7 @@ PortBase::open_same_host(detail::ReceiveLoop *loop, std::unique_ptr<DataConnecti
     return make_error({"port", 0, 0}, "port",
                       "a same-host connection, but this process has no host arena from its node");
   c->deadline = requested_deadline(qos);
+  c->relayed = ring.relayed;
   if (direction_ == profile::PortDirection::Uses) {
     auto writer = shm::RingWriter::open(arena->arena(), ring.offset);
     if (!writer)
@@ -352,7 +355,7 @@ std::vector<ConnectionStatus> PortBase::status() const {
   for (const auto &[id, c] : connections_)
     out.push_back({id, c->topic_name, matched_count(*c, direction_), c->samples.load(),
                    c->filtered.load(), deadline_misses(*c, direction_), c->in_host(),
-                   c->same_host()});
+                   c->same_host(), c->relayed});
   return out;
 }
 

@@ -42,6 +42,7 @@ struct ConnectionStatus {
   std::uint32_t deadline_missed = 0; // the connection's deadline, missed (offered or requested)
   bool in_host = false;              // both ends in one process: no DDS entities
   bool same_host = false;            // both ends on one host: a ring in shared memory
+  bool relayed = false;              // a ring the node relays to and from the ends on other hosts
 };
 
 // A same-host connection's ring, as the node gave it: where it is in the host's arena, and a
@@ -49,6 +50,7 @@ struct ConnectionStatus {
 struct RingRef {
   std::uint64_t offset = 0;
   std::uint32_t slot = 0;
+  bool relayed = false; // the node relays the ring to and from other hosts
 };
 
 // A QoS problem of a provides port's connection since it was last reported: the writer missed

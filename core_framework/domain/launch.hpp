@@ -85,7 +85,9 @@ private:
                                        const std::string &port, profile::PortDirection direction);
 
   // This application's subscribers (or publishers) on a channel's topic.
-  int members_on(const std::string &topic, bool subscribers) const;
+  std::string relaying_node_of(const ConnectionInstance &ci, const ConnectionEnd &end) const;
+  int channel_peers(const ConnectionInstance &self, const ConnectionEnd &end,
+                    bool subscribers) const;
 
   CallResult<void> start();
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <map>
+#include <set>
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -107,11 +108,12 @@ Wire ApplicationFactory::Launch::wire_of(const ConnectionInstance &ci) const {
   }
   const bool channel = ci.uses.empty() || ci.provides.empty();
   if (!ci.uses.empty())
-    w.uses = end_of(ci.uses, channel ? members_on(ci.topic, /*subscribers=*/true) : 1,
+    w.uses = end_of(ci.uses, channel ? channel_peers(ci, ci.uses, /*subscribers=*/true) : 1,
                     fmt::format("{} ({})", ci.id, ci.uses.name()));
   if (!ci.provides.empty())
-    w.provides = end_of(ci.provides, channel ? members_on(ci.topic, /*subscribers=*/false) : 1,
-                        fmt::format("{} ({})", ci.id, ci.provides.name()));
+    w.provides =
+        end_of(ci.provides, channel ? channel_peers(ci, ci.provides, /*subscribers=*/false) : 1,
+               fmt::format("{} ({})", ci.id, ci.provides.name()));
   return w;
 }
 
@@ -171,12 +173,38 @@ CallResult<ConnectionEnd> ApplicationFactory::Launch::device_end(ConnectionInsta
   return ConnectionEnd{"", port, device, ports->address};
 }
 
-int ApplicationFactory::Launch::members_on(const std::string &topic, bool subscribers) const {
-  int n = 0;
-  for (const auto &ci : app_->connections)
-    if (ci.topic == topic && !(subscribers ? ci.provides : ci.uses).empty())
-      ++n;
-  return n;
+// Where an end's data goes: through the ring of the node that relays for its process (`node`
+// not empty), or on DDS from its owner itself (a device, a QoS asking for direct DDS).
+std::string ApplicationFactory::Launch::relaying_node_of(const ConnectionInstance &ci,
+                                                         const ConnectionEnd &end) const {
+  const auto *component = end.component.empty() ? nullptr : component_of(end.component);
+  if (component == nullptr)
+    return {};
+  const auto qos = dds::connection_qos_from_json(ci.qos);
+  if (qos && qos->transport == profile::Transport::Direct)
+    return {};
+  return component->relaying_node();
+}
+
+// The peers an event channel's member of this application waits for, counted as its end sees
+// them: each member on the other side in the same node's ring; for each other node, that node's
+// relay; each member on DDS of its own (wiring.hpp: the end's matched count).
+int ApplicationFactory::Launch::channel_peers(const ConnectionInstance &self,
+                                              const ConnectionEnd &end, bool subscribers) const {
+  const std::string here = relaying_node_of(self, end);
+  int peers = 0;
+  std::set<std::string> relays;
+  for (const auto &ci : app_->connections) {
+    const auto &other = subscribers ? ci.provides : ci.uses;
+    if (ci.topic != self.topic || other.empty())
+      continue;
+    const std::string there = relaying_node_of(ci, other);
+    if (there.empty() || (!here.empty() && there == here))
+      ++peers;
+    else
+      relays.insert(there);
+  }
+  return peers + static_cast<int>(relays.size());
 }
 
 std::string ApplicationFactory::Launch::repid_of(const profile::Connection &c) const {
@@ -205,32 +233,24 @@ std::string ApplicationFactory::Launch::repid_of(const profile::Connection &c) c
 
 namespace rsca::domain {
 
-// A connection of `c` to another node, to a device or an event channel, or one that asks for
-// direct DDS, goes on DDS from c's own process (docs/architecture.md, "Same-host data"): the
-// process then joins DDS as it starts, so that DDS discovery overlaps the launch's steps before
-// `connect` instead of adding to it. Connections to components of its own node need no DDS.
+// A connection of `c` that asks for direct DDS goes on DDS from c's own process (every other
+// one goes through its node: docs/architecture.md, "Data through the nodes"): the process then
+// joins DDS as it starts, so that DDS discovery overlaps the launch's steps before `connect`
+// instead of adding to it.
 bool ApplicationFactory::Launch::joins_dds(const ComponentInstance &c) const {
   using Kind = profile::EndpointTarget::Kind;
+  if (c.relaying_node().empty())
+    return false; // a process no node relays for joins DDS when it connects, as it always did
   for (const auto &conn : request_.profile->sad->connections) {
     if (conn.provides.kind == profile::ProvidesEnd::Kind::SupportedInterface)
       continue; // control calls: through the node
-    const auto &uses = conn.uses.target;
-    const auto &provides = conn.provides.target;
     const bool provides_port = conn.provides.kind == profile::ProvidesEnd::Kind::Port;
-    const bool is_uses = uses.kind == Kind::ComponentInstantiation && uses.refid == c.id;
-    const bool is_provides =
-        provides_port && provides.kind == Kind::ComponentInstantiation && provides.refid == c.id;
-    if (!is_uses && !is_provides)
+    const auto is_end = [&c](const profile::EndpointTarget &t) {
+      return t.kind == Kind::ComponentInstantiation && t.refid == c.id;
+    };
+    if (!is_end(conn.uses.target) && !(provides_port && is_end(conn.provides.target)))
       continue;
-    const auto &other = is_uses ? provides : uses;
-    const bool to_component =
-        (is_provides || provides_port) && other.kind == Kind::ComponentInstantiation;
-    const auto *peer = to_component ? component_of(other.refid) : nullptr;
-    if (peer == nullptr || (conn.qos && conn.qos->transport == profile::Transport::Direct))
-      return true;
-    if (!c.host.empty() && peer->host == c.host)
-      continue; // in-host
-    if (peer->node != c.node)
+    if (conn.qos && conn.qos->transport == profile::Transport::Direct)
       return true;
   }
   return false;

@@ -40,8 +40,10 @@ protocol::component::ConnectRequest connect_request(const Wire &wire, const Wire
   const bool reader = std::string_view(direction) == "provides";
   request.filter = reader ? wire.filter : "";
   request.local = wire.in_one_host();
-  if (wire.on_one_node() && !asks_direct_dds(wire))
+  if (wire.through_node(end) && !asks_direct_dds(wire)) {
     request.shared_memory = true;
+    request.relay = !wire.on_one_node(); // ends on other hosts, or an event channel's
+  }
   return request;
 }
 

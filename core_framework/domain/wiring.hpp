@@ -51,6 +51,10 @@ struct Wire {
     return uses && provides && !uses->node.empty() && uses->node == provides->node &&
            !in_one_host();
   }
+  // `end` is a process a node relays for, not in one host with its peer: unless the QoS asks
+  // for direct DDS, its data goes through that node's shared memory, and through the node's
+  // relay to the ends on other hosts (node/topic_bridge.hpp).
+  bool through_node(const WireEnd &end) const { return !end.node.empty() && !in_one_host(); }
 };
 
 // How long each phase of a connect took, for the launch's progress.

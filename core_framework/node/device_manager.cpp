@@ -185,7 +185,7 @@ op::StatusReply DeviceManager::Impl::status() const {
   if (host_data) {
     const auto held = host_data->counts();
     status.shared_memory =
-        op::SharedMemoryStatus{held.rings, held.ends, held.pages, held.bytes_in_use};
+        op::SharedMemoryStatus{held.rings, held.ends, held.pages, held.bytes_in_use, held.relays};
   }
   return status;
 }
@@ -246,6 +246,18 @@ DeviceManager::create(std::shared_ptr<dds::Participant> participant, NodeOptions
   else
     spdlog::warn("no shared memory for this host's data ({}): same-host connections use DDS",
                  data.error().to_string());
+  if (impl->host_data) {
+    auto relayed = impl->host_data->start_relay(
+        [participant](const shm::Arena &arena,
+                      std::uint64_t doorbell) -> Expected<std::unique_ptr<TopicRelay>> {
+          auto bridge = TopicBridge::start(participant, arena, doorbell);
+          if (!bridge)
+            return tl::unexpected(bridge.error());
+          return std::unique_ptr<TopicRelay>(std::move(*bridge));
+        });
+    if (!relayed)
+      return tl::unexpected(relayed.error());
+  }
   auto links = ProcessLinks::start(*impl->endpoint, impl->host_data.get());
   if (!links)
     return tl::unexpected(links.error());

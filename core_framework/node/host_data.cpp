@@ -1,6 +1,7 @@
 #include "node/host_data.hpp"
 
 #include <cerrno>
+#include <new>
 
 #include <fmt/format.h>
 #include <signal.h>
@@ -17,6 +18,22 @@ Expected<std::unique_ptr<HostData>> HostData::create(std::size_t bytes) {
   if (!arena)
     return tl::unexpected(arena.error());
   return std::unique_ptr<HostData>(new HostData(std::move(*arena)));
+}
+
+Expected<void> HostData::start_relay(const MakeRelay &make) {
+  std::lock_guard lock(mutex_);
+  auto doorbell = allocator_.allocate(sizeof(shm::Doorbell));
+  if (!doorbell)
+    return make_error({"node", 0, 0}, "relay", "the host's arena has no room for a doorbell");
+  new (arena_.at(*doorbell, sizeof(shm::Doorbell))) shm::Doorbell();
+  auto relay = make(arena_, *doorbell);
+  if (!relay) {
+    allocator_.release(*doorbell);
+    return tl::unexpected(relay.error());
+  }
+  relay_doorbell_ = *doorbell;
+  relay_ = std::move(*relay);
+  return {};
 }
 
 std::optional<std::pair<std::uint64_t, std::string>> HostData::reserve_page() {
@@ -88,8 +105,30 @@ HostData::connect(pid_t pid, const std::string &target, const component_op::Conn
     end.slot = *slot;
   }
   ++(*ring)->ends;
+  if (r.relay.value_or(false)) {
+    if (auto relayed = relay_locked(**ring, end, r); !relayed) {
+      release_locked(end, /*lost=*/false);
+      return tl::unexpected(relayed.error());
+    }
+    end.relayed = true;
+  }
   pending_[key] = end;
   return component_op::Ring{(*ring)->offset, end.slot};
+}
+
+tl::expected<void, std::string> HostData::relay_locked(Ring &ring, const End &end,
+                                                       const component_op::ConnectRequest &r) {
+  if (!relay_)
+    return tl::unexpected(std::string("this node relays no data to other hosts"));
+  auto &relayed = end.writer ? ring.relayed_writers : ring.relayed_readers;
+  if (relayed == 0) {
+    const RelayRoute route{end.topic, ring.offset, end.writer, r.repid,
+                           r.qos.value_or(nlohmann::json::object())};
+    if (auto opened = relay_->open(route, ring.owner); !opened)
+      return opened;
+  }
+  ++relayed;
+  return {};
 }
 
 void HostData::connected(pid_t pid, const std::string &target, const std::string &port,
@@ -121,6 +160,11 @@ void HostData::release_locked(const End &end, bool lost) {
   auto ring = rings_.find(end.topic);
   if (ring == rings_.end())
     return;
+  if (end.relayed && relay_) {
+    auto &relayed = end.writer ? ring->second.relayed_writers : ring->second.relayed_readers;
+    if (relayed > 0 && --relayed == 0)
+      relay_->close(end.topic, end.writer);
+  }
   if (end.writer)
     ring->second.owner.remove_writer(lost);
   else
@@ -159,7 +203,8 @@ void HostData::forget(pid_t pid) {
 
 HostData::Counts HostData::counts() const {
   std::lock_guard lock(mutex_);
-  return {rings_.size(), ends_.size() + pending_.size(), pages_.size(), allocator_.in_use()};
+  return {rings_.size(), ends_.size() + pending_.size(), pages_.size(), allocator_.in_use(),
+          relay_ ? relay_->relays() : 0};
 }
 
 } // namespace rsca::node

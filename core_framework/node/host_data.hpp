@@ -10,6 +10,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -21,6 +22,7 @@
 #include <tl/expected.hpp>
 
 #include "common/diagnostic.hpp"
+#include "node/topic_bridge.hpp"
 #include "protocol/component_ops.hpp"
 #include "shm/arena.hpp"
 #include "shm/ring.hpp"
@@ -38,6 +40,13 @@ public:
   static Expected<std::unique_ptr<HostData>> create(std::size_t bytes = kArenaBytes);
 
   int arena_fd() const { return arena_.fd(); }
+
+  // Relays rings with ends on other hosts (a connect with `relay`) through the relay `make`
+  // returns for this arena and a doorbell in it (node/topic_bridge.hpp). Without one, such a
+  // connect is refused.
+  using MakeRelay = std::function<Expected<std::unique_ptr<TopicRelay>>(const shm::Arena &arena,
+                                                                        std::uint64_t doorbell)>;
+  Expected<void> start_relay(const MakeRelay &make);
   // A page for a process about to start, and the value of shm::kArenaVariable that tells it
   // (the arena at shm::kArenaFd); adopt() binds it to the process once it runs.
   std::optional<std::pair<std::uint64_t, std::string>> reserve_page();
@@ -65,6 +74,7 @@ public:
     std::size_t ends = 0;
     std::size_t pages = 0;
     std::size_t bytes_in_use = 0;
+    std::size_t relays = 0; // as the relay counts them
   };
   Counts counts() const;
 
@@ -73,11 +83,14 @@ private:
     std::uint64_t offset = 0;
     shm::RingOwner owner;
     std::size_t ends = 0;
+    std::size_t relayed_writers = 0; // ends whose records the relay carries out
+    std::size_t relayed_readers = 0; // ends the relay brings other hosts' samples to
   };
   struct End {
     std::string topic;
     bool writer = false;
     std::uint32_t slot = 0;
+    bool relayed = false;
   };
   // (pid, target, port, connection)
   using EndKey = std::tuple<pid_t, std::string, std::string, std::string>;
@@ -86,6 +99,9 @@ private:
   tl::expected<Ring *, std::string> ring_of_locked(const std::string &topic);
   void release_locked(const End &end, bool lost);
   void free_ring_locked(const std::string &topic);
+  // Counts a relayed end of `ring`, opening the relay its direction needs with the first.
+  tl::expected<void, std::string> relay_locked(Ring &ring, const End &end,
+                                               const protocol::component::ConnectRequest &r);
   // Takes the end of `key` out of `ends` and releases it; nothing if there is none.
   void release_locked(std::map<EndKey, End> &ends, const EndKey &key, bool lost);
 
@@ -96,6 +112,9 @@ private:
   std::map<EndKey, End> ends_;        // connected
   std::map<EndKey, End> pending_;     // relayed, not answered yet
   std::map<pid_t, std::uint64_t> pages_;
+  std::uint64_t relay_doorbell_ = 0;
+  // Declared last: destroyed first, while the arena and its rings are still there.
+  std::unique_ptr<TopicRelay> relay_;
 };
 
 } // namespace rsca::node

@@ -39,6 +39,9 @@ struct ConnectRequest {
   // Both ends are processes of one node, which relays the request (the domain says so): the node
   // then makes the topic's ring and adds `ring`, and the connection goes through it, not DDS.
   std::optional<bool> shared_memory;
+  // With shared_memory: the connection has (or may have) ends on other hosts, which the node
+  // reaches by relaying the ring to and from DDS (node/topic_bridge.hpp). The process sees a ring.
+  std::optional<bool> relay;
   std::optional<Ring> ring;
   static constexpr auto fields() {
     using R = ConnectRequest;
@@ -53,6 +56,7 @@ struct ConnectRequest {
                       optional("target", &R::target),
                       optional("via", &R::via),
                       optional("shared_memory", &R::shared_memory),
+                      optional("relay", &R::relay),
                       optional("ring", &R::ring)};
   }
 };
@@ -95,16 +99,22 @@ struct ConnectionStatus {
   std::optional<std::uint64_t> deadline_missed;
   std::optional<bool> in_host;
   std::optional<bool> same_host;
+  std::optional<bool> relayed;       // same_host, and the node relays it to other hosts
   std::optional<std::string> target; // a control interface's connection: whom it calls
   std::optional<std::uint64_t> calls;
   static constexpr auto fields() {
     using R = ConnectionStatus;
-    return std::tuple{
-        required("connection", &R::connection), optional("topic", &R::topic),
-        optional("matched", &R::matched),       optional("samples", &R::samples),
-        optional("filtered", &R::filtered),     optional("deadline_missed", &R::deadline_missed),
-        optional("in_host", &R::in_host),       optional("same_host", &R::same_host),
-        optional("target", &R::target),         optional("calls", &R::calls)};
+    return std::tuple{required("connection", &R::connection),
+                      optional("topic", &R::topic),
+                      optional("matched", &R::matched),
+                      optional("samples", &R::samples),
+                      optional("filtered", &R::filtered),
+                      optional("deadline_missed", &R::deadline_missed),
+                      optional("in_host", &R::in_host),
+                      optional("same_host", &R::same_host),
+                      optional("relayed", &R::relayed),
+                      optional("target", &R::target),
+                      optional("calls", &R::calls)};
   }
 };
 

@@ -143,7 +143,8 @@ struct CreateReply : ConnectionView {
 };
 
 // One connection in connection.list, with each end's live state as its owner reports it
-// ({"matched", "samples", "filtered", "deadline_missed", "in_host", "same_host"}, or {"calls"}
+// ({"matched", "samples", "filtered", "deadline_missed", "in_host", "same_host",
+// "relayed"}, or {"calls"}
 // for a caller of a supported interface), null when the end shows none: JSON, so that null stays
 // null.
 struct ListedConnection : ConnectionView {

@@ -118,14 +118,16 @@ struct NodeAnnouncement {
 
 // What the node's shared memory for its host's data holds (node/host_data.hpp).
 struct SharedMemoryStatus {
-  std::uint64_t rings = 0; // one per same-host topic
-  std::uint64_t ends = 0;  // connections' ends on them
-  std::uint64_t pages = 0; // processes' pages of doorbells
-  std::uint64_t bytes = 0; // of the arena, in use
+  std::uint64_t rings = 0;  // one per same-host topic
+  std::uint64_t ends = 0;   // connections' ends on them
+  std::uint64_t pages = 0;  // processes' pages of doorbells
+  std::uint64_t bytes = 0;  // of the arena, in use
+  std::uint64_t relays = 0; // rings relayed to or from other hosts, a direction each
   static constexpr auto fields() {
     using R = SharedMemoryStatus;
     return std::tuple{required("rings", &R::rings), required("ends", &R::ends),
-                      required("pages", &R::pages), required("bytes", &R::bytes)};
+                      required("pages", &R::pages), required("bytes", &R::bytes),
+                      optional("relays", &R::relays)};
   }
 };
 

@@ -91,7 +91,7 @@ tl::expected<RingOwner, std::string> RingOwner::create(const Arena &arena, std::
   return RingOwner(*view);
 }
 
-std::optional<std::uint32_t> RingOwner::claim_reader() {
+std::optional<std::uint32_t> RingOwner::claim_reader(Count count) {
   auto &h = *view_.header;
   for (std::uint32_t slot = 0; slot < kMaxRingReaders; ++slot) {
     std::uint32_t expected = detail::kSlotFree;
@@ -100,17 +100,18 @@ std::optional<std::uint32_t> RingOwner::claim_reader() {
     std::uint32_t used = h.slots_used.load();
     while (used < slot + 1 && !h.slots_used.compare_exchange_weak(used, slot + 1)) {
     }
-    h.readers.fetch_add(1);
+    if (count == Count::Peer)
+      h.readers.fetch_add(1);
     return slot;
   }
   return std::nullopt;
 }
 
-void RingOwner::release_reader(std::uint32_t slot) {
+void RingOwner::release_reader(std::uint32_t slot, Count count) {
   if (slot >= kMaxRingReaders)
     return;
   auto &s = view_.header->slots[slot];
-  if (s.state.exchange(detail::kSlotFree) != detail::kSlotFree)
+  if (s.state.exchange(detail::kSlotFree) != detail::kSlotFree && count == Count::Peer)
     view_.header->readers.fetch_sub(1);
   s.doorbell.store(0);
 }
@@ -125,11 +126,28 @@ void RingOwner::remove_writer(bool lost) {
     view_.header->writers_lost.fetch_add(1);
 }
 
-tl::expected<RingWriter, std::string> RingWriter::open(const Arena &arena, std::uint64_t offset) {
+void RingOwner::count_remote_readers(std::int32_t change) {
+  view_.header->readers.fetch_add(change);
+}
+
+void RingOwner::count_remote_writers(std::int32_t change) {
+  view_.header->writers.fetch_add(change);
+}
+
+void RingOwner::count_remote_alive(std::int32_t change) {
+  view_.header->remote_alive.fetch_add(change);
+}
+
+void RingOwner::count_writers_lost(std::uint32_t lost) {
+  view_.header->writers_lost.fetch_add(lost);
+}
+
+tl::expected<RingWriter, std::string> RingWriter::open(const Arena &arena, std::uint64_t offset,
+                                                       Origin origin) {
   auto view = RingView::open(arena, offset);
   if (!view)
     return tl::unexpected(view.error());
-  return RingWriter(arena, *view);
+  return RingWriter(arena, *view, origin);
 }
 
 tl::expected<std::byte *, std::string> RingWriter::reserve(std::size_t bytes) {
@@ -167,6 +185,7 @@ void RingWriter::publish() {
   auto &entry = view_.entry(seq_);
   entry.pos.store(pos_, std::memory_order_relaxed);
   entry.bytes.store(static_cast<std::uint32_t>(bytes_), std::memory_order_relaxed);
+  entry.origin.store(static_cast<std::uint32_t>(origin_), std::memory_order_relaxed);
   entry.seq.store(seq_, std::memory_order_release);
   h.head.store(pos_ + bytes_, std::memory_order_relaxed);
   h.next_seq.store(seq_ + 1, std::memory_order_release);
@@ -195,7 +214,7 @@ void RingWriter::ring_readers() const {
 
 tl::expected<RingReader, std::string> RingReader::open(const Arena &arena, std::uint64_t offset,
                                                        std::uint32_t slot, std::uint64_t doorbell,
-                                                       std::uint32_t depth) {
+                                                       std::uint32_t depth, bool skip_relayed) {
   auto view = RingView::open(arena, offset);
   if (!view)
     return tl::unexpected(view.error());
@@ -206,7 +225,7 @@ tl::expected<RingReader, std::string> RingReader::open(const Arena &arena, std::
   auto &s = view->header->slots[slot];
   if (s.state.load() != detail::kSlotClaimed)
     return tl::unexpected(fmt::format("reader slot {} was not claimed for this reader", slot));
-  RingReader reader(*view, slot, depth);
+  RingReader reader(*view, slot, depth, skip_relayed);
   s.doorbell.store(doorbell, std::memory_order_relaxed);
   s.state.store(detail::kSlotActive, std::memory_order_seq_cst);
   // After the slot is active (publish() says why the order matters): what is published from
@@ -217,7 +236,7 @@ tl::expected<RingReader, std::string> RingReader::open(const Arena &arena, std::
 
 RingReader::RingReader(RingReader &&other) noexcept
     : view_(other.view_), slot_(std::exchange(other.slot_, kMaxRingReaders)), depth_(other.depth_),
-      cursor_(other.cursor_), dropped_(other.dropped_) {}
+      skip_relayed_(other.skip_relayed_), cursor_(other.cursor_), dropped_(other.dropped_) {}
 
 RingReader::~RingReader() {
   if (slot_ >= kMaxRingReaders)

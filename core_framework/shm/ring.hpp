@@ -29,6 +29,15 @@ namespace rsca::shm {
 
 inline constexpr std::uint32_t kMaxRingReaders = 128;
 
+// Who wrote a record: a process of this host, or the node relaying what came from other hosts
+// (node/topic_bridge.hpp). The node's own reader that carries a ring's records to other hosts
+// skips what it relayed in, so that a topic with ends on several hosts never echoes.
+enum class Origin : std::uint32_t { Host = 0, Relayed = 1 };
+
+// Whether a reader slot or a writer counts as a peer of the ring's other ends (their matched
+// counts): the node's relays do not; the peers they stand for are counted as they match on DDS.
+enum class Count : std::uint8_t { Peer, Relay };
+
 struct RingLimits {
   std::uint32_t data_bytes = 256 * 1024; // a power of two; a record takes at most half
   std::uint32_t records = 1024;          // a power of two: the most a reader can fall behind
@@ -47,6 +56,7 @@ struct RecordEntry {
   std::atomic<std::uint64_t> seq{~0ull}; // the record's sequence number
   std::atomic<std::uint64_t> pos{0};     // its first byte, as a position (data_bytes wraps it)
   std::atomic<std::uint32_t> bytes{0};
+  std::atomic<std::uint32_t> origin{0}; // Origin
 };
 
 struct RingHeader {
@@ -63,6 +73,9 @@ struct RingHeader {
   std::atomic<std::uint32_t> slots_used{0};   // no slot at or above this was ever claimed
   // When a writer last wrote or said it is alive (steady clock, ns: one clock for the host).
   std::atomic<std::int64_t> alive_ns{0};
+  // Writers on other hosts that DDS says are alive (the node's relay counts them): while there
+  // is one, a lease that passed since the last record is not lost liveliness.
+  std::atomic<std::int32_t> remote_alive{0};
   ReaderSlot slots[kMaxRingReaders];
 };
 
@@ -90,13 +103,21 @@ public:
   // Makes a ring at `offset` (ring_bytes(limits) allocated there).
   static tl::expected<RingOwner, std::string> create(const Arena &arena, std::uint64_t offset,
                                                      const RingLimits &limits);
-  // A free reader slot, claimed; none when the ring has kMaxRingReaders readers.
-  std::optional<std::uint32_t> claim_reader();
-  void release_reader(std::uint32_t slot);
+  // A free reader slot, claimed; none when the ring has kMaxRingReaders readers. A relay's slot
+  // is not counted among the readers; release it with the same Count.
+  std::optional<std::uint32_t> claim_reader(Count count = Count::Peer);
+  void release_reader(std::uint32_t slot, Count count = Count::Peer);
   void add_writer();
   // `lost`: the writer's process ended without disconnecting (its readers see it as lost
   // liveliness).
   void remove_writer(bool lost);
+  // Peers on other hosts, as the node's relay learns of them from DDS: matched readers of its
+  // writer, matched writers of its reader, their writers alive, and those lost.
+  void count_remote_readers(std::int32_t change);
+  void count_remote_writers(std::int32_t change);
+  void count_remote_alive(std::int32_t change);
+  void count_writers_lost(std::uint32_t lost);
+  std::int64_t alive_ns() const { return view_.header->alive_ns.load(std::memory_order_relaxed); }
 
 private:
   explicit RingOwner(detail::RingView view) : view_(view) {}
@@ -106,7 +127,8 @@ private:
 // A writer's side: where a uses port's connection writes.
 class RingWriter {
 public:
-  static tl::expected<RingWriter, std::string> open(const Arena &arena, std::uint64_t offset);
+  static tl::expected<RingWriter, std::string> open(const Arena &arena, std::uint64_t offset,
+                                                    Origin origin = Origin::Host);
 
   // Writes one record of `bytes`, filled by `fill(std::byte *)`, and rings the readers' doorbells.
   // An error when the record cannot fit (more than half the ring).
@@ -124,7 +146,8 @@ public:
   void assert_alive();
 
 private:
-  RingWriter(const Arena &arena, detail::RingView view) : arena_(&arena), view_(view) {}
+  RingWriter(const Arena &arena, detail::RingView view, Origin origin)
+      : arena_(&arena), view_(view), origin_(origin) {}
   // Takes the write lock and room for `bytes`; publish() gives both back.
   tl::expected<std::byte *, std::string> reserve(std::size_t bytes);
   void publish();
@@ -132,6 +155,7 @@ private:
 
   const Arena *arena_;
   detail::RingView view_;
+  Origin origin_ = Origin::Host;
   std::uint64_t seq_ = 0, pos_ = 0, bytes_ = 0; // the record reserved
 };
 
@@ -140,9 +164,10 @@ class RingReader {
 public:
   // Activates `slot`, whose writers from now on ring `doorbell` (an offset in the arena). It
   // reads what is written from now on; `depth` 0 keeps all (up to the ring's records).
+  // `skip_relayed`: records of Origin::Relayed are passed over (the node's relay to DDS).
   static tl::expected<RingReader, std::string> open(const Arena &arena, std::uint64_t offset,
                                                     std::uint32_t slot, std::uint64_t doorbell,
-                                                    std::uint32_t depth);
+                                                    std::uint32_t depth, bool skip_relayed = false);
   RingReader(RingReader &&other) noexcept;
   RingReader &operator=(RingReader &&) = delete;
   RingReader(const RingReader &) = delete;
@@ -161,16 +186,21 @@ public:
   }
   // When a writer was last alive (steady clock, ns); 0: never.
   std::int64_t alive_ns() const { return view_.header->alive_ns.load(std::memory_order_relaxed); }
+  // Writers on other hosts alive now (their node's relay says so).
+  std::int32_t remote_alive() const {
+    return view_.header->remote_alive.load(std::memory_order_relaxed);
+  }
 
 private:
-  RingReader(detail::RingView view, std::uint32_t slot, std::uint32_t depth)
-      : view_(view), slot_(slot), depth_(depth) {}
+  RingReader(detail::RingView view, std::uint32_t slot, std::uint32_t depth, bool skip_relayed)
+      : view_(view), slot_(slot), depth_(depth), skip_relayed_(skip_relayed) {}
   // Moves the cursor past what is lost (overwritten, or beyond the depth); the newest published.
   std::uint64_t skip_lost();
 
   detail::RingView view_;
   std::uint32_t slot_ = kMaxRingReaders; // kMaxRingReaders: moved from
   std::uint32_t depth_ = 0;
+  bool skip_relayed_ = false;
   std::uint64_t cursor_ = 0;
   std::uint64_t dropped_ = 0;
 };
@@ -186,6 +216,9 @@ std::size_t RingReader::take(Decode &&decode, Deliver &&deliver) {
       ++dropped_; // its entry was taken by a newer record
       continue;
     }
+    if (skip_relayed_ &&
+        entry.origin.load(std::memory_order_relaxed) == static_cast<std::uint32_t>(Origin::Relayed))
+      continue;
     const std::uint64_t pos = entry.pos.load(std::memory_order_relaxed);
     const std::uint32_t bytes = entry.bytes.load(std::memory_order_relaxed);
     const std::uint64_t at = pos & (capacity - 1);

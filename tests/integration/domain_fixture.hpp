@@ -111,11 +111,12 @@ public:
   }
 
   // Launches a SAD the project ships (profiles/dom/waveforms/<app>/<app>.sad.xml) with the CLI;
-  // the application as app.show gives it.
-  Json launch_shipped(const std::string &app) {
-    auto [rc, out] =
-        cli({"launch",
-             (kSource / fmt::format("profiles/dom/waveforms/{0}/{0}.sad.xml", app)).string()});
+  // the application as app.show gives it. `options`: more of the CLI's (`--strategy spread`).
+  Json launch_shipped(const std::string &app, const std::vector<std::string> &options = {}) {
+    std::vector<std::string> args{
+        "launch", (kSource / fmt::format("profiles/dom/waveforms/{0}/{0}.sad.xml", app)).string()};
+    args.insert(args.end(), options.begin(), options.end());
+    auto [rc, out] = cli(args);
     INFO(out);
     REQUIRE(rc == 0);
     auto shown = call("app.show", Json{{"app", app}});
@@ -189,7 +190,7 @@ public:
         processes = status->at("processes");
         shared = status->value("shared_memory", Json::object());
         return processes.empty() && shared.value("rings", 0) == 0 && shared.value("ends", 0) == 0 &&
-               shared.value("pages", 0) == 0;
+               shared.value("pages", 0) == 0 && shared.value("relays", 0) == 0;
       });
       INFO(node.at("address") << " still lists " << processes.dump() << ", shared memory "
                               << shared.dump());

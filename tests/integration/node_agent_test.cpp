@@ -115,6 +115,38 @@ TEST_CASE("two component processes of one node connect through its shared memory
   domain.require_clean(pids); // with the node's shared memory empty again
 }
 
+TEST_CASE("two component processes on two nodes connect through their nodes' relays, with no "
+          "socket of their own",
+          "[integration][node-agent]") {
+  TestDomain domain(2);
+  const Json app = domain.launch_shipped("ProducerConsumer", {"--strategy", "spread"});
+  const auto pids = pids_of(app);
+  REQUIRE(pids.size() == 2);
+  REQUIRE(component_named(app, "Producer_1").at("node") !=
+          component_named(app, "Consumer_1").at("node"));
+  // Samples flow: producer -> node1's ring -> node1's relay -> DDS -> node2's relay -> node2's
+  // ring -> consumer. Each end counts the other as matched, as DDS matched the two relays.
+  const Json samples = flowing_connection(domain, "ProducerConsumer");
+  INFO(samples.dump());
+  for (const char *end : {"uses_state", "provides_state"}) {
+    CHECK(samples.at(end).value("relayed", false));
+    CHECK(samples.at(end).value("matched", 0) == 1);
+  }
+  REQUIRE(udp_sockets_of(domain.node_pid(1)) > 0);
+  for (long pid : pids)
+    CHECK(udp_sockets_of(pid) == 0);
+  for (int node : {1, 2}) { // a ring, an end and a relay on each
+    auto status = domain.call_node(node, "node.status");
+    REQUIRE(status.has_value());
+    INFO("node" << node << ": " << status->dump());
+    CHECK(status->at("shared_memory").at("rings") == 1);
+    CHECK(status->at("shared_memory").at("ends") == 1);
+    CHECK(status->at("shared_memory").at("relays") == 1);
+  }
+  REQUIRE(domain.call("app.release", Json{{"app", "ProducerConsumer"}}).has_value());
+  domain.require_clean(pids); // with both nodes' rings and relays gone
+}
+
 TEST_CASE("a connection that asks for direct DDS takes it on one node too",
           "[integration][node-agent]") {
   TestDomain domain(1);

@@ -115,7 +115,8 @@ TEST_CASE("wiring: both ends in one component host take the in-host path", "[wir
     CHECK(r.local == false);
 }
 
-TEST_CASE("wiring: two processes of one node take its shared memory, others DDS", "[wiring]") {
+TEST_CASE("wiring: a process a node relays for goes through that node; across nodes, relayed",
+          "[wiring]") {
   using rsca::protocol::component::Connect;
   auto wire = [](std::string uses_host, std::string uses_node, std::string provides_host,
                  std::string provides_node) {
@@ -128,14 +129,24 @@ TEST_CASE("wiring: two processes of one node take its shared memory, others DDS"
                 .has_value());
     return fake.requests<Connect>();
   };
-  for (const auto &r : wire("", "node1", "", "node1")) {
+  for (const auto &r : wire("", "node1", "", "node1")) { // one node: its ring only
     CHECK(r.shared_memory == true);
+    CHECK(r.relay == false);
     CHECK(r.local == false);
   }
-  for (const auto &r : wire("", "node1", "", "node2"))
-    CHECK_FALSE(r.shared_memory.has_value());
-  for (const auto &r : wire("", "node1", "", "")) // a device of the node, or an unrelayed process
-    CHECK_FALSE(r.shared_memory.has_value());
+  for (const auto &r : wire("", "node1", "", "node2")) { // two nodes: each node's ring, relayed
+    CHECK(r.shared_memory == true);
+    CHECK(r.relay == true);
+  }
+  // A device of the node or an unrelayed process is on DDS itself; the relayed end reaches it
+  // through its node's relay.
+  const auto to_device = wire("", "node1", "", "");
+  REQUIRE(to_device.size() == 2);
+  for (const auto &r : to_device)
+    CHECK(r.shared_memory.has_value() == (r.port == "out"));
+  for (const auto &r : to_device)
+    if (r.port == "out")
+      CHECK(r.relay == true);
   {
     FakeComponents fake;
     std::vector<WireEnd> made;

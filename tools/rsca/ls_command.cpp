@@ -86,6 +86,7 @@ std::string end_state(const Json &state) {
                      state.value("samples", 0),
                      missed == 0 ? "" : fmt::format(", {} deadlines missed", missed),
                      state.value("in_host", false)     ? " (in-host)"
+                     : state.value("relayed", false)   ? " (through the nodes)"
                      : state.value("same_host", false) ? " (same-host, shared memory)"
                                                        : "");
 }
