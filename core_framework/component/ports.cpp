@@ -50,9 +50,11 @@ struct DataConnection {
   std::optional<shm::RingReader> ring_reader;
   std::uint32_t writers_lost_reported = 0;
   std::chrono::nanoseconds lease{0}; // a reader's liveliness lease (0: none)
-  bool liveliness_lost = false;      // reported, and not alive again since (receive thread)
-  bool ticking = false;              // the writer's liveliness is asserted by the ticker
-  bool relayed = false;              // the node relays the ring to and from other hosts
+  // The ring's alive_ns when lost liveliness was last reported (receive thread): a gap is
+  // reported once, however it was seen.
+  std::int64_t lost_at_alive_ns = -1;
+  bool ticking = false; // the writer's liveliness is asserted by the ticker
+  bool relayed = false; // the node relays the ring to and from other hosts
 
   ~DataConnection() {
     if (ticking)
@@ -199,23 +201,29 @@ std::uint32_t local_deadline_misses(DataConnection &c) {
 }
 
 // A same-host reader's lost liveliness not reported yet: writers whose process ended while
-// connected (the node counts them in the ring), and a lease that passed since a writer was last
-// alive (once per such gap, as DDS counts a writer going from alive to not alive).
+// connected (the node counts them in the ring, and so does its relay for writers on other hosts
+// that DDS saw lose theirs), or a lease that passed since a writer was last alive. Once per gap,
+// as DDS counts a writer going from alive to not alive: a gap is the ring's last sign of life,
+// reported once whichever way it was seen.
 std::uint32_t lost_writers(DataConnection &c) {
   if (!c.ring_reader)
     return 0;
   const std::uint32_t lost = c.ring_reader->writers_lost();
-  std::uint32_t change = lost - c.writers_lost_reported;
+  const std::uint32_t change = lost - c.writers_lost_reported;
   c.writers_lost_reported = lost;
   const std::int64_t alive = c.ring_reader->alive_ns();
-  if (c.lease.count() <= 0 || alive == 0)
+  if (change > 0) {
+    c.lost_at_alive_ns = alive;
     return change;
+  }
+  if (c.lease.count() <= 0 || alive == 0 || alive == c.lost_at_alive_ns)
+    return 0;
   // A writer on another host is alive while its node's relay says so (DDS liveliness).
   const bool expired = steady_ns() - alive > c.lease.count() && c.ring_reader->remote_alive() == 0;
-  if (expired && !c.liveliness_lost)
-    ++change;
-  c.liveliness_lost = expired;
-  return change;
+  if (!expired)
+    return 0;
+  c.lost_at_alive_ns = alive;
+  return 1;
 }
 
 // How often the writer (uses) or the reader's writers (provides) missed the connection's deadline.

@@ -47,6 +47,10 @@ struct TopicBridge::Relay {
     writer.reset();
   }
 
+  // Guards what follows against the bridge's thread, which pumps the relay without the bridge's
+  // lock (a DDS write may wait): a closed relay's ring may be freed, and is never touched again.
+  std::mutex lock;
+  bool closed = false;
   shm::RingOwner owner;
   shm::Doorbell *bell; // the bridge's: rung by the listeners, for the thread to recount
   dds::Entity topic;
@@ -56,8 +60,8 @@ struct TopicBridge::Relay {
   std::unique_ptr<component::RecordRelay> out_convert;
   std::optional<shm::RingReader> ring_reader;
   std::uint32_t slot = shm::kMaxRingReaders;
-  std::int64_t lease_ns = 0;   // >0: the writer's liveliness is asserted by hand
-  std::int64_t alive_seen = 0; // the ring's alive_ns last asserted
+  std::atomic<std::int64_t> lease_ns{0}; // >0: the writer's liveliness is asserted by hand
+  std::int64_t alive_seen = 0;           // the ring's alive_ns last asserted
 
   // In: DDS's samples to the ring.
   dds::Entity reader;
@@ -67,7 +71,8 @@ struct TopicBridge::Relay {
   std::atomic<dds_instance_handle_t> own_writer{0}, own_reader{0};
   // Set by the listeners (no waiting there), applied to the ring by the bridge's thread.
   std::atomic<bool> recount{false};
-  std::atomic<std::int32_t> alive_now{0};
+  std::atomic<std::int32_t> alive_now{0}; // the reader's alive writers, its own among them
+  std::atomic<std::int32_t> own_alive{0}; // this node's own writer, when alive (not a peer)
   std::atomic<std::uint32_t> lost_pending{0};
   // What the thread counted into the ring: taken back when the relay closes.
   std::int32_t readers_counted = 0, writers_counted = 0, alive_counted = 0;
@@ -94,9 +99,14 @@ void on_subscription_matched(dds_entity_t e, const dds_subscription_matched_stat
 void on_liveliness_changed(dds_entity_t e, const dds_liveliness_changed_status_t status,
                            void *arg) {
   auto *relay = static_cast<TopicBridge::Relay *>(arg);
-  relay->alive_now.store(static_cast<std::int32_t>(status.alive_count));
-  if (status.not_alive_count_change > 0)
+  // The node's own writer of the topic (an event channel with publishers here too) is matched by
+  // its own reader: its liveliness is not a peer's.
+  const auto own = relay->own_writer.load();
+  if (own != 0 && status.last_publication_handle == own)
+    relay->own_alive.fetch_add(status.alive_count_change);
+  else if (status.not_alive_count_change > 0)
     relay->lost_pending.fetch_add(static_cast<std::uint32_t>(status.not_alive_count_change));
+  relay->alive_now.store(static_cast<std::int32_t>(status.alive_count));
   on_matched(e, arg);
 }
 void on_data_available(dds_entity_t reader, void *arg) {
@@ -110,7 +120,7 @@ void TopicBridge::Relay::pump() {
   if (writer && ring_reader) {
     out_convert->to_dds(*ring_reader, writer.get());
     if (lease_ns > 0) {
-      const std::int64_t alive = owner.alive_ns();
+      const std::int64_t alive = owner.host_alive_ns(); // not what came from other hosts
       if (alive != alive_seen) {
         dds_assert_liveliness(writer.get());
         alive_seen = alive;
@@ -133,7 +143,7 @@ void TopicBridge::Relay::apply_counts() {
     owner.count_remote_writers(writers - writers_counted);
     writers_counted = writers;
   }
-  const std::int32_t alive = reader ? alive_now.load() : 0;
+  const std::int32_t alive = reader ? std::max(0, alive_now.load() - own_alive.load()) : 0;
   owner.count_remote_alive(alive - alive_counted);
   alive_counted = alive;
   if (const auto lost = lost_pending.exchange(0); lost > 0)
@@ -170,8 +180,11 @@ TopicBridge::~TopicBridge() {
   if (thread_.joinable())
     thread_.join();
   std::lock_guard lock(mutex_);
-  for (auto &[topic, relay] : relays_)
+  for (auto &[topic, relay] : relays_) {
+    std::lock_guard relay_lock(relay->lock);
+    relay->closed = true;
     relay->uncount();
+  }
   relays_.clear();
 }
 
@@ -179,23 +192,32 @@ int TopicBridge::sleep_ms() const {
   // A relay asserting liveliness by hand looks at the ring's writers three times a lease.
   std::int64_t ms = 1000;
   for (const auto &[topic, relay] : relays_)
-    if (relay->lease_ns > 0)
-      ms = std::min<std::int64_t>(ms, std::max<std::int64_t>(1, relay->lease_ns / 3'000'000));
+    if (const std::int64_t lease = relay->lease_ns.load(); lease > 0)
+      ms = std::min<std::int64_t>(ms, std::max<std::int64_t>(1, lease / 3'000'000));
   return static_cast<int>(ms);
 }
 
 void TopicBridge::run() {
   auto *bell = arena_.object<shm::Doorbell>(doorbell_);
   int timeout_ms = 1000;
+  std::vector<std::shared_ptr<Relay>> relays;
   for (;;) {
     shm::sleep(*bell, timeout_ms, /*shared=*/true);
     shm::take(*bell);
-    std::lock_guard lock(mutex_);
-    if (stopping_)
-      return;
-    for (auto &[topic, relay] : relays_)
-      relay->pump();
-    timeout_ms = sleep_ms();
+    relays.clear();
+    {
+      std::lock_guard lock(mutex_);
+      if (stopping_)
+        return;
+      for (auto &[topic, relay] : relays_)
+        relays.push_back(relay);
+      timeout_ms = sleep_ms();
+    }
+    for (auto &relay : relays) { // each on its own lock: a close waits for its relay only
+      std::lock_guard lock(relay->lock);
+      if (!relay->closed)
+        relay->pump();
+    }
   }
 }
 
@@ -257,6 +279,9 @@ tl::expected<void, std::string> open_in(TopicBridge::Relay &r, dds_entity_t part
   if (!ring)
     return tl::unexpected(ring.error());
   r.ring_writer.emplace(std::move(*ring));
+  r.alive_now.store(0); // of an earlier reader of the topic's, if any
+  r.own_alive.store(0);
+  r.lost_pending.store(0);
   r.in_convert = component::RecordRelay::of(type);
   Listener listener(dds_create_listener(&r));
   dds_lset_data_available(listener.get(), on_data_available);
@@ -285,14 +310,16 @@ tl::expected<void, std::string> TopicBridge::open(const RelayRoute &route, shm::
   std::lock_guard lock(mutex_);
   auto &slot = relays_[route.topic];
   if (!slot)
-    slot = std::make_unique<Relay>(owner, arena_.object<shm::Doorbell>(doorbell_));
+    slot = std::make_shared<Relay>(owner, arena_.object<shm::Doorbell>(doorbell_));
   Relay &r = *slot;
+  std::unique_lock relay_lock(r.lock);
   if (!r.topic) {
     auto topic = dds::checked(dds_create_topic(participant_->get(),
                                                component::RecordRelay::of(*type)->descriptor(),
                                                route.topic.c_str(), nullptr, nullptr),
                               fmt::format("creating topic \"{}\"", route.topic));
     if (!topic) {
+      relay_lock.unlock();
       relays_.erase(route.topic);
       return tl::unexpected(topic.error().to_string());
     }
@@ -301,6 +328,7 @@ tl::expected<void, std::string> TopicBridge::open(const RelayRoute &route, shm::
   auto opened = route.outbound ? open_out(r, participant_->get(), arena_, doorbell_, route, *type)
                                : open_in(r, participant_->get(), arena_, route, *type);
   if (!opened) {
+    relay_lock.unlock();
     close_locked(route.topic, route.outbound);
     return opened;
   }
@@ -312,8 +340,10 @@ tl::expected<void, std::string> TopicBridge::open(const RelayRoute &route, shm::
 std::size_t TopicBridge::relays() const {
   std::lock_guard lock(mutex_);
   std::size_t n = 0;
-  for (const auto &[topic, relay] : relays_)
+  for (const auto &[topic, relay] : relays_) {
+    std::lock_guard relay_lock(relay->lock);
     n += (relay->writer ? 1 : 0) + (relay->reader ? 1 : 0);
+  }
   return n;
 }
 
@@ -327,6 +357,7 @@ void TopicBridge::close_locked(const std::string &topic, bool outbound) {
   if (it == relays_.end())
     return;
   Relay &r = *it->second;
+  std::unique_lock relay_lock(r.lock);
   if (outbound) {
     r.writer.reset();
     r.ring_reader.reset();
@@ -343,8 +374,10 @@ void TopicBridge::close_locked(const std::string &topic, bool outbound) {
   r.recount.store(true);
   r.apply_counts();
   if (r.idle()) {
+    r.closed = true;
     r.uncount();
-    relays_.erase(it);
+    relay_lock.unlock();
+    relays_.erase(it); // the thread may hold it a while yet: closed, it touches nothing
   }
 }
 

@@ -82,7 +82,7 @@ private:
   const shm::Arena &arena_;
   std::uint64_t doorbell_;
   mutable std::mutex mutex_;                             // guards relays_ against the thread
-  std::map<std::string, std::unique_ptr<Relay>> relays_; // by topic
+  std::map<std::string, std::shared_ptr<Relay>> relays_; // by topic
   bool stopping_ = false;
   std::thread thread_;
 };

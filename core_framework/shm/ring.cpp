@@ -177,7 +177,10 @@ tl::expected<std::byte *, std::string> RingWriter::reserve(std::size_t bytes) {
 }
 
 void RingWriter::assert_alive() {
-  view_.header->alive_ns.store(steady_now_ns(), std::memory_order_relaxed);
+  const std::int64_t now = steady_now_ns();
+  view_.header->alive_ns.store(now, std::memory_order_relaxed);
+  if (origin_ == Origin::Host)
+    view_.header->host_alive_ns.store(now, std::memory_order_relaxed);
 }
 
 void RingWriter::publish() {

@@ -73,6 +73,9 @@ struct RingHeader {
   std::atomic<std::uint32_t> slots_used{0};   // no slot at or above this was ever claimed
   // When a writer last wrote or said it is alive (steady clock, ns: one clock for the host).
   std::atomic<std::int64_t> alive_ns{0};
+  // The same for the host's own writers only (not what the node relayed in): what the node's
+  // relay says on DDS for them.
+  std::atomic<std::int64_t> host_alive_ns{0};
   // Writers on other hosts that DDS says are alive (the node's relay counts them): while there
   // is one, a lease that passed since the last record is not lost liveliness.
   std::atomic<std::int32_t> remote_alive{0};
@@ -117,7 +120,10 @@ public:
   void count_remote_writers(std::int32_t change);
   void count_remote_alive(std::int32_t change);
   void count_writers_lost(std::uint32_t lost);
-  std::int64_t alive_ns() const { return view_.header->alive_ns.load(std::memory_order_relaxed); }
+  // When a writer of this host was last alive (steady clock, ns); 0: never.
+  std::int64_t host_alive_ns() const {
+    return view_.header->host_alive_ns.load(std::memory_order_relaxed);
+  }
 
 private:
   explicit RingOwner(detail::RingView view) : view_(view) {}

@@ -6,6 +6,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <fmt/format.h>
+
 #include "node/host_data.hpp"
 #include "protocol/component_ops.hpp"
 
@@ -111,4 +113,91 @@ TEST_CASE("host data: the page of a process that died before it was adopted is n
   data->adopt(child, page->first);
   CHECK(data->counts().pages == 0);
   CHECK(data->counts().bytes_in_use == 0);
+}
+
+namespace {
+
+// A relay that records what the host's data asks of it.
+struct RecordingRelay final : node::TopicRelay {
+  std::vector<std::string> *log;
+  bool refuse = false;
+  std::size_t open_now = 0;
+  explicit RecordingRelay(std::vector<std::string> *l) : log(l) {}
+  tl::expected<void, std::string> open(const node::RelayRoute &route, shm::RingOwner) override {
+    if (refuse)
+      return tl::unexpected(std::string("refused"));
+    log->push_back(fmt::format("open {} {}", route.topic, route.outbound ? "out" : "in"));
+    ++open_now;
+    return {};
+  }
+  void close(const std::string &topic, bool outbound) override {
+    log->push_back(fmt::format("close {} {}", topic, outbound ? "out" : "in"));
+    --open_now;
+  }
+  std::size_t relays() const override { return open_now; }
+};
+
+protocol::component::ConnectRequest relayed_connect(const std::string &direction,
+                                                    const std::string &connection) {
+  auto r = same_host_connect(direction, direction == "uses" ? "out" : "in");
+  r.connection = connection;
+  r.relay = true;
+  return r;
+}
+
+} // namespace
+
+TEST_CASE("host data: a topic's relay opens with its first relayed end of a direction and closes "
+          "with the last",
+          "[host-data]") {
+  auto data = node::HostData::create(64 << 20).value();
+  std::vector<std::string> log;
+  RecordingRelay *relay = nullptr;
+  REQUIRE(
+      data->start_relay([&](const shm::Arena &,
+                            std::uint64_t doorbell) -> Expected<std::unique_ptr<node::TopicRelay>> {
+            CHECK(doorbell != 0);
+            auto made = std::make_unique<RecordingRelay>(&log);
+            relay = made.get();
+            return std::unique_ptr<node::TopicRelay>(std::move(made));
+          })
+          .has_value());
+  const std::string topic = "rsca/d/app/c1";
+  // Two publishers and a subscriber of a channel on this host, and one that is not relayed.
+  REQUIRE(data->connect(100, "a", relayed_connect("uses", "p1")).has_value());
+  REQUIRE(data->connect(101, "b", relayed_connect("uses", "p2")).has_value());
+  REQUIRE(data->connect(102, "c", relayed_connect("provides", "s1")).has_value());
+  REQUIRE(data->connect(103, "d", same_host_connect("provides", "in")).has_value());
+  for (auto [pid, target, port, connection] : {std::tuple{100, "a", "out", "p1"},
+                                               {101, "b", "out", "p2"},
+                                               {102, "c", "in", "s1"},
+                                               {103, "d", "in", "c1"}})
+    data->connected(pid, target, port, connection, true);
+  CHECK(log == std::vector<std::string>{"open " + topic + " out", "open " + topic + " in"});
+  CHECK(data->counts().relays == 2);
+  data->disconnect(100, "a", "out", "p1");
+  CHECK(log.size() == 2); // p2 still publishes
+  data->forget(101);      // its process ended
+  data->disconnect(102, "c", "in", "s1");
+  CHECK(log == std::vector<std::string>{"open " + topic + " out", "open " + topic + " in",
+                                        "close " + topic + " out", "close " + topic + " in"});
+  CHECK(data->counts().relays == 0);
+  CHECK(data->counts().rings == 1); // the unrelayed reader's
+  // A relay that cannot open refuses the connect, and nothing is held for it.
+  relay->refuse = true;
+  const auto refused = data->connect(104, "e", relayed_connect("uses", "p3"));
+  REQUIRE_FALSE(refused.has_value());
+  CHECK(refused.error() == "refused");
+  CHECK(data->counts().ends == 1);
+  data->disconnect(103, "d", "in", "c1");
+  CHECK(data->counts().rings == 0);
+}
+
+TEST_CASE("host data: without a relay, a relayed connect is refused", "[host-data]") {
+  auto data = node::HostData::create(64 << 20).value();
+  const auto refused = data->connect(100, "a", relayed_connect("uses", "p1"));
+  REQUIRE_FALSE(refused.has_value());
+  CHECK(refused.error() == "this node relays no data to other hosts");
+  CHECK(data->counts().rings == 0);
+  CHECK(data->counts().ends == 0);
 }

@@ -170,6 +170,43 @@ TEST_CASE("shm: a writer's process that ends is counted lost, and liveliness is 
   CHECK(reader.writers_lost() == 1);
 }
 
+TEST_CASE("shm: the node's relay reads what the host wrote, never what it relayed in, and is "
+          "no peer",
+          "[shm]") {
+  RingFixture f;
+  auto [owner, at] = f.make();
+  auto host = shm::RingWriter::open(f.arena, at).value();
+  auto relayed_in = shm::RingWriter::open(f.arena, at, shm::Origin::Relayed).value();
+  auto process = f.reader(owner, at);
+  const auto relay_slot = owner.claim_reader(shm::Count::Relay).value();
+  auto relay_out = shm::RingReader::open(f.arena, at, relay_slot, f.bell_at, 0,
+                                         /*skip_relayed=*/true)
+                       .value();
+  CHECK(host.readers() == 1); // the process only
+  REQUIRE(write_number(host, 1));
+  REQUIRE(write_number(relayed_in, 2));
+  REQUIRE(write_number(host, 3));
+  CHECK(take_numbers(process) == std::vector<std::uint64_t>{1, 2, 3});
+  CHECK(take_numbers(relay_out) == std::vector<std::uint64_t>{1, 3});
+  CHECK(relay_out.dropped() == 0); // skipped, not lost
+  // Peers on other hosts are counted as DDS matches them, and taken back.
+  owner.count_remote_readers(2);
+  owner.count_remote_writers(1);
+  owner.count_remote_alive(1);
+  CHECK(host.readers() == 3);
+  CHECK(process.writers() == 1);
+  CHECK(process.remote_alive() == 1);
+  owner.count_remote_readers(-2);
+  owner.count_remote_writers(-1);
+  owner.count_remote_alive(-1);
+  owner.count_writers_lost(1);
+  CHECK(host.readers() == 1);
+  CHECK(process.writers() == 0);
+  CHECK(process.writers_lost() == 1);
+  owner.release_reader(relay_slot, shm::Count::Relay);
+  CHECK(host.readers() == 1);
+}
+
 TEST_CASE("shm: a ring carries records between two processes, the reader asleep on its doorbell",
           "[shm]") {
   RingFixture f;
