@@ -6,6 +6,8 @@
 #include <catch2/catch.hpp>
 #include <fmt/format.h>
 
+#include <set>
+
 #include "domain_fixture.hpp"
 
 using namespace rsca::test;
@@ -125,6 +127,34 @@ TEST_CASE("an event channel carries events to every subscriber, and a filtered o
   REQUIRE(domain.call("app.release", Json{{"app", "Events"}}).has_value());
   CHECK(channel(domain, "Ticks").is_null());
   domain.require_clean(pids);
+}
+
+TEST_CASE("an event channel with members on two nodes is one DDS topic that each node fans out",
+          "[integration][channels]") {
+  TestDomain domain(2);
+  DdsEndpoints dds;
+  domain.install("Events");
+  auto [rc, out] = domain.cli({"launch", "Events", "--strategy", "spread"});
+  INFO(out);
+  REQUIRE(rc == 0);
+  const Json app = domain.call("app.show", Json{{"app", "Events"}}).value();
+  INFO(app.dump());
+  const auto pids = pids_of(app);
+  std::set<std::string> publishing, subscribing; // nodes
+  for (const auto &c : app.at("components"))
+    (c.at("id") == "Producer_1" ? publishing : subscribing).insert(c.at("node").get<std::string>());
+  REQUIRE(publishing.size() + subscribing.size() > 2); // spread: members on both nodes
+  CHECK(TestDomain::wait_for(
+      [&] { return property(domain, "Events/Consumer_1", "events_received") > 20; }));
+  CHECK(TestDomain::wait_for(
+      [&] { return property(domain, "Events/Consumer_2", "events_received") > 0; }));
+  // Only the nodes' relays are on the topic: a writer where the publisher is, a reader on each
+  // node with subscribers; the component processes have no DDS of their own.
+  CHECK(TestDomain::wait_for(
+      [&] { return dds.on(kTicksTopic) == publishing.size() + subscribing.size(); }));
+  REQUIRE(domain.call("app.release", Json{{"app", "Events"}}).has_value());
+  CHECK(TestDomain::wait_for([&] { return dds.on(kTicksTopic) == 0; }));
+  domain.require_clean(pids); // every node's rings and relays gone
 }
 
 TEST_CASE("a channel shared by two applications outlives the first and goes with the second, DDS "
