@@ -11,7 +11,8 @@ configuration (it joins the DDS domain of the daemons the way every rsca process
 Payloads are 64 bytes serialized; times are CLOCK_MONOTONIC (tests/bench/bench_common.hpp).
 
 latency: strict ping-pong between BenchPing_1 and BenchEcho_1 (uses port -> provides port,
-  both ways) placed on two nodes (over DDS) and on one node (through its shared memory), between
+  both ways) placed on two nodes (through each node's ring and relay: the default; and with the
+  connections asking for direct DDS) and on one node (through its shared memory), between
   `rsca-bench-iceoryx ping` and `echo` (raw iceoryx 2.0.3, woken by its WaitSet; the same-host
   baseline), and between `rsca-bench-raw ping` and `rsca-bench-raw echo`, once woken by a waitset
   (the baseline of the ratio lines) and once by a listener as rsca's receive loop is; each raw
@@ -74,8 +75,10 @@ def bench_latency(args):
             sizes = raw_sizes(raw, domain.env)
             sides = {"rsca": LatencyRsca(domain, work, count, warmup)}
             closing.callback(sides["rsca"].close)
-            sides["rsca_same_host"] = LatencyRsca(domain, work, count, warmup, same_host=True)
+            sides["rsca_same_host"] = LatencyRsca(domain, work, count, warmup, "same_host")
             closing.callback(sides["rsca_same_host"].close)
+            sides["rsca_direct"] = LatencyRsca(domain, work, count, warmup, "direct")
+            closing.callback(sides["rsca_direct"].close)
             sides["iceoryx"] = LatencyIceoryx(iceoryx, work, count, warmup,
                                               sizes["ping_sample_bytes"])
             closing.callback(sides["iceoryx"].close)
@@ -105,6 +108,9 @@ def bench_latency(args):
     sh, ix = results["rsca_same_host"], results["iceoryx"]
     results["ratio_same_host_p50"] = ratio(sh["p50_us"], w["p50_us"])
     results["ratio_same_host_iceoryx_p50"] = ratio(sh["p50_us"], ix["p50_us"])
+    d = results["rsca_direct"]
+    results["ratio_direct_p50"] = ratio(d["p50_us"], w["p50_us"])
+    results["ratio_direct_p99"] = ratio(d["p99_us"], w["p99_us"])
     with open(args.out, "w") as f:
         json.dump(results, f, indent=2)
 
@@ -114,22 +120,26 @@ def bench_latency(args):
           f"as the components are in their node's; QoS {qos['reliability']}, "
           f"{qos['durability']}, {qos['history']} {qos.get('depth', '')}.")
     print()
-    print("| round trip | rsca, two nodes (DDS) | raw Cyclone DDS (waitset) | rsca/raw "
-          "| raw, rsca's wake (listener) | rsca/that | rsca, one node (shared memory) "
-          "| same-host/raw | raw iceoryx (waitset) | same-host/iceoryx |")
-    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+    print("| round trip | rsca, two nodes (through the nodes) | raw Cyclone DDS (waitset) "
+          "| rsca/raw | raw, rsca's wake (listener) | rsca/that | rsca, two nodes (direct DDS) "
+          "| direct/raw | rsca, one node (shared memory) | same-host/raw | raw iceoryx (waitset) "
+          "| same-host/iceoryx |")
+    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
     rows = [("min_us", "min"), ("p50_us", "p50"), ("p90_us", "p90"), ("p99_us", "p99"),
             ("p999_us", "p99.9"), ("max_us", "max"), ("mean_us", "mean"),
             ("cpu_us_per_round_trip", "CPU per round trip (both processes)")]
     for key, label in rows:
         print(f"| {label} | {r[key]:.1f} us | {w[key]:.1f} us | {ratio(r[key], w[key]):.2f} "
-              f"| {wl[key]:.1f} us | {ratio(r[key], wl[key]):.2f} | {sh[key]:.1f} us "
+              f"| {wl[key]:.1f} us | {ratio(r[key], wl[key]):.2f} | {d[key]:.1f} us "
+              f"| {ratio(d[key], w[key]):.2f} | {sh[key]:.1f} us "
               f"| {ratio(sh[key], w[key]):.2f} | {ix[key]:.1f} us | {ratio(sh[key], ix[key]):.2f} |")
     print()
     print(f"ratio rsca/raw-listener p50 = {results['ratio_p50_listener']:.2f}")
     print(f"ratio rsca/raw-listener p99 = {results['ratio_p99_listener']:.2f}")
     print(f"ratio rsca/raw p50 = {results['ratio_p50']:.2f}")
     print(f"ratio rsca/raw p99 = {results['ratio_p99']:.2f}")
+    print(f"ratio direct rsca/raw p50 = {results['ratio_direct_p50']:.2f}")
+    print(f"ratio direct rsca/raw p99 = {results['ratio_direct_p99']:.2f}")
     print(f"ratio same-host rsca/raw p50 = {results['ratio_same_host_p50']:.2f}")
     print(f"ratio same-host rsca/iceoryx p50 = {results['ratio_same_host_iceoryx_p50']:.2f}")
     return 0

@@ -123,25 +123,32 @@ def cpu_us(pid):
 
 class LatencyRsca:
     """BenchPing_1 and BenchEcho_1 launched once (not started); each round configures the ping's
-    output, starts the application, waits for the file and stops it. `same_host`: both on one
-    node (placement "pack"), connected through its shared memory; else on two nodes ("spread"),
-    over DDS. Which one the domain made is checked, not assumed."""
+    output, starts the application, waits for the file and stops it. `path`:
+    - "same_host": both on one node (placement "pack"), connected through its shared memory;
+    - "relayed": on two nodes ("spread"), through each node's ring and relay (the default path);
+    - "direct": on two nodes, each process on DDS itself (the connections ask transport="direct":
+      a copy of the SAD made so under `work`).
+    Which one the domain made is checked, not assumed."""
 
-    def __init__(self, domain, work, count, warmup, same_host=False):
+    def __init__(self, domain, work, count, warmup, path="relayed"):
         self.domain, self.work, self.count, self.warmup = domain, work, count, warmup
-        self.name = "latency-same-host" if same_host else "latency"
+        self.name = {"same_host": "latency-same-host", "relayed": "latency",
+                     "direct": "latency-direct"}[path]
         sad = os.path.join(SDRROOT, "dom/waveforms/BenchPortLatency/BenchPortLatency.sad.xml")
-        domain.cli("install", sad, check=False)  # once for both sides
-        reply, _ = domain.cli("launch", "BenchPortLatency", "--name", self.name, "--no-start",
-                              "--strategy", "pack" if same_host else "spread")
+        installed, sdr = "BenchPortLatency", []
+        if path == "direct":
+            sad, root = direct_copy(sad, work)
+            installed, sdr = "BenchPortLatencyDirect", ["--sdrroot", root]
+        domain.cli(*sdr, "install", sad, check=False)  # once for the sides that share it
+        reply, _ = domain.cli("launch", installed, "--name", self.name, "--no-start",
+                              "--strategy", "pack" if path == "same_host" else "spread")
         self.pids = {c["id"]: c["pid"] for c in reply["components"]}
         self.qos = connection_qos(domain, self.name)
         listed, _ = domain.cli("ls", "connections", self.name)
-        made = [c.get("provides_state", {}).get("same_host", False)
+        made = [connection_path(c.get("provides_state", {}))
                 for c in listed.get("connections", [])]
-        if not made or any(m != same_host for m in made):
-            raise RuntimeError(f"{self.name}: connections are not all "
-                               f"{'same-host' if same_host else 'over DDS'}: {listed}")
+        if not made or any(m != path for m in made):
+            raise RuntimeError(f"{self.name}: connections are not all {path}: {listed}")
         domain.cli("configure", f"{self.name}/BenchPing_1", f"count={count}", f"warmup={warmup}")
         self.cpu_us = 0.0
         self.round_trips = 0
@@ -162,6 +169,35 @@ class LatencyRsca:
 
     def close(self):
         self.domain.cli("release", self.name, check=False)
+
+
+def connection_path(state):
+    """How a connection end is carried, from its state in `rsca ls connections`."""
+    if state.get("relayed"):
+        return "relayed"
+    return "same_host" if state.get("same_host") else "direct"
+
+
+def direct_copy(sad, work):
+    """The latency SAD with its connections asking for direct DDS, under its own name, in an SDR
+    root of its own in `work` whose components are those of tests/bench/profiles. Returns the
+    SAD's path and the SDR root."""
+    with open(sad) as f:
+        text = f.read()
+    text = text.replace('name="BenchPortLatency"', 'name="BenchPortLatencyDirect"')
+    text = text.replace("0d7c7d0e-5b7a-4c55-9d54-6f0f6a1b2c01",
+                        "0d7c7d0e-5b7a-4c55-9d54-6f0f6a1b2c02")
+    text = text.replace("    </connectinterface>",
+                        '      <qos transport="direct"/>\n    </connectinterface>')
+    sdr = os.path.join(work, "sdr-direct")
+    folder = os.path.join(sdr, "dom/waveforms/BenchPortLatencyDirect")
+    os.makedirs(folder, exist_ok=True)
+    if not os.path.exists(os.path.join(sdr, "dom/components")):
+        os.symlink(os.path.join(SDRROOT, "dom/components"), os.path.join(sdr, "dom/components"))
+    out = os.path.join(folder, "BenchPortLatencyDirect.sad.xml")
+    with open(out, "w") as f:
+        f.write(text)
+    return out, sdr
 
 
 class RawPingSide:
@@ -279,4 +315,4 @@ class LatencyRaw(RawPingSide):
 # The latency benchmark's sides: the rsca components on two nodes (over DDS) and on one (through
 # its shared memory), the raw programs with a waitset (the baseline of the ratio lines), the raw
 # programs woken the way rsca's receive loop wakes, and a raw iceoryx ping-pong.
-SIDES = ("rsca", "rsca_same_host", "raw", "raw_listener", "iceoryx")
+SIDES = ("rsca", "rsca_direct", "rsca_same_host", "raw", "raw_listener", "iceoryx")
