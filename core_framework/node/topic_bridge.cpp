@@ -223,6 +223,18 @@ void TopicBridge::run() {
 
 namespace {
 
+// An entity a DDS create call returned, and its instance handle: how its peers' statuses and
+// samples name it (the relay skips its own).
+tl::expected<std::pair<dds::Entity, dds_instance_handle_t>, std::string>
+created(dds_entity_t result, const std::string &what) {
+  auto entity = dds::checked(result, what);
+  if (!entity)
+    return tl::unexpected(entity.error().to_string());
+  dds_instance_handle_t handle = 0;
+  dds_get_instance_handle(entity->get(), &handle);
+  return std::pair{std::move(*entity), handle};
+}
+
 tl::expected<dds::Qos, std::string> relay_qos(const RelayRoute &route) {
   auto qos = dds::qos_from_json(route.qos);
   if (!qos)
@@ -256,15 +268,12 @@ tl::expected<void, std::string> open_out(TopicBridge::Relay &r, dds_entity_t par
   r.out_convert = component::RecordRelay::of(type);
   Listener listener(dds_create_listener(&r));
   dds_lset_publication_matched(listener.get(), on_publication_matched);
-  auto writer =
-      dds::checked(dds_create_writer(participant, r.topic.get(), qos->get(), listener.get()),
-                   fmt::format("creating the relay's writer on topic \"{}\"", route.topic));
+  auto writer = created(dds_create_writer(participant, r.topic.get(), qos->get(), listener.get()),
+                        fmt::format("creating the relay's writer on topic \"{}\"", route.topic));
   if (!writer)
-    return tl::unexpected(writer.error().to_string());
-  dds_instance_handle_t handle = 0;
-  if (dds_get_instance_handle(writer->get(), &handle) == 0)
-    r.own_writer.store(handle);
-  r.writer = std::move(*writer);
+    return tl::unexpected(writer.error());
+  r.own_writer.store(writer->second);
+  r.writer = std::move(writer->first);
   r.recount.store(true);
   return {};
 }
@@ -287,15 +296,12 @@ tl::expected<void, std::string> open_in(TopicBridge::Relay &r, dds_entity_t part
   dds_lset_data_available(listener.get(), on_data_available);
   dds_lset_subscription_matched(listener.get(), on_subscription_matched);
   dds_lset_liveliness_changed(listener.get(), on_liveliness_changed);
-  auto reader =
-      dds::checked(dds_create_reader(participant, r.topic.get(), qos->get(), listener.get()),
-                   fmt::format("creating the relay's reader on topic \"{}\"", route.topic));
+  auto reader = created(dds_create_reader(participant, r.topic.get(), qos->get(), listener.get()),
+                        fmt::format("creating the relay's reader on topic \"{}\"", route.topic));
   if (!reader)
-    return tl::unexpected(reader.error().to_string());
-  dds_instance_handle_t handle = 0;
-  if (dds_get_instance_handle(reader->get(), &handle) == 0)
-    r.own_reader.store(handle);
-  r.reader = std::move(*reader);
+    return tl::unexpected(reader.error());
+  r.own_reader.store(reader->second);
+  r.reader = std::move(reader->first);
   r.recount.store(true);
   return {};
 }
