@@ -257,6 +257,13 @@ def bench_fanout(args):
                       "not received by every subscriber")
         if busy_note(e):
             print(f"{n} subscribers: {busy_note(e)}")
+        publisher = e["rsca"].get("publisher", {})
+        if publisher.get("launch_cli_ms"):
+            # The set-up: every launch of the run's applications (CLI wall clock), and the
+            # channel's part of it (the domain's connect steps).
+            connect = sum(s.get("connect", 0) for s in publisher.get("launch_steps_ms", []))
+            print(f"{n} subscribers: set up in {sum(publisher['launch_cli_ms']):.0f} ms over "
+                  f"{len(publisher['launch_cli_ms'])} launch(es), connect steps {connect:.0f} ms")
     print()
     for n, e in entries.items():
         if "ratio_events_per_s" in e:

@@ -161,7 +161,7 @@ def fanout_rsca(domain, n, batch, schedule, work):
     for path in [pub_out] + subs_out:
         if os.path.exists(path):
             os.remove(path)
-    launched, launch_ms, placement = [], [], {}
+    launched, launch_ms, placement, steps = [], [], {}, []
     try:
         for name, sad in sads:  # the subscribers first, the publisher with the last of them
             domain.cli("--sdrroot", sdr, "install", sad)
@@ -171,6 +171,7 @@ def fanout_rsca(domain, n, batch, schedule, work):
                     reply, ms = domain.cli("launch", name, "--name", name.lower(), "--strategy",
                                            "spread")
                     note_placement(placement, reply)
+                    steps.append({s["step"]: s["ms"] for s in reply.get("launch", {}).get("steps", [])})
                     break
                 except RuntimeError as e:  # rolled back by the domain: nothing is left of it
                     if attempt == LAUNCH_ATTEMPTS:
@@ -196,7 +197,7 @@ def fanout_rsca(domain, n, batch, schedule, work):
             domain.cli("uninstall", name, check=False)
     return (read_u64(pub_out), [read_u64(p) for p in subs_out], qos,
             dict(props.get("properties", props), applications=len(launched),
-                 launch_cli_ms=launch_ms, placement=placement))
+                 launch_cli_ms=launch_ms, launch_steps_ms=steps, placement=placement))
 
 
 def note_placement(placement, reply):
