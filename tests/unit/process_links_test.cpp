@@ -8,7 +8,9 @@
 
 #include "control/link_socket.hpp"
 #include "link_peer.hpp"
+#include "node/host_data.hpp"
 #include "node/process_links.hpp"
+#include "protocol/component_ops.hpp"
 #include "test_domain.hpp"
 
 using namespace rsca;
@@ -31,11 +33,11 @@ struct LinksRig {
   std::vector<control::AnnouncementEvent> heard;
   std::mutex heard_mutex;
 
-  LinksRig() {
+  explicit LinksRig(node::HostData *host_data = nullptr) {
     auto n = control::Endpoint::open(participant, kLinkingNode);
     REQUIRE(n.has_value());
     node = std::move(*n);
-    auto l = node::ProcessLinks::start(*node);
+    auto l = node::ProcessLinks::start(*node, host_data);
     REQUIRE(l.has_value());
     links = std::move(*l);
     control::EndpointOptions options;
@@ -159,4 +161,46 @@ TEST_CASE("process links: a process's own call is made on DDS by its node", "[pr
   REQUIRE(reply->status == 0);
   CHECK(reply->body.at("echo").at("n") == 7);
   CHECK(reply->body.at("from") == kLinkingNode); // the node made it
+}
+
+TEST_CASE("process links: a relayed connect that asks for shared memory gets its ring from the "
+          "host's data, which lets the end go with the process",
+          "[process-links]") {
+  auto data = node::HostData::create(64 << 20).value();
+  LinksRig rig(data.get());
+  rig.caller->route(kLinkedChild, kLinkingNode);
+  protocol::component::ConnectRequest connect;
+  connect.connection = "c1";
+  connect.port = "in";
+  connect.direction = "provides";
+  connect.repid = "IDL:rsca/SampleSeq:1.0";
+  connect.topic = "t_topic_c1";
+  connect.shared_memory = true;
+  auto answer = [&](int status) {
+    auto frame = rig.process->next();
+    auto *request = std::get_if<link_msgs::Request>(&frame);
+    REQUIRE(request != nullptr);
+    auto relayed = protocol::decode<protocol::component::ConnectRequest>(request->body);
+    REQUIRE(relayed.has_value());
+    REQUIRE(relayed->ring.has_value()); // the node added the ring it made
+    CHECK(relayed->ring->offset != 0);
+    REQUIRE(rig.process->writer->send(
+        link_msgs::Reply{request->id, status, status == 0 ? "" : "refused", {}}));
+  };
+  // Made: the end is counted once the process said so.
+  auto made = rig.caller->call(kLinkedChild, "component.connect", protocol::encode(connect), 10s);
+  answer(0);
+  REQUIRE(made.get().has_value());
+  CHECK(data->counts().rings == 1);
+  CHECK(data->counts().ends == 1);
+  // Refused by the process: its new end goes, the one it had stays.
+  auto refused =
+      rig.caller->call(kLinkedChild, "component.connect", protocol::encode(connect), 10s);
+  answer(static_cast<int>(protocol::Status::Failed));
+  CHECK_FALSE(refused.get().has_value());
+  CHECK(data->counts().ends == 1);
+  // The process ends: its end and the ring go.
+  rig.links->detach(4242);
+  CHECK(data->counts().ends == 0);
+  CHECK(data->counts().rings == 0);
 }
