@@ -27,7 +27,7 @@ public:
         [this, writer] {
           const auto wire = port::wire::to_wire(value_);
           if (const dds_return_t rc = dds_write(writer, &wire); rc < 0)
-            spdlog::warn("relay to DDS: a write failed: {}", dds_strretcode(rc));
+            note_failure("relay to DDS: a write failed", dds_strretcode(rc));
         });
   }
 
@@ -52,7 +52,7 @@ public:
         if (written)
           ++relayed;
         else
-          spdlog::warn("relay from DDS: a sample is dropped: {}", written.error());
+          note_failure("relay from DDS: a sample is dropped", written.error());
       }
       dds_return_loan(reader, samples, n);
       if (static_cast<std::uint32_t>(n) < kRelayBatch)
@@ -61,7 +61,16 @@ public:
   }
 
 private:
+  // A failure that repeats with every sample (one too large for the ring) is logged at its 1st,
+  // 2nd, 4th, 8th... occurrence, with the count: the log says it goes on without flooding.
+  void note_failure(const char *what, const std::string &why) {
+    const std::uint64_t n = ++failures_;
+    if ((n & (n - 1)) == 0)
+      spdlog::warn("{}: {} ({} so far)", what, why, n);
+  }
+
   T value_; // reused from sample to sample: its buffers keep their capacity
+  std::uint64_t failures_ = 0;
 };
 
 } // namespace
