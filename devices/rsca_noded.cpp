@@ -42,6 +42,10 @@ int main(int argc, char **argv) {
                  "Folders where component executables named without a path are looked for "
                  "(default: this program's folder)");
   app.add_option("--log-dir", log_dir, "Component logs go here")->capture_default_str();
+  std::string control_socket;
+  app.add_option("--control-socket", control_socket,
+                 "A Unix socket where local clients (the CLI) reach the domain through this node "
+                 "instead of DDS (default: none)");
   app.add_option("--log-level", level, "trace, debug, info, warn, error")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   spdlog::set_level(spdlog::level::from_str(level));
@@ -56,6 +60,8 @@ int main(int argc, char **argv) {
   if (options.exec_path.empty())
     options.exec_path.push_back(own_folder());
   options.log_dir = log_dir;
+  if (!control_socket.empty())
+    options.control_socket = control_socket;
 
   rsca::node::DeviceRegistry registry;
   rsca::gpp::register_gpp(registry);

@@ -18,6 +18,7 @@
 #include "control.h" // generated from dds/control.idl
 #include "control/partition_writers.hpp"
 #include "control/worker_pool.hpp"
+#include "protocol/addresses.hpp"
 
 namespace rsca::control {
 
@@ -205,13 +206,18 @@ void Endpoint::Impl::take_replies() {
       if (!infos[i].valid_data)
         continue;
       const auto *r = static_cast<const rsca_ctl_Reply *>(samples[i]);
+      // A CLI client also reads the replies to the others (they share one way): not parsed.
+      if (!is_call_of(address, r->id))
+        continue;
       if (r->status != static_cast<std::int32_t>(Status::Ok)) {
         // A status this version does not know is a failure all the same, said as it came.
         auto error = protocol::is_known(r->status)
                          ? call_error(static_cast<Status>(r->status), str(r->error))
                          : call_error(Status::Failed,
                                       fmt::format("status {}: {}", r->status, str(r->error)));
-        error.value().details = protocol::details_of_text(str(r->body));
+        const Json error_body = parse_body(r->body);
+        error.value().details = protocol::details_of(error_body);
+        error.value().maybe_received = protocol::maybe_received_of(error_body);
         complete(str(r->id), std::move(error));
         continue;
       }
@@ -229,9 +235,7 @@ Endpoint::Endpoint(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 
 Expected<std::unique_ptr<Endpoint>> Endpoint::open(std::shared_ptr<dds::Participant> participant,
                                                    std::string address, EndpointOptions options) {
-  auto invalid = [](const std::string &a) {
-    return a.empty() || a.find_first_of("*?[]\\") != std::string::npos;
-  };
+  auto invalid = [](const std::string &a) { return a.empty() || !protocol::is_plain_address(a); };
   for (const auto &a : options.aliases)
     if (invalid(a))
       return make_error({"control", 0, 0}, "address",

@@ -24,14 +24,22 @@ void Endpoint::Impl::take_announcements() {
     const AnnouncementHandler &handler = options.on_announcement;
     for (dds_return_t i = 0; i < n; ++i) {
       const auto *a = static_cast<const rsca_ctl_Announcement *>(samples[i]);
+      const std::string announcer = str(a->announcer);
       AnnouncementEvent event;
-      event.address = str(a->address);
       if (infos[i].valid_data && infos[i].instance_state == DDS_IST_ALIVE) {
         event.kind = AnnouncementEvent::Kind::Alive;
+        event.address = str(a->address);
         event.endpoint_kind = str(a->kind);
         event.body = parse_body(a->body);
+        // The slot held another address: that one was withdrawn, its disposal overwritten.
+        if (auto before = heard_slots.heard(announcer, a->slot, event.address))
+          handler(AnnouncementEvent{AnnouncementEvent::Kind::Gone, std::move(*before), {}, {}});
       } else if (infos[i].instance_state != DDS_IST_ALIVE) {
+        auto went = heard_slots.gone(announcer, a->slot);
+        if (!went)
+          continue; // a slot freed before this endpoint heard it
         event.kind = AnnouncementEvent::Kind::Gone;
+        event.address = std::move(*went);
       } else {
         continue;
       }
@@ -67,6 +75,8 @@ Expected<void> Endpoint::Impl::announce(const std::string &as, const std::string
   }
   const std::string text = body.dump();
   rsca_ctl_Announcement a{};
+  a.announcer = const_cast<char *>(address.c_str());
+  a.slot = announcer_slots.slot_for(as);
   a.address = const_cast<char *>(as.c_str());
   a.kind = const_cast<char *>(kind.c_str());
   a.body = const_cast<char *>(text.c_str());
@@ -79,13 +89,17 @@ void Endpoint::Impl::withdraw(const std::string &as) {
   std::lock_guard lock(announcement_mutex);
   if (!announcement_writer)
     return;
+  const auto slot = announcer_slots.release(as);
+  if (!slot)
+    return;
   rsca_ctl_Announcement a{};
-  a.address = const_cast<char *>(as.c_str());
+  a.announcer = const_cast<char *>(address.c_str());
+  a.slot = *slot;
+  a.address = const_cast<char *>("");
   a.kind = const_cast<char *>("");
   a.body = const_cast<char *>("");
   dds_dispose(announcement_writer.get(), &a);
-  // And let go of the instance: a node announces every component it relays on its one writer,
-  // whose disposed instances Cyclone would otherwise keep for the node's whole life.
+  // And let go of the instance, so that readers see it without writers until the slot is reused.
   dds_unregister_instance(announcement_writer.get(), &a);
 }
 

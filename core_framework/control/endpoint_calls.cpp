@@ -183,7 +183,7 @@ std::future<CallResult<Json>> Endpoint::call(const std::string &target,
   std::string id;
   {
     std::lock_guard lock(impl_->state_mutex);
-    id = fmt::format("{}#{}", impl_->address, ++impl_->next_id);
+    id = call_id(impl_->address, ++impl_->next_id);
     Impl::Pending pending{{}, Clock::now() + timeout, target, operation};
     future = pending.promise.get_future();
     impl_->pending.emplace(id, std::move(pending));

@@ -13,11 +13,13 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <thread>
 #include <vector>
 
 #include <fmt/format.h>
 
+#include "control/announcement_slots.hpp"
 #include "control/endpoint.hpp"
 #include "control/handler_table.hpp"
 #include "control/partition_writers.hpp"
@@ -92,6 +94,17 @@ inline Json parse_body(const char *text) {
   return Json::parse(text, nullptr, /*allow_exceptions=*/false);
 }
 
+// A call's id: "<caller's address>#<sequence>", unique per caller.
+inline std::string call_id(const std::string &caller, std::uint64_t sequence) {
+  return fmt::format("{}#{}", caller, sequence);
+}
+
+inline bool is_call_of(const std::string &caller, const char *id) {
+  const std::string_view text = id != nullptr ? id : "";
+  return text.size() > caller.size() && text.compare(0, caller.size(), caller) == 0 &&
+         text[caller.size()] == '#';
+}
+
 inline std::string str(const char *text) {
   return text != nullptr ? std::string(text) : std::string();
 }
@@ -116,7 +129,9 @@ struct Endpoint::Impl {
   dds::Entity request_reader, reply_reader, announcement_reader;
   dds::Entity waitset, guard;
   dds::Entity announcement_writer;
-  std::mutex announcement_mutex; // guards announcement_writer
+  std::mutex announcement_mutex; // guards announcement_writer and announcer_slots
+  AnnouncerSlots announcer_slots;
+  HeardSlots heard_slots; // receive thread only
 
   std::unique_ptr<PartitionWriters> request_ways, reply_ways;
   std::mutex routes_mutex;

@@ -5,7 +5,10 @@
 
 #include <fmt/format.h>
 #include <sys/socket.h>
+#include <sys/stat.h>
 #include <sys/time.h>
+#include <sys/un.h>
+#include <unistd.h>
 
 namespace rsca::control {
 
@@ -22,6 +25,7 @@ protocol::CallResult<nlohmann::json> reply_result(const link::Reply &reply) {
           ? call_error(static_cast<Status>(reply.status), reply.error)
           : call_error(Status::Failed, fmt::format("status {}: {}", reply.status, reply.error));
   error.value().details = protocol::details_of(reply.body);
+  error.value().maybe_received = protocol::maybe_received_of(reply.body);
   return error;
 }
 
@@ -37,6 +41,56 @@ tl::expected<std::pair<process::Fd, process::Fd>, std::string> make_link_pair() 
   if (::socketpair(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0, fds) != 0)
     return tl::unexpected(fmt::format("socketpair: {}", std::strerror(errno)));
   return std::pair{process::Fd(fds[0]), process::Fd(fds[1])};
+}
+
+namespace {
+
+tl::expected<sockaddr_un, std::string> unix_address(const std::string &path) {
+  sockaddr_un address{};
+  address.sun_family = AF_UNIX;
+  if (path.empty() || path.size() >= sizeof(address.sun_path))
+    return tl::unexpected(fmt::format("\"{}\" cannot name a Unix socket (1 to {} bytes)", path,
+                                      sizeof(address.sun_path) - 1));
+  std::memcpy(address.sun_path, path.data(), path.size());
+  return address;
+}
+
+} // namespace
+
+tl::expected<process::Fd, std::string> listen_for_links(const std::string &path) {
+  auto address = unix_address(path);
+  if (!address)
+    return tl::unexpected(address.error());
+  process::Fd fd(::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0));
+  if (!fd)
+    return tl::unexpected(fmt::format("socket: {}", std::strerror(errno)));
+  // A socket file nobody accepts on was left by a node that died: replaced. One that accepts is
+  // another's.
+  if (process::Fd probe(::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0)); probe) {
+    if (::connect(probe.get(), reinterpret_cast<const sockaddr *>(&*address), sizeof(*address)) ==
+        0)
+      return tl::unexpected(fmt::format("{}: another process listens there", path));
+    if (errno == ECONNREFUSED)
+      ::unlink(path.c_str());
+  }
+  if (::bind(fd.get(), reinterpret_cast<const sockaddr *>(&*address), sizeof(*address)) != 0)
+    return tl::unexpected(fmt::format("bind {}: {}", path, std::strerror(errno)));
+  ::chmod(path.c_str(), 0660);
+  if (::listen(fd.get(), 64) != 0)
+    return tl::unexpected(fmt::format("listen {}: {}", path, std::strerror(errno)));
+  return fd;
+}
+
+tl::expected<process::Fd, std::string> connect_link(const std::string &path) {
+  auto address = unix_address(path);
+  if (!address)
+    return tl::unexpected(address.error());
+  process::Fd fd(::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0));
+  if (!fd)
+    return tl::unexpected(fmt::format("socket: {}", std::strerror(errno)));
+  if (::connect(fd.get(), reinterpret_cast<const sockaddr *>(&*address), sizeof(*address)) != 0)
+    return tl::unexpected(fmt::format("connect {}: {}", path, std::strerror(errno)));
+  return fd;
 }
 
 LinkWriter::LinkWriter(int fd, std::chrono::milliseconds timeout) : fd_(fd) {

@@ -25,6 +25,14 @@ protocol::link::Reply link_reply(const std::string &id,
 // process it starts (the spawn hands it over as kNodeLinkFd).
 tl::expected<std::pair<process::Fd, process::Fd>, std::string> make_link_pair();
 
+// The node's control socket: a Unix stream socket at `path` that local clients (the CLI) connect
+// to for a link of their own, instead of joining DDS (node/process_links.hpp). A stale socket file
+// (nobody accepts on it) is replaced, a live one is refused; the file is made mode 0660, so the
+// node's user and group may connect.
+tl::expected<process::Fd, std::string> listen_for_links(const std::string &path);
+// A client's link to the node listening at `path`, close-on-exec.
+tl::expected<process::Fd, std::string> connect_link(const std::string &path);
+
 // Writes frames to a link, whole, from any thread. The socket is blocking with a send timeout:
 // a peer that stops reading fails a write after `timeout`, never holds its writer forever; a
 // frame cut by that ends the link (shutdown), since the stream can no longer be read.

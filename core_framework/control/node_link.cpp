@@ -114,8 +114,10 @@ void NodeLink::Impl::complete(const std::string &id, CallResult<Json> result) {
 void NodeLink::Impl::fail_all(const std::string &why) {
   std::lock_guard lock(mutex);
   closed = true;
+  // Each was sent to the node, which may have made it: the caller cannot know its outcome.
   for (auto &[id, p] : pending)
-    p.promise.set_value(call_error(Status::Unavailable, why));
+    p.promise.set_value(
+        tl::unexpected(CallError{Status::Unavailable, why, /*maybe_received=*/true}));
   pending.clear();
 }
 

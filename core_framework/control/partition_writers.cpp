@@ -5,6 +5,8 @@
 
 #include <fmt/format.h>
 
+#include "protocol/addresses.hpp"
+
 namespace rsca::control {
 namespace {
 
@@ -28,6 +30,40 @@ bool readers_left(dds_entity_t writer) {
          status.current_count == 0;
 }
 
+// Whether one of the writer's matched readers reads in `partition` (not merely in one its
+// wildcard partition matches).
+bool matched_reader_in(dds_entity_t writer, const std::string &partition) {
+  constexpr std::size_t kMaxLooked = 256;
+  dds_instance_handle_t handles[kMaxLooked];
+  const dds_return_t n = dds_get_matched_subscriptions(writer, handles, kMaxLooked);
+  for (dds_return_t i = 0; i < n && i < static_cast<dds_return_t>(kMaxLooked); ++i) {
+    dds_builtintopic_endpoint_t *reader = dds_get_matched_subscription_data(writer, handles[i]);
+    if (reader == nullptr)
+      continue;
+    std::uint32_t count = 0;
+    char **names = nullptr;
+    bool found = false;
+    if (dds_qget_partition(reader->qos, &count, &names)) {
+      for (std::uint32_t k = 0; k < count; ++k) {
+        found = found || partition == names[k];
+        dds_free(names[k]);
+      }
+      dds_free(names);
+    }
+    dds_builtintopic_free_endpoint(reader);
+    if (found)
+      return true;
+  }
+  return false;
+}
+
+bool matched(dds_entity_t writer, const std::string &partition, bool shared) {
+  if (shared)
+    return matched_reader_in(writer, partition);
+  dds_publication_matched_status_t status{};
+  return dds_get_publication_matched_status(writer, &status) == 0 && status.current_count > 0;
+}
+
 } // namespace
 
 PartitionWriters::PartitionWriters(dds_entity_t participant, dds_entity_t topic,
@@ -35,11 +71,16 @@ PartitionWriters::PartitionWriters(dds_entity_t participant, dds_entity_t topic,
     : participant_(participant), topic_(topic), qos_(copy_of(qos)) {}
 
 CallResult<dds_entity_t> PartitionWriters::writer_for(const std::string &partition) {
+  if (!protocol::is_plain_address(partition))
+    return call_error(Status::BadRequest,
+                      fmt::format("\"{}\" is no address: it holds '*' or '?'", partition));
+  const auto shared = protocol::cli_clients_partition(partition);
+  const std::string &way = shared ? *shared : partition;
   std::lock_guard lock(mutex_);
-  if (auto it = ways_.find(partition); it != ways_.end())
+  if (auto it = ways_.find(way); it != ways_.end())
     return it->second.writer.get();
   drop_departed_locked();
-  auto pqos = partition_qos(partition);
+  auto pqos = partition_qos(way);
   auto publisher =
       dds::checked(dds_create_publisher(participant_, pqos.get(), nullptr), "creating a publisher");
   if (!publisher)
@@ -50,7 +91,7 @@ CallResult<dds_entity_t> PartitionWriters::writer_for(const std::string &partiti
     return call_error(Status::Failed, writer.error().to_string());
   dds_set_status_mask(writer->get(), DDS_PUBLICATION_MATCHED_STATUS);
   const dds_entity_t handle = writer->get();
-  ways_.emplace(partition, Way{std::move(*publisher), std::move(*writer)});
+  ways_.emplace(way, Way{std::move(*publisher), std::move(*writer), shared.has_value()});
   return handle;
 }
 
@@ -60,11 +101,11 @@ CallResult<dds_entity_t> PartitionWriters::matched_writer(const std::string &par
   auto writer = writer_for(partition);
   if (!writer)
     return writer;
+  const bool shared = protocol::cli_clients_partition(partition).has_value();
   dds::Entity waitset(dds_create_waitset(participant_));
   dds_waitset_attach(waitset.get(), *writer, *writer);
   for (;;) {
-    dds_publication_matched_status_t status{};
-    if (dds_get_publication_matched_status(*writer, &status) == 0 && status.current_count > 0)
+    if (matched(*writer, partition, shared))
       return writer;
     const auto left = deadline - Clock::now();
     if (left <= Clock::duration::zero() || stopping.load())
@@ -78,14 +119,14 @@ CallResult<dds_entity_t> PartitionWriters::matched_writer(const std::string &par
 
 void PartitionWriters::erase(const std::string &partition) {
   std::lock_guard lock(mutex_);
-  ways_.erase(partition);
+  ways_.erase(partition); // a shared way is named by its pattern, never by a caller's address
 }
 
 std::set<std::string> PartitionWriters::departed() const {
   std::lock_guard lock(mutex_);
   std::set<std::string> gone;
   for (const auto &[partition, way] : ways_)
-    if (readers_left(way.writer.get()))
+    if (!way.shared && readers_left(way.writer.get()))
       gone.insert(partition);
   return gone;
 }
@@ -96,7 +137,9 @@ std::size_t PartitionWriters::size() const {
 }
 
 void PartitionWriters::drop_departed_locked() {
-  std::erase_if(ways_, [](const auto &entry) { return readers_left(entry.second.writer.get()); });
+  std::erase_if(ways_, [](const auto &entry) {
+    return !entry.second.shared && readers_left(entry.second.writer.get());
+  });
 }
 
 } // namespace rsca::control

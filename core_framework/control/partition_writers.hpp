@@ -5,6 +5,12 @@
 // the daemon holds writers for the endpoints alive and not one per caller it ever had (issue 18,
 // defect 5: 10-13 KB per CLI command, never given back).
 //
+// A CLI client's address is the exception: all of them share one way, a writer in the wildcard
+// partition that matches every CLI address (protocol::cli_clients_partition), kept for good.
+// Cyclone keeps each endpoint's discovery instance after the endpoint is deleted (~370 B), so a
+// writer per command would still grow the daemon for ever. A reply there reaches every CLI reading
+// at the time; each takes only the replies to its own calls (by id).
+//
 // "Left" is DDS's own word for it: the writer was matched and is matched no longer, because the
 // endpoint there exited, withdrew its reader, or lost its participant's lease. The endpoint asks
 // the same question of the calls it has sent (departed()), so that a caller whose addressee died
@@ -30,10 +36,12 @@ public:
   // Writers of `topic` with QoS `qos` (copied), under publishers of `participant`.
   PartitionWriters(dds_entity_t participant, dds_entity_t topic, const dds_qos_t *qos);
 
-  // The writer into `partition`, made when there is none yet (and then the ways whose readers
-  // left are dropped).
+  // The writer into `partition` (the shared one for a CLI client's), made when there is none yet
+  // (and then the ways whose readers left are dropped). BadRequest for a partition with
+  // wildcards: a caller cannot have its replies sent to everyone.
   CallResult<dds_entity_t> writer_for(const std::string &partition);
-  // The same, once a reader in that partition is matched: volatile data written before the
+  // The same, once a reader in that partition is matched (in a shared way: a reader whose own
+  // partition is `partition`): volatile data written before the
   // match would be lost. Unavailable at `deadline`, or as soon as `stopping` is set.
   CallResult<dds_entity_t> matched_writer(const std::string &partition, Clock::time_point deadline,
                                           const std::atomic<bool> &stopping);
@@ -47,6 +55,7 @@ private:
   struct Way {
     dds::Entity publisher; // carries the partition
     dds::Entity writer;
+    bool shared = false; // the CLI clients' way: never dropped
   };
 
   // Drops the ways whose readers left. Called with mutex_ held.

@@ -273,6 +273,9 @@ DeviceManager::create(std::shared_ptr<dds::Participant> participant, NodeOptions
   if (auto ok = impl->endpoint->announce("node", protocol::encode(impl->announcement())); !ok)
     return tl::unexpected(ok.error());
   spdlog::info("node {} announced with {} device(s)", impl->dcd->name, impl->devices.size());
+  if (impl->options.control_socket)
+    if (auto ok = impl->links->listen(impl->options.control_socket->string()); !ok)
+      return tl::unexpected(ok.error());
   return std::unique_ptr<DeviceManager>(new DeviceManager(std::move(impl)));
 }
 

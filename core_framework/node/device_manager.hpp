@@ -19,6 +19,9 @@ struct NodeOptions {
   std::string domain_name = "rsca";
   std::vector<std::filesystem::path> exec_path;
   std::filesystem::path log_dir = "/tmp/rsca/logs";
+  // Where local clients (the CLI) connect for a link to the node (ProcessLinks::listen); none:
+  // they use DDS.
+  std::optional<std::filesystem::path> control_socket;
 };
 
 class DeviceManager {

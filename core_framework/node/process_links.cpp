@@ -17,6 +17,8 @@
 #include <spdlog/spdlog.h>
 #include <sys/epoll.h>
 #include <sys/eventfd.h>
+#include <sys/socket.h>
+#include <unistd.h>
 
 #include "control/link_socket.hpp"
 #include "control/worker_pool.hpp"
@@ -39,12 +41,18 @@ namespace {
 constexpr std::chrono::seconds kRelayBound{60};
 // A process's own call is given what it asks for, up to this.
 constexpr std::chrono::seconds kCallBound{30};
+// A client's (a CLI's launch waits six times its --timeout-ms), up to this.
+constexpr std::chrono::minutes kClientCallBound{10};
+// Clients connected at once, at most: one more is closed at once.
+constexpr std::size_t kMaxClients = 64;
 
 } // namespace
 
-// One process the node started, and its link.
+// One process the node started, and its link; or a client on the control socket (a CLI), which
+// may only make calls.
 struct LinkedProcess {
   pid_t pid = 0;
+  bool client = false;
   process::Fd fd;
   std::unique_ptr<control::LinkWriter> writer;
   control::FrameReader reader;
@@ -59,13 +67,16 @@ struct ProcessLinks::Impl {
   HostData *host_data = nullptr;
   process::Fd epoll;
   process::Fd wake;
+  process::Fd listener; // the control socket, when the node has one
+  std::string listener_path;
   std::thread thread;
   std::unique_ptr<control::WorkerPool> outgoing; // the processes' own calls
   std::atomic<bool> stopping{false};
 
   std::mutex mutex; // guards what follows
   std::map<pid_t, std::shared_ptr<LinkedProcess>> by_pid;
-  std::map<int, std::shared_ptr<LinkedProcess>> by_fd;
+  std::map<int, std::shared_ptr<LinkedProcess>> by_fd; // processes and clients
+  std::size_t clients = 0;
   std::map<std::string, std::shared_ptr<LinkedProcess>> by_address;
   struct Relayed {
     pid_t pid = 0;
@@ -86,6 +97,7 @@ struct ProcessLinks::Impl {
   void complete(const std::string &id, pid_t pid, CallResult<Json> result);
   void expire();
   void poll_loop();
+  void accept_clients();
   void read(int fd);
   void take(const std::shared_ptr<LinkedProcess> &process, link::Frame frame);
   void make_call(const std::shared_ptr<LinkedProcess> &process, link::Request request);
@@ -231,9 +243,46 @@ void ProcessLinks::Impl::poll_loop() {
       spdlog::error("process links: epoll_wait: {}", std::strerror(errno));
       return;
     }
-    for (int i = 0; i < n && !stopping; ++i)
-      if (events[i].data.fd != wake.get())
-        read(events[i].data.fd);
+    for (int i = 0; i < n && !stopping; ++i) {
+      const int fd = events[i].data.fd;
+      if (fd == listener.get())
+        accept_clients();
+      else if (fd != wake.get())
+        read(fd);
+    }
+  }
+}
+
+void ProcessLinks::Impl::accept_clients() {
+  for (;;) {
+    process::Fd fd(::accept4(listener.get(), nullptr, nullptr, SOCK_CLOEXEC));
+    if (!fd) {
+      if (errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR)
+        spdlog::warn("control socket {}: accept: {}", listener_path, std::strerror(errno));
+      return;
+    }
+    ucred peer{};
+    socklen_t size = sizeof(peer);
+    ::getsockopt(fd.get(), SOL_SOCKET, SO_PEERCRED, &peer, &size);
+    auto client = std::make_shared<LinkedProcess>();
+    client->pid = peer.pid;
+    client->client = true;
+    client->writer = std::make_unique<control::LinkWriter>(fd.get());
+    const int number = fd.get();
+    client->fd = std::move(fd);
+    std::lock_guard lock(mutex);
+    if (closed || clients >= kMaxClients) {
+      spdlog::warn("control socket {}: a client (pid {}) refused: {} connected already",
+                   listener_path, peer.pid, clients);
+      continue; // closed as it goes
+    }
+    ++clients;
+    by_fd[number] = client;
+    epoll_event event{};
+    event.events = EPOLLIN;
+    event.data.fd = number;
+    ::epoll_ctl(epoll.get(), EPOLL_CTL_ADD, number, &event);
+    spdlog::debug("control socket: client pid {} (uid {}) connected", peer.pid, peer.uid);
   }
 }
 
@@ -256,10 +305,17 @@ void ProcessLinks::Impl::read(int fd) {
   std::lock_guard lock(mutex);
   ::epoll_ctl(epoll.get(), EPOLL_CTL_DEL, fd, nullptr);
   by_fd.erase(fd);
+  if (process->client)
+    --clients;
   end(*process, why);
 }
 
 void ProcessLinks::Impl::take(const std::shared_ptr<LinkedProcess> &process, link::Frame frame) {
+  if (process->client && !std::holds_alternative<link::Request>(frame)) {
+    spdlog::warn("control socket: client pid {} sent a frame other than a request: ignored",
+                 process->pid);
+    return;
+  }
   if (auto *reply = std::get_if<link::Reply>(&frame)) {
     complete(reply->id, process->pid, control::reply_result(*reply));
   } else if (auto *request = std::get_if<link::Request>(&frame)) {
@@ -285,9 +341,10 @@ void ProcessLinks::Impl::take(const std::shared_ptr<LinkedProcess> &process, lin
 
 void ProcessLinks::Impl::make_call(const std::shared_ptr<LinkedProcess> &process,
                                    link::Request request) {
-  const auto timeout =
-      std::clamp(std::chrono::milliseconds(request.timeout_ms), std::chrono::milliseconds(1),
-                 std::chrono::milliseconds(kCallBound));
+  const auto bound = process->client ? std::chrono::milliseconds(kClientCallBound)
+                                     : std::chrono::milliseconds(kCallBound);
+  const auto timeout = std::clamp(std::chrono::milliseconds(request.timeout_ms),
+                                  std::chrono::milliseconds(1), bound);
   auto result = endpoint->call(request.target, request.operation, std::move(request.body), timeout);
   // Polled, so that closing the node does not wait for a call's whole timeout.
   while (result.wait_for(std::chrono::milliseconds(100)) != std::future_status::ready)
@@ -368,6 +425,24 @@ ProcessLinks::~ProcessLinks() {
   close();
 }
 
+Expected<void> ProcessLinks::listen(const std::string &path) {
+  std::lock_guard lock(impl_->mutex);
+  if (impl_->listener)
+    return make_error({"node", 0, 0}, "control-socket",
+                      fmt::format("listening at {} already", impl_->listener_path));
+  auto fd = control::listen_for_links(path);
+  if (!fd)
+    return make_error({"node", 0, 0}, "control-socket", fd.error());
+  impl_->listener = std::move(*fd);
+  impl_->listener_path = path;
+  epoll_event event{};
+  event.events = EPOLLIN;
+  event.data.fd = impl_->listener.get();
+  ::epoll_ctl(impl_->epoll.get(), EPOLL_CTL_ADD, impl_->listener.get(), &event);
+  spdlog::info("control socket: local clients connect at {}", path);
+  return {};
+}
+
 void ProcessLinks::attach(pid_t pid, process::Fd link, std::vector<std::string> addresses) {
   auto process = std::make_shared<LinkedProcess>();
   process->pid = pid;
@@ -438,6 +513,10 @@ void ProcessLinks::close() {
   [[maybe_unused]] auto n = ::write(impl_->wake.get(), &one, sizeof(one));
   impl_->thread.join();
   impl_->outgoing->stop();
+  if (impl_->listener) {
+    impl_->listener.reset();
+    ::unlink(impl_->listener_path.c_str());
+  }
 }
 
 } // namespace rsca::node

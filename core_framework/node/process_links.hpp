@@ -35,6 +35,12 @@ public:
   void attach(pid_t pid, process::Fd link, std::vector<std::string> addresses);
   // The process has exited and been reaped: its addresses are served no longer.
   void detach(pid_t pid);
+  // Listens at `path` (control/link_socket.hpp) for local clients: each connection is a link
+  // over which the client makes calls, which the node makes on DDS for it (a CLI thus needs no
+  // DDS participant of its own, and the daemons see no participant come and go per command). A
+  // client may not announce, withdraw or route; at most 64 are connected at once. The socket
+  // file goes with close().
+  Expected<void> listen(const std::string &path);
   // Stops relaying (calls under way fail) and lets go of the endpoint; attach and detach do
   // nothing afterwards. The destructor does it.
   void close();

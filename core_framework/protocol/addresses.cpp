@@ -36,6 +36,22 @@ std::string cli_address(std::string_view domain, std::string_view host, long pid
   return fmt::format("{}/cli/{}-{}-{}", domain, host, pid, number);
 }
 
+std::optional<std::string> cli_clients_partition(std::string_view address) {
+  constexpr std::string_view kCli = "/cli/";
+  const auto at = address.find(kCli);
+  if (at == std::string_view::npos || at == 0 || at + kCli.size() == address.size() ||
+      !is_plain_address(address))
+    return std::nullopt;
+  const std::string_view domain = address.substr(0, at);
+  if (domain.find('/') != std::string_view::npos)
+    return std::nullopt;
+  return fmt::format("{}/cli/*", domain);
+}
+
+bool is_plain_address(std::string_view address) {
+  return address.find_first_of("*?[]\\") == std::string_view::npos;
+}
+
 std::optional<std::uint64_t> incarnation_of(std::string_view address) {
   for (std::string_view kind : {"/component/", "/host/"}) {
     const auto at = address.find(kind);

@@ -34,6 +34,16 @@ std::string host_address(std::string_view domain, std::string_view application,
                          const LaunchIdentity &launch, std::string_view device);
 std::string cli_address(std::string_view domain, std::string_view host, long pid, int number);
 
+// The partition pattern that matches every CLI client of the domain of `address`, when `address`
+// is a CLI client's: a daemon answers all of them through one writer there, because each writer
+// it made and deleted would cost it memory for good (Cyclone keeps every endpoint's discovery
+// instance). Nothing for any other address.
+std::optional<std::string> cli_clients_partition(std::string_view address);
+
+// Whether `address` can name a partition: DDS reads '*' and '?' in one as wildcards (and '[',
+// ']', '\\' are kept out as other matchers read them).
+bool is_plain_address(std::string_view address);
+
 // The incarnation of the domain daemon that launched the component or host at `address`;
 // nothing for any other address.
 std::optional<std::uint64_t> incarnation_of(std::string_view address);

@@ -53,15 +53,22 @@ tl::unexpected<CallError> call_error(Status status, const Error &findings) {
 }
 
 nlohmann::json error_body_json(const CallError &error) {
-  if (error.details.empty())
-    return nlohmann::json::object();
-  return nlohmann::json{{"details", error.details}};
+  auto body = nlohmann::json::object();
+  if (!error.details.empty())
+    body["details"] = error.details;
+  if (error.maybe_received)
+    body["maybe_received"] = true;
+  return body;
 }
 
 std::string error_body(const CallError &error) {
-  if (error.details.empty())
+  if (error.details.empty() && !error.maybe_received)
     return {};
   return error_body_json(error).dump();
+}
+
+bool maybe_received_of(const nlohmann::json &body) {
+  return body.is_object() && body.value("maybe_received", false) == true;
 }
 
 std::vector<std::string> details_of_text(std::string_view body) {

@@ -51,12 +51,15 @@ inline tl::unexpected<CallError> call_error(Status status, std::string message) 
 // message is the first one's, and `details` keeps them all, so that no conversion drops one.
 tl::unexpected<CallError> call_error(Status status, const Error &findings);
 
-// The details of an error reply, as its body carries them ({"details": [...]}), and back; a body
-// without them gives none.
+// The details of an error reply, as its body carries them ({"details": [...], "maybe_received":
+// true}), and back; a body without them gives none.
 std::string error_body(const CallError &error);
 // The same as a JSON object (empty without details), for a transport that carries JSON.
 nlohmann::json error_body_json(const CallError &error);
 std::vector<std::string> details_of(const nlohmann::json &body);
+// Whether an error reply's body says the addressee may have acted on the request
+// (CallError::maybe_received): a call relayed by a node (a CLI's over its control socket) keeps it.
+bool maybe_received_of(const nlohmann::json &body);
 std::vector<std::string> details_of_text(std::string_view body);
 
 } // namespace rsca::protocol

@@ -174,7 +174,8 @@ class Domain:
             self._spawn(f"node{i}", [
                 os.path.join(bin_dir, "rsca-noded"), "--dcd",
                 os.path.join(sdrroot, f"dev/nodes/node{i}/DeviceManager.dcd.xml"), "--log-dir",
-                os.path.join(self.run_dir, "logs"), "--exec-path", bin_dir])
+                os.path.join(self.run_dir, "logs"), "--exec-path", bin_dir,
+                "--control-socket", os.path.join(self.run_dir, f"node{i}.sock")])
         deadline = time.monotonic() + 60
         while time.monotonic() < deadline:
             try:

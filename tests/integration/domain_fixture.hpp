@@ -57,8 +57,10 @@ public:
       : run_(fs::temp_directory_path() /
              fmt::format("rsca-it-{}-{}", getpid(), std::random_device{}())) {
     fs::create_directories(run_ / "logs");
+    // The run folder is the CLI's too: it reaches the domain through the nodes' sockets there.
     env_ = {{"RSCA_DDS_DOMAIN", std::to_string(rsca::test::isolated_domain_id())},
-            {"RSCA_DDS_TAG", rsca::test::isolated_tag()}};
+            {"RSCA_DDS_TAG", rsca::test::isolated_tag()},
+            {"RSCA_RUN_DIR", run_.string()}};
     start_domaind(registration_timeout_ms);
     for (const auto &dcd : dcds)
       launch_node(dcd);
@@ -124,13 +126,17 @@ public:
     return *shown;
   }
 
-  // Runs the CLI against this domain; returns its exit code and output.
-  std::pair<int, std::string> cli(const std::vector<std::string> &args) {
+  // Runs the CLI against this domain, with `more` of the environment; returns its exit code and
+  // output.
+  std::pair<int, std::string> cli(const std::vector<std::string> &args,
+                                  const ChildProcess::Environment &more = {}) {
     const fs::path out = run_ / "cli.out";
     std::vector<std::string> sh_args{"-c", "\"$0\" \"$@\" > " + out.string() + " 2>&1",
                                      (kBin / "rsca").string()};
     sh_args.insert(sh_args.end(), args.begin(), args.end());
-    ChildProcess cli("/bin/sh", sh_args, env_);
+    auto env = env_;
+    env.insert(env.end(), more.begin(), more.end());
+    ChildProcess cli("/bin/sh", sh_args, env);
     auto status = cli.wait_exit(60s);
     std::ifstream in(out);
     std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -288,7 +294,8 @@ private:
     nodes_.push_back(std::make_unique<ChildProcess>(
         (kBin / "rsca-noded").string(),
         std::vector<std::string>{"--dcd", dcd.string(), "--log-dir", (run_ / "logs").string(),
-                                 "--exec-path", kBin.string()},
+                                 "--exec-path", kBin.string(), "--control-socket",
+                                 (run_ / fmt::format("node{}.sock", nodes_.size() + 1)).string()},
         env_));
   }
 

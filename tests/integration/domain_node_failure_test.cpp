@@ -24,8 +24,11 @@ TEST_CASE("a node daemon killed during a launch fails it, and the rest is rolled
   TestDomain domain;
   domain.install("HangAtConfigure");
   // Both components land on node1 (first fit); the launch hangs in configure, and node1 dies.
+  // The CLI goes through node2's socket: the domain's reply is what is tested here (a CLI whose
+  // own node dies is the next test's).
   auto launch = std::async(std::launch::async, [&] {
-    return domain.cli({"launch", "HangAtConfigure"});
+    return domain.cli({"launch", "HangAtConfigure"},
+                      {{"RSCA_NODE_SOCKET", (domain.run_dir() / "node2.sock").string()}});
   });
   REQUIRE(TestDomain::wait_for([&] { return domain.running_pids().size() == 2; }));
   const auto pids = domain.running_pids();
@@ -39,6 +42,42 @@ TEST_CASE("a node daemon killed during a launch fails it, and the rest is rolled
   auto nodes = domain.call("domain.nodes");
   REQUIRE(nodes.has_value());
   CHECK(nodes->at("nodes").size() == 1);
+}
+
+TEST_CASE("a CLI whose node dies during its launch says the launch may still be under way",
+          "[integration][domain][failure]") {
+  TestDomain domain;
+  domain.install("HangAtConfigure");
+  auto launch = std::async(std::launch::async, [&] {
+    return domain.cli({"launch", "HangAtConfigure"},
+                      {{"RSCA_NODE_SOCKET", (domain.run_dir() / "node1.sock").string()}});
+  });
+  REQUIRE(TestDomain::wait_for([&] { return domain.running_pids().size() == 2; }));
+  const auto pids = domain.running_pids();
+  domain.kill_node(1);
+  auto [rc, out] = launch.get();
+  INFO(out);
+  CHECK(rc == 4); // unreachable
+  CHECK_THAT(out, Catch::Contains("the link to the node ended"));
+  CHECK_THAT(out, Catch::Contains("may still"));
+  // The domain finishes the failed launch on its own, without the CLI: node1 forgotten, the
+  // launch failed and rolled back, nothing stays.
+  REQUIRE(TestDomain::wait_for(
+      [&] {
+        auto nodes = domain.call("domain.nodes");
+        auto apps = domain.call("app.list");
+        auto devices = domain.call("domain.devices");
+        if (!nodes || !apps || !devices || nodes->at("nodes").size() != 1 ||
+            !apps->at("applications").empty())
+          return false;
+        for (const auto &d : devices->at("devices"))
+          for (const auto &[name, c] : d.at("capacity").items())
+            if (c.at("allocated").get<double>() != 0.0)
+              return false;
+        return true;
+      },
+      30s));
+  domain.require_clean(pids);
 }
 
 TEST_CASE("a restarted domain daemon sees every node again and keeps what was installed",

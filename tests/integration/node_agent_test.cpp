@@ -169,3 +169,50 @@ TEST_CASE("a connection that asks for direct DDS takes it on one node too",
   REQUIRE(domain.call("app.release", Json{{"app", "DirectPair"}}).has_value());
   domain.require_clean(pids);
 }
+
+TEST_CASE("the CLI reaches the domain through a node's control socket, with no DDS of its own",
+          "[integration][node-agent]") {
+  TestDomain domain(2);
+  REQUIRE(std::filesystem::is_socket(domain.run_dir() / "node1.sock"));
+  // On another DDS domain the CLI could not find the domain daemon: it answers all the same,
+  // because the CLI's calls go over the socket and the node makes them.
+  const ChildProcess::Environment elsewhere{{"RSCA_DDS_DOMAIN", "0"},
+                                            {"RSCA_DDS_TAG", "nobody-here"}};
+  auto [rc, out] = domain.cli({"--json", "ls", "nodes"}, elsewhere);
+  INFO(out);
+  REQUIRE(rc == 0);
+  CHECK(Json::parse(out).at("nodes").size() == 2);
+  // A launch and a release, progress and all, the same way.
+  auto [launched, launch_out] = domain.cli(
+      {"--json", "launch",
+       (kSource / "profiles/dom/waveforms/ProducerConsumer/ProducerConsumer.sad.xml").string()},
+      elsewhere);
+  INFO(launch_out);
+  REQUIRE(launched == 0);
+  CHECK(domain.call("app.show", Json{{"app", "ProducerConsumer"}}).has_value());
+  auto [released, release_out] = domain.cli({"release", "ProducerConsumer"}, elsewhere);
+  INFO(release_out);
+  CHECK(released == 0);
+  // With the sockets refused (RSCA_NODE_SOCKET=none) the CLI is on DDS, and on the other DDS
+  // domain it finds nobody.
+  const ChildProcess::Environment no_socket{
+      {"RSCA_DDS_DOMAIN", "0"}, {"RSCA_DDS_TAG", "nobody-here"}, {"RSCA_NODE_SOCKET", "none"}};
+  auto [unreachable, unreachable_out] =
+      domain.cli({"--timeout-ms", "500", "ls", "nodes"}, no_socket);
+  INFO(unreachable_out);
+  CHECK(unreachable != 0);
+}
+
+TEST_CASE("with its node's socket gone, the CLI tries the next and then DDS",
+          "[integration][node-agent]") {
+  TestDomain domain(2);
+  domain.kill_node(1); // its socket file stays behind, refusing connections
+  REQUIRE(std::filesystem::exists(domain.run_dir() / "node1.sock"));
+  auto [rc, out] = domain.cli({"--json", "ls", "nodes"});
+  INFO(out);
+  CHECK(rc == 0);
+  domain.kill_node(2);
+  auto [over_dds, dds_out] = domain.cli({"--json", "ls", "nodes"});
+  INFO(dds_out);
+  CHECK(over_dds == 0); // the domain daemon answers over DDS
+}

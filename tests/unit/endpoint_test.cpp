@@ -5,14 +5,20 @@
 #include <functional>
 #include <future>
 #include <mutex>
+#include <optional>
+#include <set>
 #include <string>
 #include <thread>
 #include <unistd.h>
 #include <vector>
 
 #include <catch2/catch.hpp>
+#include <fmt/format.h>
 
+#include "control.h" // generated from dds/control.idl
+#include "control/announcement_slots.hpp"
 #include "control/endpoint.hpp"
+#include "control/partition_writers.hpp"
 #include "test_domain.hpp"
 
 using namespace rsca;
@@ -508,4 +514,118 @@ TEST_CASE("an endpoint that holds requests answers none before it starts serving
   REQUIRE(reply.has_value());
   CHECK(reply->at("ok") == true);
   CHECK(client->call_sync("test/server", "fast", Json::object(), 5s).has_value());
+}
+
+TEST_CASE("announcement slots are reused once withdrawn, lowest first", "[control]") {
+  control::AnnouncerSlots slots;
+  CHECK(slots.slot_for("a") == 0);
+  CHECK(slots.slot_for("b") == 1);
+  CHECK(slots.slot_for("c") == 2);
+  CHECK(slots.slot_for("b") == 1); // an address keeps its slot while announced
+  CHECK(slots.release("b") == 1u);
+  CHECK(slots.release("a") == 0u);
+  CHECK_FALSE(slots.release("a").has_value());
+  CHECK(slots.slot_for("d") == 0);
+  CHECK(slots.slot_for("e") == 1);
+  CHECK(slots.slot_for("f") == 3);
+  CHECK(slots.size() == 4);
+}
+
+TEST_CASE("a heard slot says which address went, and which one a new address replaced",
+          "[control]") {
+  control::HeardSlots heard;
+  CHECK_FALSE(heard.heard("node1", 0, "app/a").has_value());
+  CHECK_FALSE(heard.heard("node2", 0, "app/b").has_value()); // another announcer's slot 0
+  CHECK_FALSE(heard.heard("node1", 0, "app/a").has_value()); // an update of the same address
+  CHECK(heard.heard("node1", 0, "app/c") == std::optional<std::string>("app/a"));
+  CHECK(heard.gone("node1", 0) == std::optional<std::string>("app/c"));
+  CHECK_FALSE(heard.gone("node1", 0).has_value()); // not heard since
+  CHECK(heard.gone("node2", 0) == std::optional<std::string>("app/b"));
+  CHECK(heard.size() == 0);
+}
+
+TEST_CASE("an address announced in a withdrawn address's slot ends that address for readers",
+          "[control]") {
+  auto pp = test::participant();
+  std::mutex m;
+  std::set<std::string> alive;
+  std::vector<std::string> gone;
+  control::EndpointOptions options;
+  options.on_announcement = [&](const control::AnnouncementEvent &e) {
+    std::lock_guard lock(m);
+    if (e.kind == control::AnnouncementEvent::Kind::Alive) {
+      alive.insert(e.address);
+      return;
+    }
+    alive.erase(e.address);
+    gone.push_back(e.address);
+  };
+  auto watcher = open(pp, "test/watcher", options);
+  auto node = open(pp, "test/node1");
+  REQUIRE(node->announce("test/node1/p1", "component", Json::object()).has_value());
+  REQUIRE(eventually([&] {
+    std::lock_guard lock(m);
+    return alive.count("test/node1/p1") == 1;
+  }));
+  // Withdrawn and replaced at once: the reader may see the disposal or only the new address.
+  node->withdraw("test/node1/p1");
+  REQUIRE(node->announce("test/node1/p2", "component", Json::object()).has_value());
+  REQUIRE(eventually([&] {
+    std::lock_guard lock(m);
+    return alive.count("test/node1/p2") == 1;
+  }));
+  std::lock_guard lock(m);
+  CHECK(alive == std::set<std::string>{"test/node1/p2"});
+  CHECK(gone == std::vector<std::string>{"test/node1/p1"});
+}
+
+TEST_CASE("CLI clients are answered through one shared writer, each getting its own replies",
+          "[control]") {
+  auto pp = test::participant();
+  auto domain = open(pp, "test/domain");
+  domain->on("echo",
+             [](const Json &body, const control::RequestContext &) -> control::CallResult<Json> {
+               return body;
+             });
+  std::vector<std::unique_ptr<control::Endpoint>> clients;
+  for (int i = 0; i < 3; ++i) {
+    auto client = open(pp, fmt::format("test/cli/host-1-{}", i));
+    auto reply = client->call_sync("test/domain", "echo", Json{{"n", i}}, 5s);
+    REQUIRE(reply.has_value());
+    CHECK(reply->at("n") == i);
+    clients.push_back(std::move(client));
+  }
+  CHECK(writers_into(pp, "rsca_ctl_Reply", "test/cli/*") == 1);
+  CHECK(writers_into(pp, "rsca_ctl_Reply", "test/cli/host-1-0") == 0);
+  clients.clear(); // all gone: the shared way stays
+  auto late = open(pp, "test/cli/host-1-9");
+  REQUIRE(late->call_sync("test/domain", "echo", Json::object(), 5s).has_value());
+  CHECK(writers_into(pp, "rsca_ctl_Reply", "test/cli/*") == 1);
+}
+
+TEST_CASE("reply ways: one for all CLI clients, one per other address, none for a pattern",
+          "[control]") {
+  auto pp = test::participant();
+  auto qos = dds::make_qos();
+  dds_qset_reliability(qos.get(), DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
+  dds::Entity topic(
+      dds_create_topic(pp->get(), &rsca_ctl_Reply_desc, "rsca_ctl_Reply", qos.get(), nullptr));
+  REQUIRE(topic.get() > 0);
+  control::PartitionWriters ways(pp->get(), topic.get(), qos.get());
+  auto a = ways.writer_for("test/cli/host-1-1");
+  auto b = ways.writer_for("test/cli/host-2-7");
+  auto node = ways.writer_for("test/node/node1");
+  REQUIRE(a.has_value());
+  REQUIRE(b.has_value());
+  REQUIRE(node.has_value());
+  CHECK(*a == *b);
+  CHECK(*a != *node);
+  CHECK(ways.size() == 2);
+  for (const char *pattern : {"test/cli/*", "test/node/?", "test/[ab]"}) {
+    auto refused = ways.writer_for(pattern);
+    REQUIRE_FALSE(refused.has_value());
+    CHECK(refused.error().status == control::Status::BadRequest);
+  }
+  CHECK(ways.size() == 2);
+  CHECK(writers_into(pp, "rsca_ctl_Reply", "test/cli/*") == 1);
 }

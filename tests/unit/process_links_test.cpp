@@ -4,7 +4,11 @@
 // what waits on it. The process is this test, on the other end of a real socket pair.
 #include <catch2/catch.hpp>
 
+#include <filesystem>
+#include <random>
 #include <thread>
+
+#include <unistd.h>
 
 #include "control/link_socket.hpp"
 #include "link_peer.hpp"
@@ -205,4 +209,65 @@ TEST_CASE("process links: a relayed connect that asks for shared memory gets its
   rig.links->detach(4242);
   CHECK(data->counts().ends == 0);
   CHECK(data->counts().rings == 0);
+}
+
+TEST_CASE("process links: a client of the control socket may call, not announce",
+          "[process-links]") {
+  LinksRig rig;
+  rig.caller->on("test.echo", [](const control::Json &body, const control::RequestContext &c) {
+    return control::CallResult<control::Json>(control::Json{{"echo", body}, {"from", c.sender}});
+  });
+  const auto path = std::filesystem::temp_directory_path() /
+                    fmt::format("rsca-links-{}-{}.sock", getpid(), std::random_device{}());
+  REQUIRE(rig.links->listen(path.string()).has_value());
+  CHECK_FALSE(rig.links->listen(path.string()).has_value()); // one socket per node
+  auto fd = control::connect_link(path.string());
+  REQUIRE(fd.has_value());
+  test::LinkPeer client(std::move(*fd));
+  // Frames are taken in order: the announcement is refused before the call is made.
+  REQUIRE(client.writer->send(link_msgs::Announce{kLinkedChild, "component", {{"pid", 1}}}));
+  REQUIRE(client.writer->send(
+      link_msgs::Request{"9", "t/cli/test", "test.echo", "t/cli/me", 5000, {{"n", 3}}}));
+  auto frame = client.next();
+  auto *reply = std::get_if<link_msgs::Reply>(&frame);
+  REQUIRE(reply != nullptr);
+  CHECK(reply->id == "9");
+  REQUIRE(reply->status == 0);
+  CHECK(reply->body.at("echo").at("n") == 3);
+  CHECK(reply->body.at("from") == kLinkingNode);
+  CHECK_FALSE(rig.heard_alive(kLinkedChild));
+  rig.links->close();
+  CHECK_FALSE(std::filesystem::exists(path)); // the socket file goes with the links
+}
+
+TEST_CASE("process links: a control socket path too long or in no folder is refused",
+          "[process-links]") {
+  LinksRig rig;
+  auto too_long = rig.links->listen("/tmp/" + std::string(200, 'x') + ".sock");
+  REQUIRE_FALSE(too_long.has_value());
+  CHECK_THAT(too_long.error().to_string(), Catch::Contains("Unix socket"));
+  CHECK_FALSE(rig.links->listen("/nonexistent-folder/node.sock").has_value());
+}
+
+TEST_CASE("process links: a control socket another node listens on is not taken over",
+          "[process-links]") {
+  LinksRig first, second;
+  const auto path = std::filesystem::temp_directory_path() /
+                    fmt::format("rsca-links-{}-{}.sock", getpid(), std::random_device{}());
+  REQUIRE(first.links->listen(path.string()).has_value());
+  auto taken = second.links->listen(path.string());
+  REQUIRE_FALSE(taken.has_value());
+  CHECK_THAT(taken.error().to_string(), Catch::Contains("another process listens there"));
+  CHECK(control::connect_link(path.string()).has_value()); // still the first's
+  first.links->close();
+  // Now a stale file nobody accepts on: replaced.
+  std::filesystem::path stale = path;
+  stale += ".stale";
+  {
+    auto fd = control::listen_for_links(stale.string());
+    REQUIRE(fd.has_value());
+  } // closed: the file stays
+  REQUIRE(std::filesystem::exists(stale));
+  CHECK(second.links->listen(stale.string()).has_value());
+  CHECK(control::connect_link(stale.string()).has_value());
 }

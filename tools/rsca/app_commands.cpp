@@ -248,8 +248,8 @@ int launch(const std::string &what, const std::string &name, bool no_start,
   }
   if (!reply && reply.error().maybe_received) {
     auto error = reply.error();
-    error.message += "; what it had started for this launch may still run (a domain daemon "
-                     "started again reports it: `rsca ls apps`)";
+    error.message += "; the launch may still be under way, or what it started may still run "
+                     "(`rsca ls apps` says; a domain daemon started again reports it)";
     return report_failure(global, "launch", error);
   }
   if (!reply)

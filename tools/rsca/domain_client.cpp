@@ -2,36 +2,97 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <iostream>
+#include <optional>
+#include <string_view>
 
 #include <fmt/format.h>
 
+#include <spdlog/spdlog.h>
+
 #include "commands.hpp"
+#include "control/endpoint.hpp"
+#include "control/link_socket.hpp"
+#include "control/node_link.hpp"
+#include "dds/dds_settings.hpp"
 #include "exit_codes.hpp"
 #include "protocol/addresses.hpp"
 
 namespace rsca::cli {
 
+namespace fs = std::filesystem;
+
+fs::path default_run_dir() {
+  if (const char *dir = std::getenv("RSCA_RUN_DIR"); dir != nullptr && *dir != '\0')
+    return dir;
+  return fs::temp_directory_path() /
+         fmt::format("rsca-{}-{}", getuid(), dds::DdsSettings::from_environment().domain_id);
+}
+
+std::vector<fs::path> node_sockets() {
+  if (const char *path = std::getenv("RSCA_NODE_SOCKET"); path != nullptr && *path != '\0') {
+    if (std::string_view(path) == "none")
+      return {};
+    return {path};
+  }
+  std::vector<fs::path> found;
+  std::error_code ec;
+  for (const auto &entry : fs::directory_iterator(default_run_dir(), ec))
+    if (entry.path().extension() == ".sock" && entry.is_socket(ec))
+      found.push_back(entry.path());
+  std::sort(found.begin(), found.end());
+  return found;
+}
+
+namespace {
+
+std::string own_address(const GlobalOptions &global) {
+  char host[128] = {};
+  gethostname(host, sizeof(host) - 1);
+  static std::atomic<int> counter{0};
+  return protocol::cli_address(global.domain, host, getpid(), ++counter);
+}
+
+// A link to the first node socket that accepts one.
+std::optional<DomainClient::Link> link_to_a_node(const std::string &address) {
+  for (const auto &path : node_sockets()) {
+    auto fd = control::connect_link(path.string());
+    if (!fd) {
+      spdlog::debug("node socket {}: {}", path.string(), fd.error());
+      continue;
+    }
+    auto link = control::NodeLink::open(std::move(*fd), address, /*workers=*/1);
+    if (link)
+      return DomainClient::Link{std::move(*link), path.string()};
+  }
+  return std::nullopt;
+}
+
+} // namespace
+
 Expected<DomainClient> DomainClient::connect(const GlobalOptions &global) {
+  const std::string address = own_address(global);
+  DomainClient client;
+  client.domain_ = global.domain;
+  if (auto link = link_to_a_node(address)) {
+    client.server_ = std::move(link->server);
+    client.socket_ = std::move(link->socket);
+    return client;
+  }
   auto settings = dds::DdsSettings::from_environment();
   settings.trace = "none";
   auto participant = dds::Participant::create(settings);
   if (!participant)
     return tl::unexpected(participant.error());
-  char host[128] = {};
-  gethostname(host, sizeof(host) - 1);
-  static std::atomic<int> counter{0};
-  const std::string address = protocol::cli_address(global.domain, host, getpid(), ++counter);
   auto endpoint = control::Endpoint::open(
       *participant, address,
       {.workers = 1, .senders = 4, .on_announcement = {}, .aliases = {}, .prepare_kinds = {}});
   if (!endpoint)
     return tl::unexpected(endpoint.error());
-  DomainClient client;
   client.participant_ = *participant;
-  client.endpoint_ = std::move(*endpoint);
-  client.domain_ = global.domain;
+  client.server_ = std::move(*endpoint);
   return client;
 }
 

@@ -29,12 +29,8 @@ fs::path own_folder() {
   return ec ? fs::path() : self.parent_path();
 }
 
-fs::path default_run_dir() {
-  if (const char *dir = std::getenv("RSCA_RUN_DIR"); dir != nullptr && *dir != '\0')
-    return dir;
-  return fs::temp_directory_path() /
-         fmt::format("rsca-{}-{}", getuid(), dds::DdsSettings::from_environment().domain_id);
-}
+// sockaddr_un's sun_path holds 108 bytes, the terminating zero included.
+constexpr std::size_t kMaxSocketPath = 108;
 
 fs::path default_sdrroot(const GlobalOptions &global) {
   if (!global.sdrroot.empty())
@@ -121,10 +117,16 @@ Expected<fs::path> node_dcd(int i, const fs::path &sdrroot, const fs::path &run)
 Expected<pid_t> spawn_node(const fs::path &dcd, const std::string &name, const fs::path &run,
                            const GlobalOptions &global) {
   const fs::path bin = own_folder();
-  return spawn_daemon(bin / "rsca-noded",
-                      {"--dcd", dcd.string(), "--domain", global.domain, "--log-dir",
-                       (run / "logs").string(), "--exec-path", bin.string()},
-                      run / (name + ".log"), run / (name + ".pid"));
+  std::vector<std::string> args{"--dcd",       dcd.string(), "--domain",
+                                global.domain, "--log-dir",  (run / "logs").string(),
+                                "--exec-path", bin.string()};
+  // The CLI reaches the domain through the node's socket; a path too long for one leaves the
+  // CLI on DDS.
+  if (const fs::path socket = run / (name + ".sock"); socket.string().size() < kMaxSocketPath) {
+    args.push_back("--control-socket");
+    args.push_back(socket.string());
+  }
+  return spawn_daemon(bin / "rsca-noded", args, run / (name + ".log"), run / (name + ".pid"));
 }
 
 int up(int nodes, const std::vector<std::string> &extra_dcds, const fs::path &run,
