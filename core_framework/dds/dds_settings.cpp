@@ -1,5 +1,7 @@
 #include "dds/dds_settings.hpp"
 
+#include <algorithm>
+
 #include <cctype>
 #include <cstdlib>
 #include <string_view>
@@ -71,6 +73,10 @@ DdsSettings DdsSettings::from_environment() {
   s.timing = timing_from_environment(s.timing, kPrefix);
   s.component_timing = timing_from_environment(s.component_timing, kComponentPrefix);
   s.trace = env_or("RSCA_DDS_TRACE", s.trace);
+  s.receive_buffer_kib = std::max<std::uint32_t>(
+      4 * kReceiveChunkKib,
+      static_cast<std::uint32_t>(std::min<std::uint64_t>(
+          env_number_or("RSCA_DDS_RECEIVE_BUFFER_KIB", s.receive_buffer_kib), 1U << 20)));
   s.tag = env_or("RSCA_DDS_TAG", s.tag);
   // Only characters that need no escaping in the XML configuration.
   std::erase_if(s.tag, [](char c) {
@@ -89,7 +95,8 @@ std::vector<std::pair<std::string, std::string>> DdsSettings::environment() cons
       {"RSCA_DDS_INTERFACE", interface_name},
       {"RSCA_DDS_PEER", peer},
       {"RSCA_DDS_TRACE", trace},
-      {"RSCA_DDS_TAG", tag}};
+      {"RSCA_DDS_TAG", tag},
+      {"RSCA_DDS_RECEIVE_BUFFER_KIB", std::to_string(receive_buffer_kib)}};
   for (auto &variable : timing_environment(timing, kPrefix))
     env.push_back(std::move(variable));
   for (auto &variable : timing_environment(component_timing, kComponentPrefix))
@@ -123,6 +130,8 @@ std::string cyclone_config(const DdsSettings &settings) {
   replace_all(text, "${LEASE}", fmt::format("{}ms", settings.timing.lease.count()));
   replace_all(text, "${HEARTBEAT}", fmt::format("{}ms", settings.timing.heartbeat.count()));
   replace_all(text, "${WRITER_LINGER}", fmt::format("{}ms", settings.timing.writer_linger.count()));
+  replace_all(text, "${RECEIVE_BUFFER}", fmt::format("{}KiB", settings.receive_buffer_kib));
+  replace_all(text, "${RECEIVE_CHUNK}", fmt::format("{}KiB", DdsSettings::kReceiveChunkKib));
   replace_all(text, "${TRACE}", settings.trace);
   replace_all(text, "${TAG}", settings.tag);
   return text;

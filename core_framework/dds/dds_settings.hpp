@@ -56,6 +56,13 @@ struct DdsSettings {
                 std::chrono::milliseconds(1000)};
   Timing component_timing{std::chrono::milliseconds(10000), std::chrono::milliseconds(100),
                           std::chrono::milliseconds(10)};
+  // The buffer each of Cyclone's receive threads writes incoming datagrams into, in turn, and the
+  // chunk it takes at a time. Cyclone's 1 MiB is touched page by page as traffic arrives and given
+  // back only when it is full and a new one is taken: an idle daemon's resident memory rose ~4 KB
+  // a second for minutes, up to ~2 MiB (two receive threads) before falling back. Control and
+  // relayed traffic needs far less. RSCA_DDS_RECEIVE_BUFFER_KIB sets it (at least 4 chunks).
+  std::uint32_t receive_buffer_kib = 256;
+  static constexpr std::uint32_t kReceiveChunkKib = 64;
   std::string trace = "warning";
   // Cyclone's discovery tag: participants only discover those with the same domain id and tag.
   // Tests and benchmarks give each run one of its own, so runs that happen to share a domain id
@@ -63,9 +70,9 @@ struct DdsSettings {
   std::string tag;
 
   // Defaults overridden by RSCA_DDS_DOMAIN, RSCA_DDS_INTERFACE, RSCA_DDS_PEER, RSCA_DDS_TRACE,
-  // RSCA_DDS_TAG, and for `timing` RSCA_DDS_LEASE_MS, RSCA_DDS_HEARTBEAT_MS,
-  // RSCA_DDS_WRITER_LINGER_MS (for `component_timing` the same with RSCA_DDS_COMPONENT_ instead
-  // of RSCA_DDS_).
+  // RSCA_DDS_TAG, RSCA_DDS_RECEIVE_BUFFER_KIB, and for `timing` RSCA_DDS_LEASE_MS,
+  // RSCA_DDS_HEARTBEAT_MS, RSCA_DDS_WRITER_LINGER_MS (for `component_timing` the same with
+  // RSCA_DDS_COMPONENT_ instead of RSCA_DDS_).
   static DdsSettings from_environment();
   // The variables that make a child process join the same domain with the same settings.
   std::vector<std::pair<std::string, std::string>> environment() const;

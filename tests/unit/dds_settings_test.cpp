@@ -148,3 +148,29 @@ TEST_CASE("a domain whose discovery port another socket holds is refused with th
   CHECK_THAT(participant.error().to_string(),
              Catch::Contains("is among the ephemeral ports another socket may hold"));
 }
+
+TEST_CASE("the receive buffer is 256 KiB unless the environment says, at least four chunks",
+          "[dds]") {
+  DdsSettings settings;
+  CHECK_THAT(cyclone_config(settings),
+             Catch::Contains("<ReceiveBufferSize>256KiB</ReceiveBufferSize>") &&
+                 Catch::Contains("<ReceiveBufferChunkSize>64KiB</ReceiveBufferChunkSize>"));
+  ::setenv("RSCA_DDS_RECEIVE_BUFFER_KIB", "1024", 1);
+  const auto larger = DdsSettings::from_environment();
+  ::setenv("RSCA_DDS_RECEIVE_BUFFER_KIB", "8", 1);
+  const auto too_small = DdsSettings::from_environment();
+  ::unsetenv("RSCA_DDS_RECEIVE_BUFFER_KIB");
+  CHECK(larger.receive_buffer_kib == 1024);
+  CHECK(too_small.receive_buffer_kib == 4 * DdsSettings::kReceiveChunkKib);
+  // A child process gets the same.
+  bool passed_on = false;
+  for (const auto &[name, value] : larger.environment())
+    passed_on = passed_on || (name == "RSCA_DDS_RECEIVE_BUFFER_KIB" && value == "1024");
+  CHECK(passed_on);
+  // And Cyclone takes it: a participant is made with it.
+  auto own = larger;
+  own.domain_id = rsca::test::isolated_domain_id();
+  own.tag = rsca::test::isolated_tag();
+  auto participant = rsca::dds::Participant::create(own);
+  CHECK(participant.has_value());
+}
