@@ -28,20 +28,30 @@ std::optional<std::uint32_t> AnnouncerSlots::release(const std::string &address)
 
 std::optional<std::string> HeardSlots::heard(const std::string &announcer, std::uint32_t slot,
                                              const std::string &address) {
-  auto [it, inserted] = addresses_.try_emplace({announcer, slot}, address);
+  const Slot at{announcer, slot};
+  slot_of_[address] = at;
+  auto [it, inserted] = addresses_.try_emplace(at, address);
   if (inserted || it->second == address)
     return std::nullopt;
-  std::string before = std::move(it->second);
-  it->second = address;
+  std::string before = std::exchange(it->second, address);
+  auto where = slot_of_.find(before);
+  if (where == slot_of_.end() || where->second != at)
+    return std::nullopt; // heard elsewhere since
+  slot_of_.erase(where);
   return before;
 }
 
 std::optional<std::string> HeardSlots::gone(const std::string &announcer, std::uint32_t slot) {
-  auto it = addresses_.find({announcer, slot});
+  const Slot at{announcer, slot};
+  auto it = addresses_.find(at);
   if (it == addresses_.end())
     return std::nullopt;
   std::string address = std::move(it->second);
   addresses_.erase(it);
+  auto where = slot_of_.find(address);
+  if (where == slot_of_.end() || where->second != at)
+    return std::nullopt; // heard elsewhere since
+  slot_of_.erase(where);
   return address;
 }
 

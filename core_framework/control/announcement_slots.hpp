@@ -26,6 +26,7 @@ public:
   std::uint32_t slot_for(const std::string &address);
   // Frees the slot of `address` and returns it; nothing if it had none.
   std::optional<std::uint32_t> release(const std::string &address);
+  bool has(const std::string &address) const { return slots_.contains(address); }
   std::size_t size() const { return slots_.size(); }
 
 private:
@@ -36,7 +37,8 @@ private:
 
 class HeardSlots {
 public:
-  // A slot now holds `address`; returns the address it held before, if another.
+  // A slot now holds `address`; returns the address it held before, if another that was not
+  // heard in another slot since.
   std::optional<std::string> heard(const std::string &announcer, std::uint32_t slot,
                                    const std::string &address);
   // A slot was disposed or lost its writer; returns the address it held, if any was heard.
@@ -44,7 +46,12 @@ public:
   std::size_t size() const { return addresses_.size(); }
 
 private:
-  std::map<std::pair<std::string, std::uint32_t>, std::string> addresses_;
+  using Slot = std::pair<std::string, std::uint32_t>; // announcer, slot
+  std::map<Slot, std::string> addresses_;
+  // Where each address was heard last: a take returns samples by instance, not in time order, so
+  // an address withdrawn and announced again in another slot may be heard there before its old
+  // slot's end, which then must not end it.
+  std::map<std::string, Slot> slot_of_;
 };
 
 } // namespace rsca::control

@@ -76,12 +76,16 @@ Expected<void> Endpoint::Impl::announce(const std::string &as, const std::string
   const std::string text = body.dump();
   rsca_ctl_Announcement a{};
   a.announcer = const_cast<char *>(address.c_str());
+  const bool fresh = !announcer_slots.has(as);
   a.slot = announcer_slots.slot_for(as);
   a.address = const_cast<char *>(as.c_str());
   a.kind = const_cast<char *>(kind.c_str());
   a.body = const_cast<char *>(text.c_str());
-  if (dds_return_t rc = dds_write(announcement_writer.get(), &a); rc < 0)
+  if (dds_return_t rc = dds_write(announcement_writer.get(), &a); rc < 0) {
+    if (fresh)
+      announcer_slots.release(as); // nothing was written in it
     return tl::unexpected(dds::dds_error(rc, "announcing"));
+  }
   return {};
 }
 

@@ -3,6 +3,7 @@
 #include <cerrno>
 #include <cstring>
 
+#include <fcntl.h>
 #include <fmt/format.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
@@ -85,11 +86,14 @@ tl::expected<process::Fd, std::string> connect_link(const std::string &path) {
   auto address = unix_address(path);
   if (!address)
     return tl::unexpected(address.error());
-  process::Fd fd(::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0));
+  // Non-blocking while connecting: a node whose backlog is full refuses (EAGAIN) instead of
+  // holding the caller; blocking again afterwards, as LinkWriter expects.
+  process::Fd fd(::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0));
   if (!fd)
     return tl::unexpected(fmt::format("socket: {}", std::strerror(errno)));
   if (::connect(fd.get(), reinterpret_cast<const sockaddr *>(&*address), sizeof(*address)) != 0)
     return tl::unexpected(fmt::format("connect {}: {}", path, std::strerror(errno)));
+  ::fcntl(fd.get(), F_SETFL, ::fcntl(fd.get(), F_GETFL) & ~O_NONBLOCK);
   return fd;
 }
 

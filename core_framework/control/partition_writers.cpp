@@ -58,11 +58,19 @@ bool matched_reader_in(dds_entity_t writer, const std::string &partition) {
 }
 
 bool matched(dds_entity_t writer, const std::string &partition, bool shared) {
-  if (shared)
-    return matched_reader_in(writer, partition);
+  // Read in both cases: reading the status clears its trigger, which would otherwise wake the
+  // waitset at once for ever after the first match.
   dds_publication_matched_status_t status{};
-  return dds_get_publication_matched_status(writer, &status) == 0 && status.current_count > 0;
+  const bool any =
+      dds_get_publication_matched_status(writer, &status) == 0 && status.current_count > 0;
+  if (!shared || !any)
+    return any;
+  return matched_reader_in(writer, partition);
 }
+
+// The shared way keeps the last replies only: with every CLI client's reader on one writer, one
+// client that stops acknowledging must not make writes block (and fail) for all the others.
+constexpr std::int32_t kSharedReplyHistory = 64;
 
 } // namespace
 
@@ -85,7 +93,10 @@ CallResult<dds_entity_t> PartitionWriters::writer_for(const std::string &partiti
       dds::checked(dds_create_publisher(participant_, pqos.get(), nullptr), "creating a publisher");
   if (!publisher)
     return call_error(Status::Failed, publisher.error().to_string());
-  auto writer = dds::checked(dds_create_writer(publisher->get(), topic_, qos_.get(), nullptr),
+  auto wqos = copy_of(qos_.get());
+  if (shared)
+    dds_qset_history(wqos.get(), DDS_HISTORY_KEEP_LAST, kSharedReplyHistory);
+  auto writer = dds::checked(dds_create_writer(publisher->get(), topic_, wqos.get(), nullptr),
                              "creating a writer");
   if (!writer)
     return call_error(Status::Failed, writer.error().to_string());

@@ -262,6 +262,11 @@ DeviceManager::create(std::shared_ptr<dds::Participant> participant, NodeOptions
   if (!links)
     return tl::unexpected(links.error());
   impl->links = std::move(*links);
+  // Before anything serves or is announced: a node that cannot listen where it is told stops
+  // with nothing to take down but its links.
+  if (impl->options.control_socket)
+    if (auto ok = impl->links->listen(impl->options.control_socket->string()); !ok)
+      return tl::unexpected(ok.error());
   if (auto ok = impl->start_devices(registry); !ok)
     return tl::unexpected(ok.error());
   impl->serve();
@@ -273,9 +278,6 @@ DeviceManager::create(std::shared_ptr<dds::Participant> participant, NodeOptions
   if (auto ok = impl->endpoint->announce("node", protocol::encode(impl->announcement())); !ok)
     return tl::unexpected(ok.error());
   spdlog::info("node {} announced with {} device(s)", impl->dcd->name, impl->devices.size());
-  if (impl->options.control_socket)
-    if (auto ok = impl->links->listen(impl->options.control_socket->string()); !ok)
-      return tl::unexpected(ok.error());
   return std::unique_ptr<DeviceManager>(new DeviceManager(std::move(impl)));
 }
 

@@ -42,9 +42,14 @@ constexpr std::chrono::seconds kRelayBound{60};
 // A process's own call is given what it asks for, up to this.
 constexpr std::chrono::seconds kCallBound{30};
 // A client's (a CLI's launch waits six times its --timeout-ms), up to this.
-constexpr std::chrono::minutes kClientCallBound{10};
+constexpr std::chrono::hours kClientCallBound{1};
 // Clients connected at once, at most: one more is closed at once.
 constexpr std::size_t kMaxClients = 64;
+// Calls one client has under way, at most: more are refused at once.
+constexpr int kMaxClientCalls = 8;
+// Threads that wait for clients' calls: apart from the processes' own, so that clients (a launch
+// waits for minutes) never hold up a component's call.
+constexpr std::size_t kClientCallThreads = 4;
 
 } // namespace
 
@@ -58,8 +63,9 @@ struct LinkedProcess {
   control::FrameReader reader;
   std::vector<std::string> addresses;
   std::set<std::string> announced;
-  bool ended = false;
-  std::string why; // why it ended
+  std::atomic<bool> ended{false};
+  std::atomic<int> calls{0}; // a client's calls under way
+  std::string why;           // why it ended
 };
 
 struct ProcessLinks::Impl {
@@ -70,7 +76,10 @@ struct ProcessLinks::Impl {
   process::Fd listener; // the control socket, when the node has one
   std::string listener_path;
   std::thread thread;
-  std::unique_ptr<control::WorkerPool> outgoing; // the processes' own calls
+  std::unique_ptr<control::WorkerPool> outgoing;               // the processes' own calls
+  std::unique_ptr<control::WorkerPool> client_calls;           // the clients'
+  std::atomic<int> listener_fd{-1};                            // read by the poll thread
+  std::chrono::steady_clock::time_point accept_paused_until{}; // poll thread only
   std::atomic<bool> stopping{false};
 
   std::mutex mutex; // guards what follows
@@ -98,6 +107,9 @@ struct ProcessLinks::Impl {
   void expire();
   void poll_loop();
   void accept_clients();
+  // Out of descriptors, the listener stays readable: it leaves the poll for a second.
+  void pause_accepting();
+  void resume_accepting();
   void read(int fd);
   void take(const std::shared_ptr<LinkedProcess> &process, link::Frame frame);
   void make_call(const std::shared_ptr<LinkedProcess> &process, link::Request request);
@@ -239,13 +251,14 @@ void ProcessLinks::Impl::poll_loop() {
   while (!stopping) {
     const int n = ::epoll_wait(epoll.get(), events, kEvents, 1000);
     expire();
+    resume_accepting();
     if (n < 0 && errno != EINTR) {
       spdlog::error("process links: epoll_wait: {}", std::strerror(errno));
       return;
     }
     for (int i = 0; i < n && !stopping; ++i) {
       const int fd = events[i].data.fd;
-      if (fd == listener.get())
+      if (fd == listener_fd.load())
         accept_clients();
       else if (fd != wake.get())
         read(fd);
@@ -255,10 +268,15 @@ void ProcessLinks::Impl::poll_loop() {
 
 void ProcessLinks::Impl::accept_clients() {
   for (;;) {
-    process::Fd fd(::accept4(listener.get(), nullptr, nullptr, SOCK_CLOEXEC));
+    process::Fd fd(::accept4(listener_fd.load(), nullptr, nullptr, SOCK_CLOEXEC));
     if (!fd) {
-      if (errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR)
+      if (errno == EMFILE || errno == ENFILE || errno == ENOBUFS || errno == ENOMEM) {
+        spdlog::warn("control socket {}: accept: {}; clients wait a second", listener_path,
+                     std::strerror(errno));
+        pause_accepting();
+      } else if (errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR) {
         spdlog::warn("control socket {}: accept: {}", listener_path, std::strerror(errno));
+      }
       return;
     }
     ucred peer{};
@@ -284,6 +302,22 @@ void ProcessLinks::Impl::accept_clients() {
     ::epoll_ctl(epoll.get(), EPOLL_CTL_ADD, number, &event);
     spdlog::debug("control socket: client pid {} (uid {}) connected", peer.pid, peer.uid);
   }
+}
+
+void ProcessLinks::Impl::pause_accepting() {
+  ::epoll_ctl(epoll.get(), EPOLL_CTL_DEL, listener_fd.load(), nullptr);
+  accept_paused_until = std::chrono::steady_clock::now() + std::chrono::seconds(1);
+}
+
+void ProcessLinks::Impl::resume_accepting() {
+  if (accept_paused_until == std::chrono::steady_clock::time_point{} ||
+      std::chrono::steady_clock::now() < accept_paused_until)
+    return;
+  accept_paused_until = {};
+  epoll_event event{};
+  event.events = EPOLLIN;
+  event.data.fd = listener_fd.load();
+  ::epoll_ctl(epoll.get(), EPOLL_CTL_ADD, listener_fd.load(), &event);
 }
 
 void ProcessLinks::Impl::read(int fd) {
@@ -319,8 +353,22 @@ void ProcessLinks::Impl::take(const std::shared_ptr<LinkedProcess> &process, lin
   if (auto *reply = std::get_if<link::Reply>(&frame)) {
     complete(reply->id, process->pid, control::reply_result(*reply));
   } else if (auto *request = std::get_if<link::Request>(&frame)) {
-    outgoing->post(
-        [this, process, r = std::move(*request)]() mutable { make_call(process, std::move(r)); });
+    if (!process->client) {
+      outgoing->post(
+          [this, process, r = std::move(*request)]() mutable { make_call(process, std::move(r)); });
+      return;
+    }
+    if (process->calls.fetch_add(1) >= kMaxClientCalls) {
+      process->calls.fetch_sub(1);
+      (void)process->writer->send(control::link_reply(
+          request->id, call_error(Status::Rejected, fmt::format("over {} calls under way at once",
+                                                                kMaxClientCalls))));
+      return;
+    }
+    client_calls->post([this, process, r = std::move(*request)]() mutable {
+      make_call(process, std::move(r));
+      process->calls.fetch_sub(1);
+    });
   } else if (auto *a = std::get_if<link::Announce>(&frame)) {
     announce(*process, *a);
   } else if (auto *w = std::get_if<link::Withdraw>(&frame)) {
@@ -346,9 +394,10 @@ void ProcessLinks::Impl::make_call(const std::shared_ptr<LinkedProcess> &process
   const auto timeout = std::clamp(std::chrono::milliseconds(request.timeout_ms),
                                   std::chrono::milliseconds(1), bound);
   auto result = endpoint->call(request.target, request.operation, std::move(request.body), timeout);
-  // Polled, so that closing the node does not wait for a call's whole timeout.
+  // Polled, so that closing the node, or the caller going, does not wait for a call's whole
+  // timeout (the call itself ends at its deadline in the endpoint).
   while (result.wait_for(std::chrono::milliseconds(100)) != std::future_status::ready)
-    if (stopping)
+    if (stopping || process->ended)
       return;
   const auto reply = control::link_reply(request.id, result.get());
   if (auto sent = process->writer->send(reply); !sent)
@@ -416,6 +465,7 @@ Expected<std::unique_ptr<ProcessLinks>> ProcessLinks::start(control::Endpoint &e
   event.data.fd = impl->wake.get();
   ::epoll_ctl(impl->epoll.get(), EPOLL_CTL_ADD, impl->wake.get(), &event);
   impl->outgoing = std::make_unique<control::WorkerPool>(4);
+  impl->client_calls = std::make_unique<control::WorkerPool>(kClientCallThreads);
   Impl *raw = impl.get();
   impl->thread = std::thread([raw] { raw->poll_loop(); });
   return std::unique_ptr<ProcessLinks>(new ProcessLinks(std::move(impl)));
@@ -435,6 +485,7 @@ Expected<void> ProcessLinks::listen(const std::string &path) {
     return make_error({"node", 0, 0}, "control-socket", fd.error());
   impl_->listener = std::move(*fd);
   impl_->listener_path = path;
+  impl_->listener_fd = impl_->listener.get();
   epoll_event event{};
   event.events = EPOLLIN;
   event.data.fd = impl_->listener.get();
@@ -513,6 +564,7 @@ void ProcessLinks::close() {
   [[maybe_unused]] auto n = ::write(impl_->wake.get(), &one, sizeof(one));
   impl_->thread.join();
   impl_->outgoing->stop();
+  impl_->client_calls->stop();
   if (impl_->listener) {
     impl_->listener.reset();
     ::unlink(impl_->listener_path.c_str());

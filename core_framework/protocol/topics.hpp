@@ -12,7 +12,9 @@ namespace rsca::protocol {
 // The control plane's three topics, shared by every domain (partitions keep domains apart).
 inline constexpr const char *kRequestTopic = "rsca_ctl_Request";
 inline constexpr const char *kReplyTopic = "rsca_ctl_Reply";
-inline constexpr const char *kAnnouncementTopic = "rsca_ctl_Announcement";
+// Version 2: keyed by announcer and slot (dds/control.idl). A daemon of the address-keyed version
+// is on another topic, never mis-reading these.
+inline constexpr const char *kAnnouncementTopic = "rsca_ctl_Announcement_v2";
 
 // A domain's events (control/domain_events.hpp).
 std::string domain_events_topic(std::string_view domain);

@@ -629,3 +629,18 @@ TEST_CASE("reply ways: one for all CLI clients, one per other address, none for 
   CHECK(ways.size() == 2);
   CHECK(writers_into(pp, "rsca_ctl_Reply", "test/cli/*") == 1);
 }
+
+TEST_CASE("an address heard in a new slot is not ended by its old slot's late end", "[control]") {
+  control::HeardSlots heard;
+  CHECK_FALSE(heard.heard("node1", 0, "app/a").has_value());
+  // a withdrawn, slot 0 reused by b, a announced again in slot 1: taken by instance, slot 1 first.
+  CHECK_FALSE(heard.heard("node1", 1, "app/a").has_value());
+  CHECK_FALSE(heard.heard("node1", 0, "app/b").has_value()); // a lives in slot 1: not ended
+  CHECK(heard.gone("node1", 0) == std::optional<std::string>("app/b"));
+  CHECK(heard.gone("node1", 1) == std::optional<std::string>("app/a"));
+  // The same order with a disposal in slot 0 instead of its reuse.
+  CHECK_FALSE(heard.heard("node1", 0, "app/c").has_value());
+  CHECK_FALSE(heard.heard("node1", 1, "app/c").has_value());
+  CHECK_FALSE(heard.gone("node1", 0).has_value());
+  CHECK(heard.gone("node1", 1) == std::optional<std::string>("app/c"));
+}

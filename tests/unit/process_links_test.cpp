@@ -6,6 +6,7 @@
 
 #include <filesystem>
 #include <random>
+#include <set>
 #include <thread>
 
 #include <unistd.h>
@@ -270,4 +271,41 @@ TEST_CASE("process links: a control socket another node listens on is not taken 
   REQUIRE(std::filesystem::exists(stale));
   CHECK(second.links->listen(stale.string()).has_value());
   CHECK(control::connect_link(stale.string()).has_value());
+}
+
+TEST_CASE("process links: a client has at most 8 calls under way; one more is refused at once",
+          "[process-links]") {
+  LinksRig rig;
+  std::promise<void> gate;
+  std::shared_future<void> opened = gate.get_future().share();
+  rig.caller->on("test.wait", [opened](const control::Json &, const control::RequestContext &) {
+    opened.wait();
+    return control::CallResult<control::Json>(control::Json::object());
+  });
+  const auto path = std::filesystem::temp_directory_path() /
+                    fmt::format("rsca-links-{}-{}.sock", getpid(), std::random_device{}());
+  REQUIRE(rig.links->listen(path.string()).has_value());
+  auto fd = control::connect_link(path.string());
+  REQUIRE(fd.has_value());
+  test::LinkPeer client(std::move(*fd));
+  for (int i = 1; i <= 9; ++i)
+    REQUIRE(client.writer->send(link_msgs::Request{std::to_string(i), "t/cli/test", "test.wait",
+                                                   "t/cli/me", 5000, control::Json::object()}));
+  // The ninth is answered first, refused; the eight others once the handler lets them go.
+  auto frame = client.next();
+  auto *refused = std::get_if<link_msgs::Reply>(&frame);
+  REQUIRE(refused != nullptr);
+  CHECK(refused->id == "9");
+  CHECK(refused->status == static_cast<std::int32_t>(protocol::Status::Rejected));
+  gate.set_value();
+  std::set<std::string> answered;
+  for (int i = 0; i < 8; ++i) {
+    auto next = client.next();
+    auto *reply = std::get_if<link_msgs::Reply>(&next);
+    REQUIRE(reply != nullptr);
+    CHECK(reply->status == 0);
+    answered.insert(reply->id);
+  }
+  CHECK(answered.size() == 8);
+  CHECK_FALSE(answered.contains("9"));
 }

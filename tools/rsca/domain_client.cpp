@@ -27,8 +27,12 @@ namespace fs = std::filesystem;
 fs::path default_run_dir() {
   if (const char *dir = std::getenv("RSCA_RUN_DIR"); dir != nullptr && *dir != '\0')
     return dir;
+  // Per DDS domain id and discovery tag: two local domains that differ by either have a folder
+  // each, and a CLI finds the node sockets of its own.
+  const auto dds = dds::DdsSettings::from_environment();
   return fs::temp_directory_path() /
-         fmt::format("rsca-{}-{}", getuid(), dds::DdsSettings::from_environment().domain_id);
+         (dds.tag.empty() ? fmt::format("rsca-{}-{}", getuid(), dds.domain_id)
+                          : fmt::format("rsca-{}-{}-{}", getuid(), dds.domain_id, dds.tag));
 }
 
 std::vector<fs::path> node_sockets() {
