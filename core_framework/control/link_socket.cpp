@@ -46,55 +46,66 @@ tl::expected<std::pair<process::Fd, process::Fd>, std::string> make_link_pair() 
 
 namespace {
 
-tl::expected<sockaddr_un, std::string> unix_address(const std::string &path) {
+// A non-blocking Unix stream socket and the address of `path`, for listening or connecting.
+struct UnixSocket {
+  process::Fd fd;
   sockaddr_un address{};
-  address.sun_family = AF_UNIX;
-  if (path.empty() || path.size() >= sizeof(address.sun_path))
+};
+
+tl::expected<UnixSocket, std::string> unix_socket(const std::string &path) {
+  UnixSocket s;
+  s.address.sun_family = AF_UNIX;
+  if (path.empty() || path.size() >= sizeof(s.address.sun_path))
     return tl::unexpected(fmt::format("\"{}\" cannot name a Unix socket (1 to {} bytes)", path,
-                                      sizeof(address.sun_path) - 1));
-  std::memcpy(address.sun_path, path.data(), path.size());
-  return address;
+                                      sizeof(s.address.sun_path) - 1));
+  std::memcpy(s.address.sun_path, path.data(), path.size());
+  s.fd = process::Fd(::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0));
+  if (!s.fd)
+    return tl::unexpected(fmt::format("socket: {}", std::strerror(errno)));
+  return s;
+}
+
+// 0 once connected, else errno.
+int connect_to(const UnixSocket &s) {
+  return ::connect(s.fd.get(), reinterpret_cast<const sockaddr *>(&s.address), sizeof(s.address)) ==
+                 0
+             ? 0
+             : errno;
 }
 
 } // namespace
 
 tl::expected<process::Fd, std::string> listen_for_links(const std::string &path) {
-  auto address = unix_address(path);
-  if (!address)
-    return tl::unexpected(address.error());
-  process::Fd fd(::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0));
-  if (!fd)
-    return tl::unexpected(fmt::format("socket: {}", std::strerror(errno)));
+  auto s = unix_socket(path);
+  if (!s)
+    return tl::unexpected(s.error());
   // A socket file nobody accepts on was left by a node that died: replaced. One that accepts is
   // another's.
-  if (process::Fd probe(::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0)); probe) {
-    if (::connect(probe.get(), reinterpret_cast<const sockaddr *>(&*address), sizeof(*address)) ==
-        0)
+  if (auto probe = unix_socket(path)) {
+    const int error = connect_to(*probe);
+    if (error == 0)
       return tl::unexpected(fmt::format("{}: another process listens there", path));
-    if (errno == ECONNREFUSED)
+    if (error == ECONNREFUSED)
       ::unlink(path.c_str());
   }
-  if (::bind(fd.get(), reinterpret_cast<const sockaddr *>(&*address), sizeof(*address)) != 0)
+  if (::bind(s->fd.get(), reinterpret_cast<const sockaddr *>(&s->address), sizeof(s->address)) != 0)
     return tl::unexpected(fmt::format("bind {}: {}", path, std::strerror(errno)));
   ::chmod(path.c_str(), 0660);
-  if (::listen(fd.get(), 64) != 0)
+  if (::listen(s->fd.get(), 64) != 0)
     return tl::unexpected(fmt::format("listen {}: {}", path, std::strerror(errno)));
-  return fd;
+  return std::move(s->fd);
 }
 
 tl::expected<process::Fd, std::string> connect_link(const std::string &path) {
-  auto address = unix_address(path);
-  if (!address)
-    return tl::unexpected(address.error());
   // Non-blocking while connecting: a node whose backlog is full refuses (EAGAIN) instead of
   // holding the caller; blocking again afterwards, as LinkWriter expects.
-  process::Fd fd(::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0));
-  if (!fd)
-    return tl::unexpected(fmt::format("socket: {}", std::strerror(errno)));
-  if (::connect(fd.get(), reinterpret_cast<const sockaddr *>(&*address), sizeof(*address)) != 0)
-    return tl::unexpected(fmt::format("connect {}: {}", path, std::strerror(errno)));
-  ::fcntl(fd.get(), F_SETFL, ::fcntl(fd.get(), F_GETFL) & ~O_NONBLOCK);
-  return fd;
+  auto s = unix_socket(path);
+  if (!s)
+    return tl::unexpected(s.error());
+  if (const int error = connect_to(*s); error != 0)
+    return tl::unexpected(fmt::format("connect {}: {}", path, std::strerror(error)));
+  ::fcntl(s->fd.get(), F_SETFL, ::fcntl(s->fd.get(), F_GETFL) & ~O_NONBLOCK);
+  return std::move(s->fd);
 }
 
 LinkWriter::LinkWriter(int fd, std::chrono::milliseconds timeout) : fd_(fd) {

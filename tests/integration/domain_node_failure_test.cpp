@@ -8,7 +8,11 @@
 #include <unistd.h>
 
 #include <fstream>
+#include <future>
 #include <sstream>
+#include <string>
+#include <tuple>
+#include <vector>
 
 #include <catch2/catch.hpp>
 #include <fmt/format.h>
@@ -19,26 +23,43 @@ using namespace rsca::test;
 using namespace std::chrono_literals;
 using rsca::control::Json;
 
+namespace {
+
+struct KilledDuringLaunch {
+  int rc = 0;
+  std::string out;
+  std::vector<long> pids; // the components node1 ran
+};
+
+// Launches HangAtConfigure with the CLI going through `socket` (node1's or node2's); both
+// components land on node1 (first fit), the launch hangs in configure, and node1 is killed.
+KilledDuringLaunch kill_node1_during_launch(TestDomain &domain, const std::string &socket) {
+  domain.install("HangAtConfigure");
+  auto launch = std::async(std::launch::async, [&] {
+    return domain.cli({"launch", "HangAtConfigure"},
+                      {{"RSCA_NODE_SOCKET", (domain.run_dir() / socket).string()}});
+  });
+  REQUIRE(TestDomain::wait_for([&] { return domain.running_pids().size() == 2; }));
+  KilledDuringLaunch killed;
+  killed.pids = domain.running_pids();
+  domain.kill_node(1);
+  std::tie(killed.rc, killed.out) = launch.get();
+  return killed;
+}
+
+} // namespace
+
 TEST_CASE("a node daemon killed during a launch fails it, and the rest is rolled back",
           "[integration][domain][failure]") {
   TestDomain domain;
-  domain.install("HangAtConfigure");
-  // Both components land on node1 (first fit); the launch hangs in configure, and node1 dies.
   // The CLI goes through node2's socket: the domain's reply is what is tested here (a CLI whose
   // own node dies is the next test's).
-  auto launch = std::async(std::launch::async, [&] {
-    return domain.cli({"launch", "HangAtConfigure"},
-                      {{"RSCA_NODE_SOCKET", (domain.run_dir() / "node2.sock").string()}});
-  });
-  REQUIRE(TestDomain::wait_for([&] { return domain.running_pids().size() == 2; }));
-  const auto pids = domain.running_pids();
-  domain.kill_node(1);
-  auto [rc, out] = launch.get();
-  INFO(out);
-  CHECK(rc != 0);
-  CHECK_THAT(out, Catch::Contains("failed at step"));
+  const auto killed = kill_node1_during_launch(domain, "node2.sock");
+  INFO(killed.out);
+  CHECK(killed.rc != 0);
+  CHECK_THAT(killed.out, Catch::Contains("failed at step"));
   // The node's components die with it; nothing stays allocated; the domain forgot node1.
-  domain.require_clean(pids);
+  domain.require_clean(killed.pids);
   auto nodes = domain.call("domain.nodes");
   REQUIRE(nodes.has_value());
   CHECK(nodes->at("nodes").size() == 1);
@@ -47,19 +68,11 @@ TEST_CASE("a node daemon killed during a launch fails it, and the rest is rolled
 TEST_CASE("a CLI whose node dies during its launch says the launch may still be under way",
           "[integration][domain][failure]") {
   TestDomain domain;
-  domain.install("HangAtConfigure");
-  auto launch = std::async(std::launch::async, [&] {
-    return domain.cli({"launch", "HangAtConfigure"},
-                      {{"RSCA_NODE_SOCKET", (domain.run_dir() / "node1.sock").string()}});
-  });
-  REQUIRE(TestDomain::wait_for([&] { return domain.running_pids().size() == 2; }));
-  const auto pids = domain.running_pids();
-  domain.kill_node(1);
-  auto [rc, out] = launch.get();
-  INFO(out);
-  CHECK(rc == 4); // unreachable
-  CHECK_THAT(out, Catch::Contains("the link to the node ended"));
-  CHECK_THAT(out, Catch::Contains("may still"));
+  const auto killed = kill_node1_during_launch(domain, "node1.sock");
+  INFO(killed.out);
+  CHECK(killed.rc == 4); // unreachable
+  CHECK_THAT(killed.out, Catch::Contains("the link to the node ended"));
+  CHECK_THAT(killed.out, Catch::Contains("may still"));
   // The domain finishes the failed launch on its own, without the CLI: node1 forgotten, the
   // launch failed and rolled back, nothing stays.
   REQUIRE(TestDomain::wait_for(
@@ -77,7 +90,7 @@ TEST_CASE("a CLI whose node dies during its launch says the launch may still be 
         return true;
       },
       30s));
-  domain.require_clean(pids);
+  domain.require_clean(killed.pids);
 }
 
 TEST_CASE("a restarted domain daemon sees every node again and keeps what was installed",
