@@ -174,10 +174,9 @@ TEST_CASE("the CLI reaches the domain through a node's control socket, with no D
           "[integration][node-agent]") {
   TestDomain domain(2);
   REQUIRE(std::filesystem::is_socket(domain.run_dir() / "node1.sock"));
-  // On another DDS domain the CLI could not find the domain daemon: it answers all the same,
-  // because the CLI's calls go over the socket and the node makes them.
-  const ChildProcess::Environment elsewhere{{"RSCA_DDS_DOMAIN", "0"},
-                                            {"RSCA_DDS_TAG", "nobody-here"}};
+  // With another discovery tag the CLI could not find the domain daemon on DDS: it answers all
+  // the same, because the CLI's calls go over the socket and the node makes them.
+  const ChildProcess::Environment elsewhere{{"RSCA_DDS_TAG", "nobody-here"}};
   auto [rc, out] = domain.cli({"--json", "ls", "nodes"}, elsewhere);
   INFO(out);
   REQUIRE(rc == 0);
@@ -193,10 +192,10 @@ TEST_CASE("the CLI reaches the domain through a node's control socket, with no D
   auto [released, release_out] = domain.cli({"release", "ProducerConsumer"}, elsewhere);
   INFO(release_out);
   CHECK(released == 0);
-  // With the sockets refused (RSCA_NODE_SOCKET=none) the CLI is on DDS, and on the other DDS
-  // domain it finds nobody.
-  const ChildProcess::Environment no_socket{
-      {"RSCA_DDS_DOMAIN", "0"}, {"RSCA_DDS_TAG", "nobody-here"}, {"RSCA_NODE_SOCKET", "none"}};
+  // With the sockets refused (RSCA_NODE_SOCKET=none) the CLI is on DDS, and with the other tag
+  // it finds nobody.
+  const ChildProcess::Environment no_socket{{"RSCA_DDS_TAG", "nobody-here"},
+                                            {"RSCA_NODE_SOCKET", "none"}};
   auto [unreachable, unreachable_out] =
       domain.cli({"--timeout-ms", "500", "ls", "nodes"}, no_socket);
   INFO(unreachable_out);
