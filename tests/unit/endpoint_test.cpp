@@ -15,16 +15,16 @@
 #include <catch2/catch.hpp>
 #include <fmt/format.h>
 
-#include "control.h" // generated from dds/control.idl
 #include "control/endpoint.hpp"
-#include "control/partition_writers.hpp"
 #include "test_domain.hpp"
+#include "writers_into.hpp"
 
 using namespace rsca;
 using namespace std::chrono_literals;
 using control::Endpoint;
 using control::Json;
 using control::Status;
+using rsca::test::writers_into;
 
 namespace {
 
@@ -56,36 +56,6 @@ private:
   std::condition_variable cv_;
   bool open_ = false;
 };
-
-// How many writers of this participant's control plane write `topic` into `partition` (an
-// address), as DDS's built-in publication topic shows them.
-int writers_into(const std::shared_ptr<dds::Participant> &pp, const char *topic,
-                 const std::string &partition) {
-  const dds_entity_t reader =
-      dds_create_reader(pp->get(), DDS_BUILTIN_TOPIC_DCPSPUBLICATION, nullptr, nullptr);
-  REQUIRE(reader > 0);
-  void *samples[256] = {nullptr};
-  dds_sample_info_t infos[256];
-  const dds_return_t n = dds_read(reader, samples, infos, 256, 256);
-  int count = 0;
-  for (dds_return_t i = 0; i < n; ++i) {
-    const auto *w = static_cast<const dds_builtintopic_endpoint_t *>(samples[i]);
-    uint32_t names = 0;
-    char **parts = nullptr;
-    if (!infos[i].valid_data || std::string(w->topic_name) != topic ||
-        !dds_qget_partition(w->qos, &names, &parts))
-      continue;
-    for (uint32_t k = 0; k < names; ++k) {
-      count += partition == parts[k] ? 1 : 0;
-      dds_free(parts[k]);
-    }
-    dds_free(parts);
-  }
-  if (n > 0)
-    dds_return_loan(reader, samples, n);
-  dds_delete(reader);
-  return count;
-}
 
 // Polls `done` until it holds or 5 s have passed.
 bool eventually(const std::function<bool()> &done) {
@@ -571,32 +541,5 @@ TEST_CASE("CLI clients are answered through one shared writer, each getting its 
   clients.clear(); // all gone: the shared way stays
   auto late = open(pp, "test/cli/host-1-9");
   REQUIRE(late->call_sync("test/domain", "echo", Json::object(), 5s).has_value());
-  CHECK(writers_into(pp, "rsca_ctl_Reply", "test/cli/*") == 1);
-}
-
-TEST_CASE("reply ways: one for all CLI clients, one per other address, none for a pattern",
-          "[control]") {
-  auto pp = test::participant();
-  auto qos = dds::make_qos();
-  dds_qset_reliability(qos.get(), DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
-  dds::Entity topic(
-      dds_create_topic(pp->get(), &rsca_ctl_Reply_desc, "rsca_ctl_Reply", qos.get(), nullptr));
-  REQUIRE(topic.get() > 0);
-  control::PartitionWriters ways(pp->get(), topic.get(), qos.get());
-  auto a = ways.writer_for("test/cli/host-1-1");
-  auto b = ways.writer_for("test/cli/host-2-7");
-  auto node = ways.writer_for("test/node/node1");
-  REQUIRE(a.has_value());
-  REQUIRE(b.has_value());
-  REQUIRE(node.has_value());
-  CHECK(*a == *b);
-  CHECK(*a != *node);
-  CHECK(ways.size() == 2);
-  for (const char *pattern : {"test/cli/*", "test/node/?", "test/[ab]"}) {
-    auto refused = ways.writer_for(pattern);
-    REQUIRE_FALSE(refused.has_value());
-    CHECK(refused.error().status == control::Status::BadRequest);
-  }
-  CHECK(ways.size() == 2);
   CHECK(writers_into(pp, "rsca_ctl_Reply", "test/cli/*") == 1);
 }
