@@ -36,7 +36,7 @@ public:
                          rsca::protocol::CallError{rsca::protocol::Status::Failed, "refused"});
         continue;
       }
-      out.push_back(answer(c));
+      out.emplace_back(tl::in_place, answer(c));
     }
     return out;
   }
