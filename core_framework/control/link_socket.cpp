@@ -75,10 +75,23 @@ int connect_to(const UnixSocket &s) {
 
 } // namespace
 
-tl::expected<process::Fd, std::string> listen_for_links(const std::string &path) {
+namespace detail {
+
+tl::expected<process::Fd, std::string> bind_unix_socket(const std::string &path, mode_t mode) {
   auto s = unix_socket(path);
   if (!s)
     return tl::unexpected(s.error());
+  // Linux makes the socket file with the socket's own mode less the umask: set before bind, the
+  // file is never more open than `mode`.
+  ::fchmod(s->fd.get(), mode);
+  if (::bind(s->fd.get(), reinterpret_cast<const sockaddr *>(&s->address), sizeof(s->address)) != 0)
+    return tl::unexpected(fmt::format("bind {}: {}", path, std::strerror(errno)));
+  return std::move(s->fd);
+}
+
+} // namespace detail
+
+tl::expected<process::Fd, std::string> listen_for_links(const std::string &path) {
   // A socket file nobody accepts on was left by a node that died: replaced. One that accepts is
   // another's.
   if (auto probe = unix_socket(path)) {
@@ -88,12 +101,13 @@ tl::expected<process::Fd, std::string> listen_for_links(const std::string &path)
     if (error == ECONNREFUSED)
       ::unlink(path.c_str());
   }
-  if (::bind(s->fd.get(), reinterpret_cast<const sockaddr *>(&s->address), sizeof(s->address)) != 0)
-    return tl::unexpected(fmt::format("bind {}: {}", path, std::strerror(errno)));
-  ::chmod(path.c_str(), 0660);
-  if (::listen(s->fd.get(), 64) != 0)
+  auto fd = detail::bind_unix_socket(path, 0660);
+  if (!fd)
+    return fd;
+  ::chmod(path.c_str(), 0660); // exactly, whatever the umask took
+  if (::listen(fd->get(), 64) != 0)
     return tl::unexpected(fmt::format("listen {}: {}", path, std::strerror(errno)));
-  return std::move(s->fd);
+  return fd;
 }
 
 tl::expected<process::Fd, std::string> connect_link(const std::string &path) {

@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include <sys/types.h>
+
 #include <tl/expected.hpp>
 
 #include "process/fd.hpp"
@@ -32,6 +34,12 @@ tl::expected<std::pair<process::Fd, process::Fd>, std::string> make_link_pair();
 tl::expected<process::Fd, std::string> listen_for_links(const std::string &path);
 // A client's link to the node listening at `path`, close-on-exec.
 tl::expected<process::Fd, std::string> connect_link(const std::string &path);
+
+namespace detail {
+// A Unix socket bound at `path` (not yet listening) whose file is never more open than `mode`
+// less the umask, not even for an instant: listen_for_links then sets `mode` exactly.
+tl::expected<process::Fd, std::string> bind_unix_socket(const std::string &path, mode_t mode);
+} // namespace detail
 
 // Writes frames to a link, whole, from any thread. The socket is blocking with a send timeout:
 // a peer that stops reading fails a write after `timeout`, never holds its writer forever; a

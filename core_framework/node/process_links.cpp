@@ -353,6 +353,11 @@ void ProcessLinks::Impl::take(const std::shared_ptr<LinkedProcess> &process, lin
   if (auto *reply = std::get_if<link::Reply>(&frame)) {
     complete(reply->id, process->pid, control::reply_result(*reply));
   } else if (auto *request = std::get_if<link::Request>(&frame)) {
+    if (request->target == link::kHelloTarget && request->operation == link::kHelloOperation) {
+      (void)process->writer->send(
+          control::link_reply(request->id, Json{{"node", endpoint->address()}}));
+      return;
+    }
     if (!process->client) {
       outgoing->post(
           [this, process, r = std::move(*request)]() mutable { make_call(process, std::move(r)); });

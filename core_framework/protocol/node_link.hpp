@@ -25,6 +25,11 @@ inline constexpr int kNodeLinkFd = 3;
 inline constexpr const char *kNodeLinkVariable = "RSCA_NODE_LINK_FD";
 inline constexpr std::uint32_t kMaxLinkFrame = 16U << 20U;
 
+// A request the node's link answers itself, at once, with {"node": its address}: a local client
+// (the CLI) asks it before relying on a node, since a hung node's socket still accepts.
+inline constexpr const char *kHelloTarget = "";
+inline constexpr const char *kHelloOperation = "link.hello";
+
 // A call, either way: from the node, one addressed to the process (target is one of its
 // addresses); from the process, one it makes (the node makes it on DDS).
 struct Request {

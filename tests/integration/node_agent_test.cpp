@@ -3,6 +3,7 @@
 // participant (no UDP socket) unless it has data ports to connect.
 #include <catch2/catch.hpp>
 
+#include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -214,4 +215,14 @@ TEST_CASE("with its node's socket gone, the CLI tries the next and then DDS",
   auto [over_dds, dds_out] = domain.cli({"--json", "ls", "nodes"});
   INFO(dds_out);
   CHECK(over_dds == 0); // the domain daemon answers over DDS
+}
+
+TEST_CASE("a hung node's socket still accepts; the CLI finds it silent and goes on to the next",
+          "[integration][node-agent]") {
+  TestDomain domain(2);
+  ::kill(domain.node_pid(1), SIGSTOP); // the kernel still accepts on its socket
+  auto [rc, out] = domain.cli({"--json", "--timeout-ms", "5000", "ls", "nodes"});
+  ::kill(domain.node_pid(1), SIGCONT);
+  INFO(out);
+  CHECK(rc == 0); // through node2, not a timeout waiting on node1
 }

@@ -3,9 +3,13 @@
 // out and come back with their errors whole, and the end of the link fails what waits on it.
 #include <catch2/catch.hpp>
 
+#include <filesystem>
+#include <random>
 #include <thread>
 
 #include <sys/socket.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include "control/link_socket.hpp"
 #include "control/node_link.hpp"
@@ -147,4 +151,26 @@ TEST_CASE("node link: frames are cut whole from partial reads; an oversized or f
     CHECK_FALSE(reader.read_from(in, frames, why));
     CHECK_THAT(why, Catch::Contains("shutdown"));
   }
+}
+
+TEST_CASE("node link: the control socket's file is never more open than 0660, whatever the umask",
+          "[node-link]") {
+  const auto path = std::filesystem::temp_directory_path() /
+                    fmt::format("rsca-mode-{}-{}.sock", getpid(), std::random_device{}());
+  const mode_t old_umask = ::umask(0);
+  auto bound = control::detail::bind_unix_socket(path.string(), 0660);
+  ::umask(old_umask);
+  REQUIRE(bound.has_value());
+  struct stat st {};
+  REQUIRE(::stat(path.c_str(), &st) == 0);
+  CHECK((st.st_mode & 0777) == 0660); // as bound, before any chmod
+  std::filesystem::remove(path);
+
+  ::umask(0077); // takes the group's bits at bind; the listener gives them back
+  auto listening = control::listen_for_links(path.string());
+  ::umask(old_umask);
+  REQUIRE(listening.has_value());
+  REQUIRE(::stat(path.c_str(), &st) == 0);
+  CHECK((st.st_mode & 0777) == 0660);
+  std::filesystem::remove(path);
 }

@@ -225,6 +225,15 @@ TEST_CASE("process links: a client of the control socket may call, not announce"
   auto fd = control::connect_link(path.string());
   REQUIRE(fd.has_value());
   test::LinkPeer client(std::move(*fd));
+  // The link's hello is answered by the node itself.
+  REQUIRE(client.writer->send(link_msgs::Request{"1", link_msgs::kHelloTarget,
+                                                 link_msgs::kHelloOperation, "t/cli/me", 1000,
+                                                 control::Json::object()}));
+  auto hello = client.next();
+  auto *hello_reply = std::get_if<link_msgs::Reply>(&hello);
+  REQUIRE(hello_reply != nullptr);
+  REQUIRE(hello_reply->status == 0);
+  CHECK(hello_reply->body.at("node") == kLinkingNode);
   // Frames are taken in order: the announcement is refused before the call is made.
   REQUIRE(client.writer->send(link_msgs::Announce{kLinkedChild, "component", {{"pid", 1}}}));
   REQUIRE(client.writer->send(

@@ -19,6 +19,7 @@
 #include "dds/dds_settings.hpp"
 #include "exit_codes.hpp"
 #include "protocol/addresses.hpp"
+#include "protocol/node_link.hpp"
 
 namespace rsca::cli {
 
@@ -59,17 +60,30 @@ std::string own_address(const GlobalOptions &global) {
   return protocol::cli_address(global.domain, host, getpid(), ++counter);
 }
 
-// A link to the first node socket that accepts one.
+// How long a node has to answer the link's hello: a hung node's socket still accepts, and the CLI
+// goes on to the next node, or to DDS, instead of waiting out its call.
+constexpr std::chrono::milliseconds kNodeHelloTimeout{1000};
+
+// A link to the first node socket that accepts one and whose node answers.
 std::optional<DomainClient::Link> link_to_a_node(const std::string &address) {
+  namespace link = protocol::link;
   for (const auto &path : node_sockets()) {
     auto fd = control::connect_link(path.string());
     if (!fd) {
       spdlog::debug("node socket {}: {}", path.string(), fd.error());
       continue;
     }
-    auto link = control::NodeLink::open(std::move(*fd), address, /*workers=*/1);
-    if (link)
-      return DomainClient::Link{std::move(*link), path.string()};
+    auto opened = control::NodeLink::open(std::move(*fd), address, /*workers=*/1);
+    if (!opened)
+      continue;
+    auto hello = (*opened)->call(link::kHelloTarget, link::kHelloOperation, control::Json::object(),
+                                 kNodeHelloTimeout);
+    if (auto answer = hello.get(); !answer) {
+      spdlog::debug("node socket {}: the node does not answer: {}", path.string(),
+                    answer.error().message);
+      continue;
+    }
+    return DomainClient::Link{std::move(*opened), path.string()};
   }
   return std::nullopt;
 }
