@@ -63,6 +63,12 @@ void NodeLink::Impl::read_loop() {
     pollfd fds[2] = {{fd.get(), POLLIN, 0}, {wake.get(), POLLIN, 0}};
     if (::poll(fds, 2, poll_timeout_ms()) < 0 && errno != EINTR)
       break;
+    if ((fds[1].revents & POLLIN) != 0) {
+      // Drained, or it stays readable and every later poll returns at once: the reader would
+      // spin on a CPU for as long as the link lives.
+      std::uint64_t count = 0;
+      [[maybe_unused]] auto n = ::read(wake.get(), &count, sizeof(count));
+    }
     expire();
     if (stopping || (fds[0].revents & (POLLIN | POLLHUP | POLLERR)) == 0)
       continue;

@@ -7,6 +7,8 @@
 #include <random>
 #include <thread>
 
+#include <time.h>
+
 #include <sys/socket.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -83,6 +85,29 @@ TEST_CASE("node link: a call goes to the node and its error comes back with ever
   CHECK(answer.error().status == protocol::Status::Rejected);
   CHECK(answer.error().message == "no room");
   CHECK(answer.error().details == std::vector<std::string>{"first", "second"});
+}
+
+namespace {
+// CPU time this process used while it waited `wall` with nothing to do.
+std::chrono::nanoseconds cpu_while_idle(std::chrono::milliseconds wall) {
+  const auto cpu_now = [] {
+    timespec ts{};
+    ::clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return std::chrono::seconds(ts.tv_sec) + std::chrono::nanoseconds(ts.tv_nsec);
+  };
+  const auto before = cpu_now();
+  std::this_thread::sleep_for(wall); // the idle time observed, not a wait for a condition
+  return cpu_now() - before;
+}
+} // namespace
+
+TEST_CASE("node link: a link waiting on a long call is idle, not spinning", "[node-link]") {
+  auto [link, node] = make_link_ends("d/component/app.1.1/C_1");
+  // Each call wakes the reader to learn its deadline; the wake must not stay pending.
+  auto waiting = link->call("d/domain", "x", {}, std::chrono::seconds(60));
+  node->next();
+  const auto used = cpu_while_idle(std::chrono::milliseconds(300));
+  CHECK(used < std::chrono::milliseconds(100)); // a spinning reader takes all 300
 }
 
 TEST_CASE("node link: an unanswered call times out, and the link's end fails the rest at once",
