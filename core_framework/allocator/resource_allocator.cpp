@@ -40,6 +40,7 @@ Plan part_on(const Plan &plan, const std::set<std::string> &held) {
 
 void ResourceAllocator::set_node_devices(const std::string &node, std::vector<Device> devices) {
   std::lock_guard lock(mutex_);
+  suspended_.erase(node);
   DomainState kept;
   for (auto &[id, state] : devices_)
     if (state.device.node != node)
@@ -63,8 +64,24 @@ void ResourceAllocator::set_node_devices(const std::string &node, std::vector<De
   forget_devices_locked(gone);
 }
 
+void ResourceAllocator::suspend_node(const std::string &node) {
+  std::lock_guard lock(mutex_);
+  suspended_.insert(node);
+}
+
+DomainState ResourceAllocator::plannable_locked() const {
+  if (suspended_.empty())
+    return devices_;
+  DomainState plannable;
+  for (const auto &[id, state] : devices_)
+    if (suspended_.count(state.device.node) == 0)
+      plannable.emplace(id, state);
+  return plannable;
+}
+
 void ResourceAllocator::remove_node(const std::string &node) {
   std::lock_guard lock(mutex_);
+  suspended_.erase(node);
   std::set<std::string> gone;
   for (const auto &[id, state] : devices_)
     if (state.device.node == node)
@@ -83,16 +100,16 @@ void ResourceAllocator::forget_devices_locked(const std::set<std::string> &gone)
 tl::expected<Plan, std::vector<Rejection>>
 ResourceAllocator::plan(const PlanRequest &request, const PlanOptions &options) const {
   std::lock_guard lock(mutex_);
-  return make_plan(devices_, request, options);
+  return make_plan(plannable_locked(), request, options);
 }
 
 tl::expected<Plan, std::vector<Rejection>> ResourceAllocator::allocate(const PlanRequest &request,
                                                                        const PlanOptions &options) {
   std::lock_guard lock(mutex_);
-  auto plan = make_plan(devices_, request, options);
+  auto plan = make_plan(plannable_locked(), request, options);
   if (!plan)
     return plan;
-  commit(devices_, *plan);
+  commit(devices_, *plan); // on devices plannable_locked() copied: the same ids
   plan->allocation = ++last_allocation_;
   reservations_.emplace(plan->allocation, Reservation{*plan, devices_of(*plan)});
   return plan;

@@ -26,6 +26,9 @@ public:
   void set_node_devices(const std::string &node, std::vector<Device> devices);
   // Forgets a node and everything reserved on its devices.
   void remove_node(const std::string &node);
+  // A node that is lost (unreachable; its processes may still run): its devices keep what is
+  // reserved on them but take no new placement until set_node_devices says it is back.
+  void suspend_node(const std::string &node);
 
   // Plans on the current state and reserves nothing (rsca plan).
   tl::expected<Plan, std::vector<Rejection>> plan(const PlanRequest &request,
@@ -52,8 +55,12 @@ private:
   // Drops the devices `gone` from every reservation. Called with mutex_ held.
   void forget_devices_locked(const std::set<std::string> &gone);
 
+  // The devices plans may use: all but those of suspended nodes. Called with mutex_ held.
+  DomainState plannable_locked() const;
+
   mutable std::mutex mutex_;
   DomainState devices_;
+  std::set<std::string> suspended_; // nodes
   std::map<AllocationId, Reservation> reservations_;
   AllocationId last_allocation_ = 0;
 };

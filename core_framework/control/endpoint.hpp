@@ -46,6 +46,9 @@ struct AnnouncementEvent {
   std::string address;
   std::string endpoint_kind; // "node", "component", "domain"; empty when Gone
   Json body;                 // empty when Gone
+  // Gone: withdrawn by its announcer (it stopped), not lost with its DDS lease (it died, or is
+  // cut off: which, nobody can tell from here).
+  bool withdrawn = false;
 };
 using AnnouncementHandler = std::function<void(const AnnouncementEvent &)>;
 

@@ -8,6 +8,7 @@
 #include <spdlog/spdlog.h>
 
 #include "control.h" // generated from dds/control.idl
+#include "protocol/topics.hpp"
 
 namespace rsca::control {
 
@@ -26,20 +27,27 @@ void Endpoint::Impl::take_announcements() {
       const auto *a = static_cast<const rsca_ctl_Announcement *>(samples[i]);
       const std::string announcer = str(a->announcer);
       AnnouncementEvent event;
-      if (infos[i].valid_data && infos[i].instance_state == DDS_IST_ALIVE) {
+      // A withdrawal's sample, whatever the instance's state now (a reused slot is alive again).
+      const bool withdrawal = infos[i].valid_data && str(a->kind) == protocol::kWithdrawnKind;
+      if (infos[i].valid_data && infos[i].instance_state == DDS_IST_ALIVE && !withdrawal) {
         event.kind = AnnouncementEvent::Kind::Alive;
         event.address = str(a->address);
         event.endpoint_kind = str(a->kind);
         event.body = parse_body(a->body);
         // The slot held another address: that one was withdrawn, its disposal overwritten.
         if (auto before = heard_slots.heard(announcer, a->slot, event.address))
-          handler(AnnouncementEvent{AnnouncementEvent::Kind::Gone, std::move(*before), {}, {}});
-      } else if (infos[i].instance_state != DDS_IST_ALIVE) {
+          handler(AnnouncementEvent{AnnouncementEvent::Kind::Gone,
+                                    std::move(*before),
+                                    {},
+                                    {},
+                                    /*withdrawn=*/true});
+      } else if (infos[i].instance_state != DDS_IST_ALIVE || withdrawal) {
         auto went = heard_slots.gone(announcer, a->slot);
         if (!went)
           continue; // a slot freed before this endpoint heard it
         event.kind = AnnouncementEvent::Kind::Gone;
         event.address = std::move(*went);
+        event.withdrawn = withdrawal;
       } else {
         continue;
       }
@@ -100,9 +108,9 @@ void Endpoint::Impl::withdraw(const std::string &as) {
   a.announcer = const_cast<char *>(address.c_str());
   a.slot = *slot;
   a.address = const_cast<char *>("");
-  a.kind = const_cast<char *>("");
+  a.kind = const_cast<char *>(protocol::kWithdrawnKind);
   a.body = const_cast<char *>("");
-  dds_dispose(announcement_writer.get(), &a);
+  dds_writedispose(announcement_writer.get(), &a); // with data: withdrawn, not lost
   // And let go of the instance, so that readers see it without writers until the slot is reused.
   dds_unregister_instance(announcement_writer.get(), &a);
 }

@@ -36,16 +36,27 @@ const ComponentInstance *Application::find_component(std::string_view id) const 
   return nullptr;
 }
 
-std::vector<std::string> exited_components(const Application &app) {
+namespace {
+std::vector<std::string> components_in(const Application &app, ComponentState state) {
   std::vector<std::string> ids;
   for (const auto &c : app.components)
-    if (c.state == ComponentState::Exited)
+    if (c.state == state)
       ids.push_back(c.id);
   return ids;
 }
+} // namespace
+
+std::vector<std::string> exited_components(const Application &app) {
+  return components_in(app, ComponentState::Exited);
+}
+
+std::vector<std::string> unreachable_components(const Application &app) {
+  return components_in(app, ComponentState::Unreachable);
+}
 
 std::string state_of(const Application &app) {
-  return exited_components(app).empty() ? std::string(to_string(app.state)) : "degraded";
+  const bool whole = exited_components(app).empty() && unreachable_components(app).empty();
+  return whole ? std::string(to_string(app.state)) : "degraded";
 }
 
 protocol::application::ApplicationView view_of(const Application &app) {

@@ -33,6 +33,7 @@ struct ComponentInstance {
   std::string spd;     // the SPD it runs from
   long pid = 0;
   ComponentState state = ComponentState::Allocated;
+  ComponentState state_before_lost = ComponentState::Allocated; // restored when its node is back
   std::uint32_t start_order = 0;
   bool assembly_controller = false;
   // The node that relays to its process (which that node started); empty when none does.
@@ -91,6 +92,8 @@ struct Application {
 
 // The ids of the components that exited while the application ran.
 std::vector<std::string> exited_components(const Application &app);
+// Those on a node that is lost (they may still run).
+std::vector<std::string> unreachable_components(const Application &app);
 // The application's state as users see it: "degraded" once a component has exited (until it is
 // released), else its lifecycle state.
 std::string state_of(const Application &app);

@@ -21,11 +21,13 @@ CallResult<std::shared_ptr<Application>> ApplicationFactory::create(const Launch
 
 namespace {
 
+// Exited, or on a node that is lost: not called, since it cannot answer.
 bool exited(const ComponentInstance &c) {
-  return c.state == ComponentState::Exited;
+  return c.state == ComponentState::Exited || c.state == ComponentState::Unreachable;
 }
 
-// Marks the components `ids` names as `state`, except those that exited meanwhile.
+// Marks the components `ids` names as `state`, except those that exited (or became unreachable)
+// meanwhile.
 void mark(Application &app, const std::vector<std::string> &ids, ComponentState state) {
   for (const auto &id : ids)
     if (auto *c = app.find_component(id); c != nullptr && !exited(*c))

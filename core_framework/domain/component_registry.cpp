@@ -29,6 +29,19 @@ std::vector<std::string> ComponentRegistry::node_gone(const std::string &node,
   return gone;
 }
 
+void ComponentRegistry::reachable_again(const std::string &address) {
+  {
+    std::lock_guard lock(mutex_);
+    auto it = entries_.find(address);
+    if (it == entries_.end())
+      return;
+    it->second.exited = false;
+    it->second.why.clear();
+    it->second.registered = true;
+  }
+  changed_.notify_all();
+}
+
 void ComponentRegistry::announced(const std::string &address) {
   {
     std::lock_guard lock(mutex_);

@@ -23,8 +23,11 @@ public:
   // Its endpoint disappeared from DDS: not registered until it announces itself again.
   void gone(const std::string &address);
   void exited(const std::string &address, const std::string &why);
-  // The node is gone and its components with it: marks them exited, and returns their addresses.
+  // The node is lost: marks its components exited for the launches that wait on them (they
+  // cannot be reached), and returns their addresses.
   std::vector<std::string> node_gone(const std::string &node, const std::string &why);
+  // Its node is back and its process lived on: registered again, no longer exited.
+  void reachable_again(const std::string &address);
   // Forgets an address (its component was released), so a later one can reuse it.
   void forget(const std::string &address);
 

@@ -29,6 +29,11 @@ CallResult<const ComponentInstance *> target_of(const Application &app,
     if (c.state == ComponentState::Exited)
       return control::call_error(
           Status::Failed, fmt::format("component {} of application {} has exited", c.id, app.name));
+    if (c.state == ComponentState::Unreachable)
+      return control::call_error(
+          Status::Unavailable,
+          fmt::format("component {} of application {} is unreachable: its node {} is lost", c.id,
+                      app.name, c.node));
     return &c;
   }
   return control::call_error(

@@ -1,4 +1,4 @@
-// The DomainManager's nodes, devices, connections and channels: what nodes and components
+// The DomainManager's devices, connections and channels: what components
 // announce, where a connection's end is served, the connections' live state, runtime connections
 // kept across restarts, and event channels.
 #include <algorithm>
@@ -102,20 +102,6 @@ connection_ops::ChannelView view_of(const EventChannel &channel) {
   return view;
 }
 
-Json device_ids(const protocol::node::NodeAnnouncement &node) {
-  Json ids = Json::array();
-  for (const auto &d : node.devices)
-    ids.push_back(d.id);
-  return ids;
-}
-
-std::vector<allocator::Device> devices_of(const protocol::node::NodeAnnouncement &node) {
-  std::vector<allocator::Device> devices;
-  for (const auto &d : node.devices)
-    devices.push_back(allocator::device_from_announcement(node.node, protocol::encode(d)));
-  return devices;
-}
-
 // {"application", "component", "port"}, {"application", "port"} (an external port) or
 // {"device", "port"}.
 CallResult<PortRef> port_ref(const connection_ops::PortEnd &end, const char *key) {
@@ -140,7 +126,7 @@ CallResult<PortRef> port_ref(const connection_ops::PortEnd &end, const char *key
 // not exited (one that exited cannot answer) and the devices its connections reach.
 void status_addresses(const Application &app, std::set<std::string> &addresses) {
   for (const auto &c : app.components)
-    if (c.state != ComponentState::Exited)
+    if (c.state != ComponentState::Exited && c.state != ComponentState::Unreachable)
       addresses.insert(c.address);
   for (const auto &c : app.connections)
     for (const auto *end : {&c.uses, &c.provides})
@@ -173,52 +159,7 @@ void DomainManager::Impl::on_announcement(const control::AnnouncementEvent &even
   if (event.kind != Kind::Gone)
     return;
   components.gone(event.address);
-  node_gone(event.address);
-}
-
-// A node's announcement is untrusted like any message: one that does not fit the contract is
-// not taken (its devices would be guesses), and said so.
-void DomainManager::Impl::node_alive(const control::AnnouncementEvent &event) {
-  auto announced = protocol::decode<protocol::node::NodeAnnouncement>(event.body);
-  if (!announced) {
-    const std::string why = excerpt(announced.error(), 300);
-    if (nodes.refused(event.address, why))
-      spdlog::warn("node at {}: its announcement is not taken: {}", excerpt(event.address), why);
-    return;
-  }
-  const std::string node = announced->node;
-  const auto devices = announced->devices.size();
-  allocator.set_node_devices(node, devices_of(*announced));
-  const Json ids = device_ids(*announced);
-  const bool fresh = nodes.alive(event.address, std::move(*announced));
-  runtime_connections->endpoints_changed(); // connections waiting for its devices
-  if (!fresh)
-    return;
-  spdlog::info("node {} registered with {} device(s)", node, devices);
-  events->publish("node.added", {{"node", node}, {"devices", ids}});
-}
-
-void DomainManager::Impl::node_gone(const std::string &address) {
-  {
-    std::lock_guard lock(unknown_mutex);
-    unknown.erase(address); // an unknown component that went away
-  }
-  auto gone = nodes.gone(address);
-  if (!gone)
-    return;
-  const std::string node = gone->announcement.node;
-  spdlog::warn("node {} is gone; its devices leave the domain", node);
-  events->publish("node.removed", {{"node", node}, {"devices", device_ids(gone->announcement)}});
-  allocator.remove_node(node);
-  // Its component processes died with it (they cannot outlive their node); their own leases
-  // are longer than a node's, so their announcements would linger.
-  const auto why = fmt::format("its node {} is gone", node);
-  for (const auto &component : components.node_gone(node, why))
-    endpoint->abandon(component, why);
-  mark_exited([&node](const ComponentInstance &c) { return c.node == node; }, why);
-  runtime_connections->owner_gone_later([prefix = node + ":"](const PortRef &ref) {
-    return ref.kind == PortRef::Kind::Device && ref.owner.starts_with(prefix);
-  });
+  node_gone(event.address, event.withdrawn);
 }
 
 // A component announced itself. One that an earlier run of this domain daemon launched (its

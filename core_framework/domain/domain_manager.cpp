@@ -282,8 +282,8 @@ DomainManager::Impl::start_or_stop(const app_ops::AppRequest &request, bool star
 CallResult<app_ops::ListReply> DomainManager::Impl::list_applications() {
   app_ops::ListReply reply;
   for (const auto &app : applications.snapshots())
-    reply.applications.push_back(
-        {app.name, app.installed, state_of(app), exited_components(app), app.components.size()});
+    reply.applications.push_back({app.name, app.installed, state_of(app), exited_components(app),
+                                  app.components.size(), unreachable_components(app)});
   reply.unknown = unknown_components();
   return reply;
 }
@@ -360,7 +360,8 @@ DomainManager::DomainManager(std::unique_ptr<Impl> impl) : impl_(std::move(impl)
 
 DomainManager::~DomainManager() {
   // Releasing applications is the operator's decision; the domain only stops serving.
-  impl_->runtime_connections->stop(); // its thread calls through the endpoint
+  impl_->node_returns->stop();        // its thread calls through the endpoint
+  impl_->runtime_connections->stop(); // so does this one's
   // The handlers reach the endpoint through impl_->endpoint, which reset() clears before the
   // endpoint's destructor waits for them (ThreadSanitizer saw connection.list read it meanwhile).
   impl_->endpoint->stop_serving();
@@ -373,6 +374,7 @@ DomainManager::create(std::shared_ptr<dds::Participant> participant, DomainOptio
   impl->options = std::move(options);
   impl->participant = participant;
   impl->channels.emplace(impl->options.name);
+  impl->node_returns = std::make_unique<control::WorkerPool>(1);
   std::error_code ec;
   fs::create_directories(impl->options.repository, ec);
   if (ec)

@@ -1,8 +1,9 @@
 // Internal to the DomainManager: its parts and the operations it serves, shared by the files that
-// implement them (domain_manager.cpp: installs and applications; domain_connections.cpp: nodes,
-// devices, connections and channels). Each part owns its state and its lock: the installed
-// applications (InstalledRepository), the running ones (ApplicationRegistry), the nodes (below),
-// runtime connections (ConnectionManager), event channels (EventChannelManager).
+// implement them (domain_manager.cpp: installs and applications; domain_nodes.cpp: nodes that
+// announce themselves, are lost and are back; domain_connections.cpp: devices, connections and
+// channels). Each part owns its state and its lock: the installed applications
+// (InstalledRepository), the running ones (ApplicationRegistry), the nodes (below), runtime
+// connections (ConnectionManager), event channels (EventChannelManager).
 #pragma once
 
 #include <atomic>
@@ -17,6 +18,7 @@
 
 #include "control/domain_events.hpp"
 #include "control/operation.hpp"
+#include "control/worker_pool.hpp"
 #include "domain/application_registry.hpp"
 #include "domain/connection_manager.hpp"
 #include "domain/domain_manager.hpp"
@@ -40,6 +42,13 @@ namespace domain_ops = protocol::domain;
 struct UnknownComponent {
   std::string address;
   protocol::component::Announcement announcement;
+};
+
+// A component process on a node when the node was lost: its pid and label (APPLICATION/COMPONENT,
+// as the node lists it).
+struct LostProcess {
+  long pid = 0;
+  std::string label;
 };
 
 struct DomainManager::Impl {
@@ -66,6 +75,10 @@ struct DomainManager::Impl {
   NodeDirectory nodes;
   std::mutex unknown_mutex; // guards unknown
   std::map<std::string, UnknownComponent> unknown;
+  std::mutex lost_mutex;                                          // guards lost_processes
+  std::map<std::string, std::vector<LostProcess>> lost_processes; // by node, until it is back
+  // Where a node that is back is asked what it runs: the announcement's thread must not wait.
+  std::unique_ptr<control::WorkerPool> node_returns;
 
   ApplicationFactory factory();
   // Runs a change of `name`'s state under the registry's lock (ApplicationFactory::ApplyChange).
@@ -103,10 +116,15 @@ struct DomainManager::Impl {
   template <control::Operation Op, typename Handler>
   void serve_op(Handler handler);
 
-  // Nodes, devices, connections and channels (domain_connections.cpp).
-  void on_announcement(const control::AnnouncementEvent &event);
+  // Nodes that announce themselves, are lost and are back (domain_nodes.cpp).
   void node_alive(const control::AnnouncementEvent &event);
-  void node_gone(const std::string &address);
+  // A node withdrawn (it stopped) or lost (its lease ran out: dead, or cut off).
+  void node_gone(const std::string &address, bool withdrawn);
+  void mark_unreachable(const std::string &node, const std::string &why);
+  void node_back(const std::string &node);
+
+  // Devices, connections and channels (domain_connections.cpp).
+  void on_announcement(const control::AnnouncementEvent &event);
   void component_announced(const control::AnnouncementEvent &event);
   CallResult<std::string> device_address(const std::string &id);
   CallResult<ResolvedEnd> resolve_end(const PortRef &ref, profile::PortDirection direction);

@@ -34,7 +34,7 @@ std::vector<NodeDirectory::Refused> NodeDirectory::refused_nodes() const {
   return out;
 }
 
-std::optional<NodeDirectory::Node> NodeDirectory::gone(const std::string &address) {
+std::optional<NodeDirectory::Node> NodeDirectory::gone(const std::string &address, bool lost) {
   std::lock_guard lock(mutex_);
   refused_.erase(address);
   auto it = std::find_if(nodes_.begin(), nodes_.end(),
@@ -43,6 +43,20 @@ std::optional<NodeDirectory::Node> NodeDirectory::gone(const std::string &addres
     return std::nullopt;
   Node node = std::move(it->second);
   nodes_.erase(it);
+  if (lost)
+    lost_[node.announcement.node] = node; // one per name: bounded by the nodes there were
+  else
+    lost_.erase(node.announcement.node);
+  return node;
+}
+
+std::optional<NodeDirectory::Node> NodeDirectory::take_lost(const std::string &name) {
+  std::lock_guard lock(mutex_);
+  auto it = lost_.find(name);
+  if (it == lost_.end())
+    return std::nullopt;
+  Node node = std::move(it->second);
+  lost_.erase(it);
   return node;
 }
 

@@ -33,8 +33,11 @@ public:
   bool alive(const std::string &address, protocol::node::NodeAnnouncement announcement);
   // Records that the node at `address` was refused, and why; false when it was already.
   bool refused(const std::string &address, std::string why);
-  // The node at `address` left: its record, now dropped; nothing for an address no node has.
-  std::optional<Node> gone(const std::string &address);
+  // The node at `address` left: its record, now dropped, and kept as lost when `lost` (it may be
+  // back); nothing for an address no node has.
+  std::optional<Node> gone(const std::string &address, bool lost);
+  // The record of the node `name` when it was lost, taken (it is back); nothing if it was not.
+  std::optional<Node> take_lost(const std::string &name);
 
   bool contains(const std::string &node) const;
   std::optional<std::string> address_of(const std::string &node) const;
@@ -51,6 +54,7 @@ private:
   mutable std::mutex mutex_;
   std::map<std::string, Node> nodes_;          // by name
   std::map<std::string, std::string> refused_; // why, by address
+  std::map<std::string, Node> lost_;           // by name, until it is back
 };
 
 } // namespace rsca::domain

@@ -19,6 +19,8 @@ namespace application {
 
 // A component's life as the domain sees it, in the order a launch and a release pass through.
 // Exited is final while the application runs: a component that exited is never called again.
+// Unreachable is not: its node was lost (a network partition, or the node died), and when the
+// node is back the component is running again if its process lived on, else exited.
 enum class ComponentState : std::uint8_t {
   Allocated,  // placed, its device's capacity reserved
   Executed,   // its process started
@@ -26,7 +28,8 @@ enum class ComponentState : std::uint8_t {
   Running,
   Stopped,
   Exited, // its process ended without being asked to
-  Released
+  Released,
+  Unreachable // its node is lost; it may still run
 };
 
 } // namespace application
@@ -38,7 +41,7 @@ struct EnumNames<application::ComponentState> {
       std::pair{S::Allocated, "allocated"},   std::pair{S::Executed, "executed"},
       std::pair{S::Registered, "registered"}, std::pair{S::Running, "running"},
       std::pair{S::Stopped, "stopped"},       std::pair{S::Exited, "exited"},
-      std::pair{S::Released, "released"}};
+      std::pair{S::Released, "released"},     std::pair{S::Unreachable, "unreachable"}};
 };
 
 } // namespace rsca::protocol
@@ -252,11 +255,15 @@ struct ApplicationSummary {
   std::string state;
   std::vector<std::string> exited;
   std::uint64_t components = 0;
+  std::vector<std::string> unreachable; // on a node that is lost
   static constexpr auto fields() {
     using R = ApplicationSummary;
-    return std::tuple{required("name", &R::name), required("installed", &R::installed),
-                      required("state", &R::state), required("exited", &R::exited),
-                      required("components", &R::components)};
+    return std::tuple{required("name", &R::name),
+                      required("installed", &R::installed),
+                      required("state", &R::state),
+                      required("exited", &R::exited),
+                      required("components", &R::components),
+                      optional("unreachable", &R::unreachable)};
   }
 };
 

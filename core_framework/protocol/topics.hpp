@@ -15,6 +15,9 @@ inline constexpr const char *kReplyTopic = "rsca_ctl_Reply";
 // Version 2: keyed by announcer and slot (dds/control.idl). A daemon of the address-keyed version
 // is on another topic, never mis-reading these.
 inline constexpr const char *kAnnouncementTopic = "rsca_ctl_Announcement_v2";
+// The kind of an announcement's last sample when its announcer withdrew it (it stopped), unlike
+// one lost with the announcer's DDS lease (it died, or is cut off).
+inline constexpr const char *kWithdrawnKind = "withdrawn";
 
 // A domain's events (control/domain_events.hpp).
 std::string domain_events_topic(std::string_view domain);

@@ -156,7 +156,8 @@ TEST_CASE("a component that crashes after launch is reported to the domain",
   domain.require_clean(pids_of(app));
 }
 
-TEST_CASE("the components of a node that dies are reported exited, with the node as the reason",
+TEST_CASE("the components of a node that dies are reported unreachable, with the node as the "
+          "reason, and exited once it is back as a new run",
           "[integration][domain][failure]") {
   TestDomain domain;
   const Json app = domain.create("Healthy");
@@ -165,26 +166,39 @@ TEST_CASE("the components of a node that dies are reported exited, with the node
   for (const auto &c : app.at("components"))
     on_node += c.at("node") == node ? 1 : 0;
   domain.kill_node(node == "node1" ? 1 : 2);
-  // A component's own lease is long (its node watches it); the node's loss is what tells.
-  // Events: two nodes added, the application created, the node removed, its components exited.
+  // A component's own lease is long (its node watches it); the node's loss is what tells. The
+  // domain cannot tell a dead node from an unreachable one: its components are unreachable.
+  // Events: two nodes added, the application created, the node removed, its components
+  // unreachable.
   auto [rc, out] = domain.cli(
       {"--json", "events", "--count", std::to_string(4 + on_node), "--wait-ms", "10000"});
   INFO(out);
   REQUIRE(rc == 0);
   std::istringstream lines(out);
-  int exited = 0;
+  int unreachable = 0;
   for (std::string line; std::getline(lines, line);) {
     const Json event = Json::parse(line);
-    if (event.at("kind") != "component.exited")
+    if (event.at("kind") != "component.unreachable")
       continue;
-    CHECK(event.at("details").at("why") == fmt::format("its node {} is gone", node));
-    ++exited;
+    CHECK(event.at("details").at("why") == fmt::format("its node {} is lost", node));
+    ++unreachable;
   }
-  CHECK(exited == on_node);
-  auto shown = domain.call("app.show", Json{{"app", "Healthy"}});
-  REQUIRE(shown.has_value());
-  for (const auto &c : shown->at("components"))
-    CHECK((c.at("state") == "exited") == (c.at("node") == node));
+  CHECK(unreachable == on_node);
+  auto state_on = [&](const std::string &expected) {
+    auto shown = domain.call("app.show", Json{{"app", "Healthy"}});
+    REQUIRE(shown.has_value());
+    CHECK(shown->at("state") == "degraded");
+    for (const auto &c : shown->at("components"))
+      CHECK((c.at("state") == expected) == (c.at("node") == node));
+  };
+  state_on("unreachable");
+  // Back as a new run of the node daemon: its processes died with the old one.
+  domain.start_node(TestDomain::shipped_nodes(2)[node == "node1" ? 0 : 1]);
+  REQUIRE(TestDomain::wait_for([&] {
+    auto shown = domain.call("app.show", Json{{"app", "Healthy"}});
+    return shown && shown->at("exited").size() == static_cast<std::size_t>(on_node);
+  }));
+  state_on("exited");
   REQUIRE(domain.call("app.release", Json{{"app", "Healthy"}}).has_value());
   domain.require_clean(pids_of(app));
 }

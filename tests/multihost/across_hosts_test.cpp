@@ -4,7 +4,9 @@
 
 #include <algorithm>
 #include <csignal>
+#include <map>
 #include <set>
+#include <thread>
 
 #include "hosts_domain.hpp"
 
@@ -72,5 +74,81 @@ TEST_CASE("ProducerConsumer spread over two network hosts: launched, matched, it
   CHECK(apps.json().at("applications").empty());
   CHECK(HostsDomain::wait_for([&] {
     return std::none_of(pids.begin(), pids.end(), [](pid_t pid) { return ::kill(pid, 0) == 0; });
+  }));
+}
+
+TEST_CASE("a host's link down for 5 s and back: its node lost and back, its component reachable "
+          "again, the connection carrying data again, nothing twice",
+          "[multihost]") {
+  HostsDomain domain(2);
+  const auto launched =
+      domain.cli(1, {"launch", kProducerConsumer, "--strategy", "spread"}, HostsDomain::over_dds());
+  INFO(launched.out << launched.err);
+  REQUIRE(launched.rc == 0);
+  const auto reply = launched.json();
+  std::map<std::string, pid_t> pid_of;
+  int consumer_node = 0;
+  for (const auto &c : reply.at("components")) {
+    pid_of[c.at("id").get<std::string>()] = c.at("pid").get<pid_t>();
+    if (c.at("id") == "Consumer_1")
+      consumer_node = c.at("node") == "node1" ? 1 : 2;
+  }
+  REQUIRE(HostsDomain::wait_for([&] { return samples_flow(domain); }));
+
+  // The cable of the consumer's host pulled: the domain (over DDS, on its own host) sees the
+  // node lost and its component unreachable, not exited.
+  const auto pulled_at = std::chrono::steady_clock::now();
+  domain.hosts().set_link(HostsDomain::host_of_node(consumer_node), false);
+  auto app_summary = [&] {
+    const auto listed =
+        domain.cli(1, {"--timeout-ms", "2000", "ls", "apps"}, HostsDomain::over_dds());
+    const auto json = listed.json();
+    return listed.rc == 0 && !json.is_discarded() && json.at("applications").size() == 1
+               ? json.at("applications")[0]
+               : Json();
+  };
+  REQUIRE(HostsDomain::wait_for([&] {
+    const auto app = app_summary();
+    return !app.is_null() && app.value("unreachable", Json::array()) == Json::array({"Consumer_1"});
+  }));
+  CHECK(app_summary().at("state") == "degraded");
+  CHECK(app_summary().at("exited").empty());
+  // Down for 5 s in all, as the issue's scenario: the time is the scenario, not a wait.
+  std::this_thread::sleep_until(pulled_at + 5s);
+  domain.hosts().set_link(HostsDomain::host_of_node(consumer_node), true);
+
+  // Back: the component is reachable again in the state it had, nothing exited.
+  REQUIRE(HostsDomain::wait_for([&] {
+    const auto app = app_summary();
+    return !app.is_null() && app.at("state") == "running" &&
+           app.value("unreachable", Json::array()).empty();
+  }));
+  CHECK(app_summary().at("exited").empty());
+  // Data flows again on the one connection there is: the consumer's count grows.
+  const auto samples_now = [&] {
+    const auto c = connection_state(domain, "ProducerConsumer", "samples");
+    return c.is_null() || !c.contains("provides_state") || c.at("provides_state").is_null()
+               ? -1
+               : c.at("provides_state").at("samples").get<int>();
+  };
+  const int after_heal = samples_now();
+  REQUIRE(after_heal >= 0);
+  CHECK(HostsDomain::wait_for([&] { return samples_now() > after_heal; }));
+  const auto listed = domain.cli(1, {"ls", "connections", "ProducerConsumer"});
+  REQUIRE(listed.rc == 0);
+  CHECK(listed.json().at("connections").size() == 1);
+  const auto shown = domain.cli(1, {"show", "ProducerConsumer"}, HostsDomain::over_dds());
+  INFO(shown.out << shown.err);
+  REQUIRE(shown.rc == 0);
+  for (const auto &c : shown.json().at("components")) {
+    CHECK(c.at("state") == "running");
+    CHECK(c.at("pid").get<pid_t>() == pid_of.at(c.at("id").get<std::string>())); // not twice
+  }
+
+  const auto released = domain.cli(1, {"release", "ProducerConsumer"}, HostsDomain::over_dds());
+  CHECK(released.rc == 0);
+  CHECK(HostsDomain::wait_for([&] {
+    return std::none_of(pid_of.begin(), pid_of.end(),
+                        [](const auto &p) { return ::kill(p.second, 0) == 0; });
   }));
 }

@@ -232,10 +232,18 @@ TEST_CASE("announcements are seen, updated and withdrawn", "[control]") {
     }));
     REQUIRE(node->announce("node", Json{{"devices", 2}}).has_value());
     CHECK(wait_for([](const auto &ev) { return ev.back().body.value("devices", 0) == 2; }));
-  } // the endpoint goes: its announcement is disposed
+  } // the endpoint goes without withdrawing: DDS disposes its announcement, with no data
   CHECK(wait_for([](const auto &ev) {
     return ev.back().address == "test/node1" &&
-           ev.back().kind == control::AnnouncementEvent::Kind::Gone;
+           ev.back().kind == control::AnnouncementEvent::Kind::Gone && !ev.back().withdrawn;
+  }));
+  auto node2 = open(pp, "test/node2");
+  REQUIRE(node2->announce("node", Json::object()).has_value());
+  CHECK(wait_for([](const auto &ev) { return ev.back().address == "test/node2"; }));
+  node2->withdraw(); // said, not lost
+  CHECK(wait_for([](const auto &ev) {
+    return ev.back().address == "test/node2" &&
+           ev.back().kind == control::AnnouncementEvent::Kind::Gone && ev.back().withdrawn;
   }));
 }
 

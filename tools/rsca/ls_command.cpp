@@ -20,8 +20,11 @@ using control::Json;
 void print_apps(const app_ops::ListReply &r) {
   fmt::print("{:<24} {:<24} {:<10} {}\n", "APPLICATION", "INSTALLED AS", "STATE", "COMPONENTS");
   for (const auto &a : r.applications)
-    fmt::print("{:<24} {:<24} {:<10} {}{}\n", a.name, a.installed, a.state, a.components,
-               a.exited.empty() ? "" : fmt::format("  (exited: {})", fmt::join(a.exited, ", ")));
+    fmt::print("{:<24} {:<24} {:<10} {}{}{}\n", a.name, a.installed, a.state, a.components,
+               a.exited.empty() ? "" : fmt::format("  (exited: {})", fmt::join(a.exited, ", ")),
+               a.unreachable.empty()
+                   ? ""
+                   : fmt::format("  (unreachable: {})", fmt::join(a.unreachable, ", ")));
   // Left by an earlier run of the domain daemon (one that was killed): the domain cannot release
   // them, the operator can.
   if (r.unknown.empty())
