@@ -108,8 +108,14 @@ class Domain:
     environment of the daemons (and so of the components) and of the CLI, e.g. RSCA_DDS_* settings
     (docs/architecture.md). `env` is what other programs of the run must use to join the domain."""
 
-    def __init__(self, rsca, nodes, sdrroot=None, env=None, domaind_args=None, cli_args=None):
+    def __init__(self, rsca, nodes, sdrroot=None, env=None, domaind_args=None, cli_args=None,
+                 hosts=None, cli_host=None):
         self.rsca = rsca
+        # With hosts (network namespaces, tools/hosts), the daemons are started by hand, the domain
+        # daemon on hosts[0] and node i on hosts[i]; with cli_host, the CLI runs on that host and
+        # over DDS (not through a node's socket).
+        self.hosts = hosts
+        self.cli_host = cli_host
         # With domaind_args (e.g. ["--registration-timeout-ms", "60000"]), the daemons are started
         # here as `rsca domain up` starts them (own session, log and pid file in the run folder,
         # the SDR root's DMD and dev/nodes/nodeI DCDs), rsca-domaind with these arguments more.
@@ -130,8 +136,11 @@ class Domain:
 
     def cli(self, *args, check=True, timeout=600):
         started = time.perf_counter()
-        out = subprocess.run([self.rsca, "--json", *self.cli_args, *args], env=self.env,
-                             capture_output=True, text=True, timeout=timeout)
+        command, env = [self.rsca, "--json", *self.cli_args, *args], self.env
+        if self.cli_host:
+            command = ["ip", "netns", "exec", self.cli_host, *command]
+            env = dict(env, RSCA_NODE_SOCKET="none")
+        out = subprocess.run(command, env=env, capture_output=True, text=True, timeout=timeout)
         elapsed = (time.perf_counter() - started) * 1e3
         if check and out.returncode != 0:
             raise RuntimeError(f"rsca {' '.join(args)} failed ({out.returncode}): "
@@ -154,7 +163,9 @@ class Domain:
                     walk(v)
         walk(reply)
 
-    def _spawn(self, name, args):
+    def _spawn(self, name, args, host=None):
+        if host:
+            args = ["ip", "netns", "exec", host, *args]
         with open(os.path.join(self.run_dir, f"{name}.log"), "ab") as log:
             proc = subprocess.Popen(args, env=self.env, stdin=subprocess.DEVNULL, stdout=log,
                                     stderr=subprocess.STDOUT, start_new_session=True)
@@ -169,13 +180,14 @@ class Domain:
         self._spawn("domaind", [os.path.join(bin_dir, "rsca-domaind"), "--dmd",
                                 os.path.join(sdrroot, "dom/domain/DomainManager.dmd.xml"),
                                 "--repository", os.path.join(self.run_dir, "repository"),
-                                *self.domaind_args])
+                                *(self.domaind_args or [])], host=self.hosts and self.hosts[0])
         for i in range(1, self.nodes + 1):
             self._spawn(f"node{i}", [
                 os.path.join(bin_dir, "rsca-noded"), "--dcd",
                 os.path.join(sdrroot, f"dev/nodes/node{i}/DeviceManager.dcd.xml"), "--log-dir",
                 os.path.join(self.run_dir, "logs"), "--exec-path", bin_dir,
-                "--control-socket", os.path.join(self.run_dir, f"node{i}.sock")])
+                "--control-socket", os.path.join(self.run_dir, f"node{i}.sock")],
+                host=self.hosts and self.hosts[i])
         deadline = time.monotonic() + 60
         while time.monotonic() < deadline:
             try:
@@ -189,7 +201,7 @@ class Domain:
 
     def __enter__(self):
         try:
-            if self.domaind_args:
+            if self.domaind_args or self.hosts:
                 self._up_by_hand()
             else:
                 subprocess.run([self.rsca, *self._global(), "domain", "up", "--nodes",
@@ -214,6 +226,9 @@ class Domain:
         for pid in leftovers:
             kill_group(pid)
         wait_gone(leftovers, 5)
+        for proc in self.spawned:  # stopped as a service manager would, first
+            if proc.poll() is None:
+                proc.terminate()
         for proc in self.spawned:  # reaped: no zombie outlives the benchmark
             try:
                 proc.wait(timeout=5)

@@ -182,3 +182,35 @@ TEST_CASE_METHOD(
   allocator.release(*planned);
   CHECK(cpu_allocated(allocator, "n1:GPP") == Approx(30));
 }
+
+TEST_CASE_METHOD(TwoNodes,
+                 "allocator: a lost node keeps its reservations and takes no placement until it "
+                 "is back",
+                 "[allocator]") {
+  const auto a = allocator.allocate(spread_app(pkg), {});
+  REQUIRE(a.has_value());
+  allocator.suspend_node("n2");
+  CHECK(cpu_allocated(allocator, "n2:GPP") == Approx(20)); // its processes may still run
+
+  PlanRequest on_n2;
+  on_n2.components = {pinned("b", pkg, "n2:GPP")};
+  CHECK_FALSE(allocator.plan(on_n2, {}).has_value());
+  CHECK_FALSE(allocator.allocate(on_n2, {}).has_value());
+  PlanRequest anywhere;
+  anywhere.components = {pinned("b", pkg, "n1:GPP")};
+  anywhere.components[0].device.reset(); // the planner chooses
+  const auto elsewhere = allocator.plan(anywhere, {});
+  REQUIRE(elsewhere.has_value());
+  CHECK(elsewhere->placements.at(0).device == "n1:GPP");
+
+  // Back, the same run: its share is still A's, and it takes placements again.
+  allocator.set_node_devices("n2", {one_cpu_gpp("n2")});
+  CHECK(cpu_allocated(allocator, "n2:GPP") == Approx(20));
+  const auto b = allocator.allocate(on_n2, {});
+  REQUIRE(b.has_value());
+  CHECK(cpu_allocated(allocator, "n2:GPP") == Approx(50));
+  allocator.release(*a);
+  allocator.release(*b);
+  CHECK(cpu_allocated(allocator, "n2:GPP") == Approx(0).margin(1e-9));
+  CHECK(allocator.reservations() == 0);
+}
