@@ -11,35 +11,12 @@ every component runs and every connection is matched) and the domain's own time 
 """
 import os
 import statistics
-import subprocess
 import sys
 import json
 
-from local_domain import Domain, bench_arguments, summary
+from local_domain import Domain, NetHosts, bench_arguments, summary
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-HOSTS_TOOL = os.path.join(ROOT, "tools/hosts")
 SAD = "dom/waveforms/ProducerConsumer/ProducerConsumer.sad.xml"
-
-
-class NetHosts:
-    """tools/hosts up N, removed when it goes (also on failure)."""
-
-    def __init__(self, count):
-        self.name = f"rsca{os.getpid()}b"
-        self.count = count
-        self.hosts = []
-
-    def __enter__(self):
-        out = subprocess.run([HOSTS_TOOL, "up", str(self.count), "--name", self.name],
-                             capture_output=True, text=True)
-        if out.returncode != 0:
-            raise RuntimeError(f"tools/hosts up: {out.stderr.strip()}")
-        self.hosts = [line.split()[0] for line in out.stdout.splitlines() if line.strip()]
-        return self
-
-    def __exit__(self, *exc):
-        subprocess.run([HOSTS_TOOL, "down", self.name], capture_output=True)
 
 
 def launches(domain, runs):
@@ -58,10 +35,10 @@ def launches(domain, runs):
 
 def main():
     args = bench_arguments(__doc__).parse_args()
-    probe = subprocess.run([HOSTS_TOOL, "probe"], capture_output=True, text=True)
-    if probe.returncode != 0:
-        print(f"skipped: {probe.stderr.strip()}")
-        json.dump({"skipped": probe.stderr.strip()}, open(args.out, "w"))
+    why = NetHosts.unavailable()
+    if why:
+        print(f"skipped: {why}")
+        json.dump({"skipped": why}, open(args.out, "w"))
         return
     runs = 5 if args.quick else 20
     rsca = os.path.join(args.bin, "rsca")

@@ -102,6 +102,40 @@ def dds_env():
                 RSCA_DDS_TAG=f"bench-{os.getpid()}")
 
 
+class NetHosts:
+    """`tools/hosts up N` (network namespaces on a bridge; needs root), removed when it goes, also
+    on failure. `hosts`: their namespaces; a process runs on one as `ip netns exec HOST ...`."""
+    TOOL = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(
+        os.path.abspath(__file__)))), "tools/hosts")
+
+    def __init__(self, count):
+        self.name = f"rsca{os.getpid()}b"
+        self.count = count
+        self.hosts = []
+
+    @classmethod
+    def unavailable(cls):
+        """Why hosts cannot be made here, or None when they can."""
+        probe = subprocess.run([cls.TOOL, "probe"], capture_output=True, text=True)
+        return None if probe.returncode == 0 else probe.stderr.strip()
+
+    def __enter__(self):
+        out = subprocess.run([self.TOOL, "up", str(self.count), "--name", self.name],
+                             capture_output=True, text=True)
+        if out.returncode != 0:
+            raise RuntimeError(f"tools/hosts up: {out.stderr.strip()}")
+        self.hosts = [line.split()[0] for line in out.stdout.splitlines() if line.strip()]
+        return self
+
+    def __exit__(self, *exc):
+        subprocess.run([self.TOOL, "down", self.name], capture_output=True)
+
+
+def on_host(host, args):
+    """`args` run on network host `host` (a namespace of NetHosts), or here when None."""
+    return ["ip", "netns", "exec", host, *args] if host else list(args)
+
+
 class Domain:
     """`rsca domain up --nodes N` on a DDS domain id and run folder of its own. With `sdrroot`,
     the DMD and the node DCDs (dev/nodes/node1..N) come from that SDR root; `env` adds to the
@@ -138,7 +172,7 @@ class Domain:
         started = time.perf_counter()
         command, env = [self.rsca, "--json", *self.cli_args, *args], self.env
         if self.cli_host:
-            command = ["ip", "netns", "exec", self.cli_host, *command]
+            command = on_host(self.cli_host, command)
             env = dict(env, RSCA_NODE_SOCKET="none")
         out = subprocess.run(command, env=env, capture_output=True, text=True, timeout=timeout)
         elapsed = (time.perf_counter() - started) * 1e3
@@ -164,8 +198,7 @@ class Domain:
         walk(reply)
 
     def _spawn(self, name, args, host=None):
-        if host:
-            args = ["ip", "netns", "exec", host, *args]
+        args = on_host(host, args)
         with open(os.path.join(self.run_dir, f"{name}.log"), "ab") as log:
             proc = subprocess.Popen(args, env=self.env, stdin=subprocess.DEVNULL, stdout=log,
                                     stderr=subprocess.STDOUT, start_new_session=True)

@@ -46,11 +46,68 @@ import shutil
 import sys
 import tempfile
 
-from local_domain import Domain
+from local_domain import Domain, NetHosts
 from port_bench_fanout import Schedule, analyse_fanout, fanout_raw, fanout_rsca
 from port_bench_helpers import (FANOUT_LEASE_MS, SDRROOT, SIDES, LatencyIceoryx, LatencyRaw,
                                 LatencyRsca, busy_note, host_state, latency_stats, lease_env, ratio,
                                 raw_sizes)
+
+
+def bench_latency_hosts(args):
+    """Round trips between two network hosts (tools/hosts): BenchPing_1 and BenchEcho_1 on node1
+    and node2, each node on a host of its own, through the nodes and with direct DDS; the raw
+    DDS ping on node1's host and its echo on node2's, the baseline (issue 21)."""
+    why = NetHosts.unavailable()
+    if why:
+        print(f"skipped: {why}")
+        with open(args.out, "w") as f:
+            json.dump({"skipped": why}, f)
+        return 0
+    sides_hosts = ("rsca", "rsca_direct", "raw")
+    orders = [sides_hosts[i:] + sides_hosts[:i] for i in range(len(sides_hosts))]
+    count, warmup = (1000, 2000) if args.quick else (2000, 2000)
+    rsca = os.path.join(args.bin, "rsca")
+    raw = os.path.join(args.bin, "rsca-bench-raw")
+    work = tempfile.mkdtemp(prefix="rsca-portbench-")
+    env = dict(lease_env(args.lease_ms), RSCA_DDS_INTERFACE="eth0")
+    rtts = {name: array.array("Q") for name in sides_hosts}
+    try:
+        with NetHosts(3) as net, \
+                Domain(rsca, nodes=2, sdrroot=SDRROOT, env=env, hosts=net.hosts) as domain, \
+                contextlib.ExitStack() as closing:
+            sides = {"rsca": LatencyRsca(domain, work, count, warmup)}
+            closing.callback(sides["rsca"].close)
+            sides["rsca_direct"] = LatencyRsca(domain, work, count, warmup, "direct")
+            closing.callback(sides["rsca_direct"].close)
+            sides["raw"] = LatencyRaw(domain, raw, work, sides["rsca"].qos, count, warmup,
+                                      "waitset", hosts=(net.hosts[1], net.hosts[2]))
+            closing.callback(sides["raw"].close)
+            for index, order in enumerate(orders):
+                for name in order:
+                    rtts[name].extend(sides[name].run(index))
+    finally:
+        if not args.keep:
+            shutil.rmtree(work, ignore_errors=True)
+    results = {name: latency_stats(rtts[name]) for name in sides_hosts}
+    r, d, w = results["rsca"], results["rsca_direct"], results["raw"]
+    results["ratio_cross_host_p50"] = ratio(r["p50_us"], w["p50_us"])
+    results["ratio_cross_host_direct_p50"] = ratio(d["p50_us"], w["p50_us"])
+    with open(args.out, "w") as f:
+        json.dump(results, f, indent=2)
+    print(f"Round trip between two network hosts (namespaces on a bridge, tools/hosts), strict "
+          f"ping-pong, {len(orders)} rounds of {warmup} warm-up and {count} measured each.")
+    print()
+    print("| round trip | rsca, through the nodes | rsca, direct DDS | raw Cyclone DDS (waitset) "
+          "| nodes/raw | direct/raw |")
+    print("| --- | --- | --- | --- | --- | --- |")
+    for key, label in (("min_us", "min"), ("p50_us", "p50"), ("p90_us", "p90"),
+                       ("p99_us", "p99"), ("max_us", "max")):
+        print(f"| {label} | {r[key]:.1f} us | {d[key]:.1f} us | {w[key]:.1f} us "
+              f"| {ratio(r[key], w[key]):.2f} | {ratio(d[key], w[key]):.2f} |")
+    print()
+    print(f"ratio cross-host rsca/raw p50 = {results['ratio_cross_host_p50']:.2f}")
+    print(f"ratio cross-host direct rsca/raw p50 = {results['ratio_cross_host_direct_p50']:.2f}")
+    return 0
 
 
 def bench_latency(args):
@@ -295,10 +352,14 @@ def main():
                         "(fanout default 10000; latency default: the project's, 1000 for the "
                         "daemons, 10000 for components and raw programs)")
     parser.add_argument("--keep", action="store_true", help="keep the raw measurement files")
+    parser.add_argument("--hosts", action="store_true",
+                        help="latency: between two network hosts (tools/hosts; needs root)")
     args = parser.parse_args()
     if args.lease_ms is None and args.benchmark == "fanout":
         args.lease_ms = FANOUT_LEASE_MS
-    return bench_latency(args) if args.benchmark == "latency" else bench_fanout(args)
+    if args.benchmark == "latency":
+        return bench_latency_hosts(args) if args.hosts else bench_latency(args)
+    return bench_fanout(args)
 
 
 if __name__ == "__main__":

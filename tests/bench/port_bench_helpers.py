@@ -10,7 +10,7 @@ import statistics
 import subprocess
 import time
 
-from local_domain import Processes, percentile
+from local_domain import Processes, on_host, percentile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SDRROOT = os.path.join(HERE, "profiles")
@@ -290,9 +290,10 @@ class LatencyRaw(RawPingSide):
     The two share a session of their own, as BenchPing_1 and BenchEcho_1 share the session of the
     node that started them (local_domain.Processes says why that matters)."""
 
-    def __init__(self, domain, raw, work, qos, count, warmup, wake):
+    def __init__(self, domain, raw, work, qos, count, warmup, wake, hosts=(None, None)):
         super().__init__(work, count, warmup)
         self.domain, self.raw, self.wake = domain, raw, wake
+        self.ping_host, self.echo_host = hosts  # network hosts (port_bench.py --hosts), or here
         self.ping_topic = f"rsca_bench_raw_ping_{wake}_{os.getpid()}"
         self.echo_topic = f"rsca_bench_raw_echo_{wake}_{os.getpid()}"
         self.qos = json.dumps(qos)
@@ -300,15 +301,17 @@ class LatencyRaw(RawPingSide):
 
     def _start_echo(self):
         self.echo = self.procs.start(
-            [self.raw, "echo", "--in", self.ping_topic, "--out", self.echo_topic, "--qos",
-             self.qos, "--wake", self.wake], self.domain.env,
+            on_host(self.echo_host,
+                    [self.raw, "echo", "--in", self.ping_topic, "--out", self.echo_topic, "--qos",
+                     self.qos, "--wake", self.wake]), self.domain.env,
             os.path.join(self.work, f"raw-{self.wake}-echo.log"))
 
     def run(self, index):
         output = os.path.join(self.work, f"raw-{self.wake}-rtt-{index}.bin")
-        return run_ping(self, [self.raw, "ping", "--out", self.ping_topic, "--in",
-                               self.echo_topic, "--qos", self.qos, "--wake", self.wake, "--count",
-                               str(self.count), "--warmup", str(self.warmup), "--output", output],
+        return run_ping(self, on_host(self.ping_host, [
+                            self.raw, "ping", "--out", self.ping_topic, "--in", self.echo_topic,
+                            "--qos", self.qos, "--wake", self.wake, "--count", str(self.count),
+                            "--warmup", str(self.warmup), "--output", output]),
                         self.domain.env, f"raw-{self.wake}-ping-{index}.log", output)
 
 
