@@ -46,6 +46,15 @@ int main(int argc, char **argv) {
   app.add_option("--control-socket", control_socket,
                  "A Unix socket where local clients (the CLI) reach the domain through this node "
                  "instead of DDS (default: none)");
+  std::uint32_t ring_kib = options.rings.data_bytes / 1024;
+  app.add_option("--ring-kib", ring_kib,
+                 "Data in each same-host ring, in KiB (a power of two, 4 to 262144; a sample takes "
+                 "at most half)")
+      ->capture_default_str();
+  app.add_option("--ring-records", options.rings.records,
+                 "Records in each same-host ring (a power of two, 16 to 1048576): the most a "
+                 "reader may fall behind")
+      ->capture_default_str();
   app.add_option("--log-level", level, "trace, debug, info, warn, error")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   spdlog::set_level(spdlog::level::from_str(level));
@@ -53,6 +62,11 @@ int main(int argc, char **argv) {
   spdlog::info("running at nice {} (components at {})", nice, rsca::application_nice());
 
   options.dcd = dcd;
+  if (ring_kib > (256U << 10U)) {
+    spdlog::error("--ring-kib {}: a ring holds at most 262144 KiB", ring_kib);
+    return 2;
+  }
+  options.rings.data_bytes = ring_kib * 1024;
   if (!sdrroot.empty())
     options.sdrroot = sdrroot;
   for (const auto &p : exec_path)

@@ -240,8 +240,10 @@ DeviceManager::create(std::shared_ptr<dds::Participant> participant, NodeOptions
   if (!endpoint)
     return tl::unexpected(endpoint.error());
   impl->endpoint = std::move(*endpoint);
+  if (auto why = shm::check(impl->options.rings))
+    return make_error({impl->options.dcd.string(), 0, 0}, "ring", *why);
   // Without shared memory the node still works: its processes then connect over DDS.
-  if (auto data = HostData::create(); data)
+  if (auto data = HostData::create(impl->options.rings); data)
     impl->host_data = std::move(*data);
   else
     spdlog::warn("no shared memory for this host's data ({}): same-host connections use DDS",

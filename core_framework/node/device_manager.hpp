@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "node/logical_device.hpp"
+#include "shm/ring.hpp"
 
 namespace rsca::node {
 
@@ -22,6 +23,9 @@ struct NodeOptions {
   // Where local clients (the CLI) connect for a link to the node (ProcessLinks::listen); none:
   // they use DDS.
   std::optional<std::filesystem::path> control_socket;
+  // Each ring of same-host data (one per topic with ends on this host): its bytes of data (a
+  // sample takes at most half) and records (the most a reader may fall behind).
+  shm::RingLimits rings;
 };
 
 class DeviceManager {

@@ -11,13 +11,16 @@ namespace rsca::node {
 
 namespace component_op = protocol::component;
 
-HostData::HostData(shm::Arena arena) : arena_(std::move(arena)), allocator_(arena_.size()) {}
+HostData::HostData(shm::Arena arena, shm::RingLimits rings)
+    : arena_(std::move(arena)), ring_limits_(rings), allocator_(arena_.size()) {}
 
-Expected<std::unique_ptr<HostData>> HostData::create(std::size_t bytes) {
+Expected<std::unique_ptr<HostData>> HostData::create(shm::RingLimits rings, std::size_t bytes) {
+  if (auto why = shm::check(rings))
+    return make_error({"node", 0, 0}, "ring", *why);
   auto arena = shm::Arena::create(bytes);
   if (!arena)
     return tl::unexpected(arena.error());
-  return std::unique_ptr<HostData>(new HostData(std::move(*arena)));
+  return std::unique_ptr<HostData>(new HostData(std::move(*arena), rings));
 }
 
 Expected<void> HostData::start_relay(const MakeRelay &make) {
@@ -66,7 +69,7 @@ void HostData::release_page(std::uint64_t page) {
 tl::expected<HostData::Ring *, std::string> HostData::ring_of_locked(const std::string &topic) {
   if (auto it = rings_.find(topic); it != rings_.end())
     return &it->second;
-  const shm::RingLimits limits;
+  const shm::RingLimits &limits = ring_limits_;
   auto offset = allocator_.allocate(shm::ring_bytes(limits));
   if (!offset)
     return tl::unexpected(

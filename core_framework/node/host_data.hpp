@@ -37,7 +37,9 @@ public:
   // thousands of components). Memory is taken only as they are used.
   static constexpr std::size_t kPageBytes = 256 * 1024;
 
-  static Expected<std::unique_ptr<HostData>> create(std::size_t bytes = kArenaBytes);
+  // Each same-host ring is made with `rings` (shm::check says which limits can be).
+  static Expected<std::unique_ptr<HostData>> create(shm::RingLimits rings = {},
+                                                    std::size_t bytes = kArenaBytes);
 
   int arena_fd() const { return arena_.fd(); }
 
@@ -95,7 +97,7 @@ private:
   // (pid, target, port, connection)
   using EndKey = std::tuple<pid_t, std::string, std::string, std::string>;
 
-  explicit HostData(shm::Arena arena);
+  HostData(shm::Arena arena, shm::RingLimits rings);
   tl::expected<Ring *, std::string> ring_of_locked(const std::string &topic);
   void release_locked(const End &end, bool lost);
   void free_ring_locked(const std::string &topic);
@@ -106,6 +108,7 @@ private:
   void release_locked(std::map<EndKey, End> &ends, const EndKey &key, bool lost);
 
   shm::Arena arena_;
+  const shm::RingLimits ring_limits_;
   mutable std::mutex mutex_; // guards what follows
   shm::ArenaAllocator allocator_;
   std::map<std::string, Ring> rings_; // by topic

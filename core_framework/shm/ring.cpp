@@ -45,6 +45,16 @@ std::int64_t steady_now_ns() {
 
 } // namespace
 
+std::optional<std::string> check(const RingLimits &limits) {
+  if (!power_of_two(limits.data_bytes) || !power_of_two(limits.records))
+    return "a ring's bytes and records are powers of two";
+  if (limits.data_bytes < (4U << 10U) || limits.data_bytes > (256U << 20U))
+    return fmt::format("a ring holds 4 KiB to 256 MiB of data, not {} bytes", limits.data_bytes);
+  if (limits.records < 16 || limits.records > (1U << 20U))
+    return fmt::format("a ring holds 16 to 1048576 records, not {}", limits.records);
+  return std::nullopt;
+}
+
 std::size_t ring_bytes(const RingLimits &limits) {
   return data_offset(limits.records) + limits.data_bytes;
 }
@@ -65,8 +75,8 @@ tl::expected<RingView, std::string> RingView::open(const Arena &arena, std::uint
 
 tl::expected<RingOwner, std::string> RingOwner::create(const Arena &arena, std::uint64_t offset,
                                                        const RingLimits &limits) {
-  if (!power_of_two(limits.data_bytes) || !power_of_two(limits.records))
-    return tl::unexpected(std::string("a ring's bytes and records are powers of two"));
+  if (auto why = check(limits))
+    return tl::unexpected(*why);
   std::byte *at = arena.at(offset, ring_bytes(limits));
   if (at == nullptr || offset % alignof(RingHeader) != 0)
     return tl::unexpected(fmt::format("no ring of {} bytes fits at offset {} of the arena",

@@ -43,6 +43,10 @@ struct RingLimits {
   std::uint32_t records = 1024;          // a power of two: the most a reader can fall behind
 };
 
+// Why `limits` cannot make a ring (not powers of two, or outside 4 KiB..256 MiB of data and
+// 16..1 Mi records), or nothing when they can.
+std::optional<std::string> check(const RingLimits &limits);
+
 namespace detail {
 
 enum SlotState : std::uint32_t { kSlotFree = 0, kSlotClaimed = 1, kSlotActive = 2 };

@@ -10,6 +10,7 @@
 
 #include "node/host_data.hpp"
 #include "protocol/component_ops.hpp"
+#include "shm/ring.hpp"
 
 using namespace rsca;
 
@@ -31,7 +32,7 @@ protocol::component::ConnectRequest same_host_connect(const std::string &directi
 
 TEST_CASE("host data: two ends of a topic share one ring; it goes with its last end",
           "[host-data]") {
-  auto data = node::HostData::create(64 << 20).value();
+  auto data = node::HostData::create({}, 64 << 20).value();
   const auto writer = data->connect(100, "a", same_host_connect("uses", "out"));
   REQUIRE(writer.has_value());
   data->connected(100, "a", "out", "c1", true);
@@ -64,7 +65,7 @@ TEST_CASE("host data: two ends of a topic share one ring; it goes with its last 
 
 TEST_CASE("host data: a same-host connect without its topic is refused, holding nothing",
           "[host-data]") {
-  auto data = node::HostData::create(64 << 20).value();
+  auto data = node::HostData::create({}, 64 << 20).value();
   auto no_topic = same_host_connect("uses", "out");
   no_topic.topic.reset();
   const auto refused = data->connect(100, "a", no_topic);
@@ -77,7 +78,7 @@ TEST_CASE("host data: a same-host connect without its topic is refused, holding 
 TEST_CASE("host data: a process that ends lets go of its page and its ends; its readers see a "
           "lost writer",
           "[host-data]") {
-  auto data = node::HostData::create(64 << 20).value();
+  auto data = node::HostData::create({}, 64 << 20).value();
   auto page = data->reserve_page();
   REQUIRE(page.has_value());
   CHECK(page->second.starts_with("4:"));
@@ -102,7 +103,7 @@ TEST_CASE("host data: a process that ends lets go of its page and its ends; its 
 
 TEST_CASE("host data: the page of a process that died before it was adopted is not kept",
           "[host-data]") {
-  auto data = node::HostData::create(64 << 20).value();
+  auto data = node::HostData::create({}, 64 << 20).value();
   const pid_t child = ::fork();
   REQUIRE(child >= 0);
   if (child == 0)
@@ -150,7 +151,7 @@ protocol::component::ConnectRequest relayed_connect(const std::string &direction
 TEST_CASE("host data: a topic's relay opens with its first relayed end of a direction and closes "
           "with the last",
           "[host-data]") {
-  auto data = node::HostData::create(64 << 20).value();
+  auto data = node::HostData::create({}, 64 << 20).value();
   std::vector<std::string> log;
   RecordingRelay *relay = nullptr;
   REQUIRE(
@@ -194,10 +195,36 @@ TEST_CASE("host data: a topic's relay opens with its first relayed end of a dire
 }
 
 TEST_CASE("host data: without a relay, a relayed connect is refused", "[host-data]") {
-  auto data = node::HostData::create(64 << 20).value();
+  auto data = node::HostData::create({}, 64 << 20).value();
   const auto refused = data->connect(100, "a", relayed_connect("uses", "p1"));
   REQUIRE_FALSE(refused.has_value());
   CHECK(refused.error() == "this node relays no data to other hosts");
   CHECK(data->counts().rings == 0);
   CHECK(data->counts().ends == 0);
+}
+
+TEST_CASE("host data: rings are made as the node was told; limits no ring can have are refused",
+          "[host-data]") {
+  CHECK_FALSE(node::HostData::create({3000, 64}, 64 << 20).has_value()); // not a power of two
+  CHECK_FALSE(node::HostData::create({1U << 30U, 64}, 64 << 20).has_value());
+  CHECK_FALSE(node::HostData::create({1U << 16U, 8}, 64 << 20).has_value());
+  auto data = node::HostData::create({1U << 20U, 64}, 64 << 20).value();
+  const auto writer = data->connect(100, "a", same_host_connect("uses", "out"));
+  REQUIRE(writer.has_value());
+  auto arena = shm::Arena::map(process::Fd(::dup(data->arena_fd())));
+  REQUIRE(arena.has_value());
+  auto view = shm::detail::RingView::open(*arena, writer->offset);
+  REQUIRE(view.has_value());
+  CHECK(view->data_bytes == (1U << 20U)); // a sample of up to 512 KiB goes through
+  CHECK(view->records == 64);
+  data->disconnect(100, "a", "out", "c1");
+}
+
+TEST_CASE("shm: ring limits are checked before a ring is made", "[host-data]") {
+  CHECK_FALSE(shm::check({}).has_value()); // the default
+  CHECK_FALSE(shm::check({4096, 16}).has_value());
+  CHECK(shm::check({4096, 15}).has_value());
+  CHECK(shm::check({2048, 16}).has_value());
+  CHECK(shm::check({1U << 29U, 16}).has_value());
+  CHECK(shm::check({4096, 1U << 21U}).has_value());
 }

@@ -171,7 +171,7 @@ TEST_CASE("process links: a process's own call is made on DDS by its node", "[pr
 TEST_CASE("process links: a relayed connect that asks for shared memory gets its ring from the "
           "host's data, which lets the end go with the process",
           "[process-links]") {
-  auto data = node::HostData::create(64 << 20).value();
+  auto data = node::HostData::create({}, 64 << 20).value();
   LinksRig rig(data.get());
   rig.caller->route(kLinkedChild, kLinkingNode);
   protocol::component::ConnectRequest connect;
