@@ -9,6 +9,7 @@
 #include <type_traits>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
 #include "allocator/plan_json.hpp"
@@ -271,6 +272,15 @@ DomainManager::Impl::start_or_stop(const app_ops::AppRequest &request, bool star
   if (!app)
     return control::call_error(Status::NotFound,
                                fmt::format("application {} was released meanwhile", name));
+  // Its unreachable components could not follow: when their node is back they would be left in
+  // the state they had, at odds with the application's.
+  if (const auto unreachable = unreachable_components(*app); !unreachable.empty())
+    return control::call_error(
+        Status::Unavailable,
+        fmt::format("application {} cannot {}: {} {} unreachable (its node is lost); try again "
+                    "when it is back",
+                    name, start ? "start" : "stop", fmt::join(unreachable, ", "),
+                    unreachable.size() == 1 ? "is" : "are"));
   auto done = start ? factory().start(*app, apply_to(name)) : factory().stop(*app, apply_to(name));
   if (!done)
     return tl::unexpected(done.error());
@@ -360,8 +370,9 @@ DomainManager::DomainManager(std::unique_ptr<Impl> impl) : impl_(std::move(impl)
 
 DomainManager::~DomainManager() {
   // Releasing applications is the operator's decision; the domain only stops serving.
-  impl_->node_returns->stop();        // its thread calls through the endpoint
-  impl_->runtime_connections->stop(); // so does this one's
+  impl_->stopping_node_returns = true; // a return still queued changes nothing, asks nothing
+  impl_->node_returns->stop();         // its thread calls through the endpoint
+  impl_->runtime_connections->stop();  // so does this one's
   // The handlers reach the endpoint through impl_->endpoint, which reset() clears before the
   // endpoint's destructor waits for them (ThreadSanitizer saw connection.list read it meanwhile).
   impl_->endpoint->stop_serving();

@@ -75,8 +75,10 @@ struct DomainManager::Impl {
   NodeDirectory nodes;
   std::mutex unknown_mutex; // guards unknown
   std::map<std::string, UnknownComponent> unknown;
-  std::mutex lost_mutex;                                          // guards lost_processes
+  std::mutex lost_mutex; // guards lost_processes and node_epochs
   std::map<std::string, std::vector<LostProcess>> lost_processes; // by node, until it is back
+  std::map<std::string, std::uint64_t> node_epochs;               // by node: one more at each loss
+  std::atomic<bool> stopping_node_returns{false};
   // Where a node that is back is asked what it runs: the announcement's thread must not wait.
   std::unique_ptr<control::WorkerPool> node_returns;
 
@@ -121,7 +123,9 @@ struct DomainManager::Impl {
   // A node withdrawn (it stopped) or lost (its lease ran out: dead, or cut off).
   void node_gone(const std::string &address, bool withdrawn);
   void mark_unreachable(const std::string &node, const std::string &why);
-  void node_back(const std::string &node);
+  void node_back(const std::string &node, std::uint64_t epoch);
+  std::uint64_t node_epoch(const std::string &node);
+  std::optional<std::set<long>> processes_on(const std::string &node, std::uint64_t epoch);
 
   // Devices, connections and channels (domain_connections.cpp).
   void on_announcement(const control::AnnouncementEvent &event);

@@ -79,7 +79,7 @@ void DomainManager::Impl::node_alive(const control::AnnouncementEvent &event) {
   }
   events->publish("node.added", {{"node", node}, {"devices", ids}, {"back", lost.has_value()}});
   if (lost)
-    node_returns->post([this, node] { node_back(node); });
+    node_returns->post([this, node, epoch = node_epoch(node)] { node_back(node, epoch); });
 }
 
 void DomainManager::Impl::node_gone(const std::string &address, bool withdrawn) {
@@ -120,6 +120,7 @@ void DomainManager::Impl::node_gone(const std::string &address, bool withdrawn) 
 
 void DomainManager::Impl::mark_unreachable(const std::string &node, const std::string &why) {
   std::lock_guard lock(lost_mutex);
+  ++node_epochs[node]; // a node_back under way for an earlier return no longer applies
   auto &processes = lost_processes[node];
   applications.update_all([&](Application &app) {
     for (auto &c : app.components) {
@@ -139,56 +140,80 @@ void DomainManager::Impl::mark_unreachable(const std::string &node, const std::s
   });
 }
 
-// Runs on its own thread (node_returns): it waits for the node's answer.
-void DomainManager::Impl::node_back(const std::string &node) {
+std::uint64_t DomainManager::Impl::node_epoch(const std::string &node) {
+  std::lock_guard lock(lost_mutex);
+  return node_epochs[node];
+}
+
+// The processes node `node` runs (pids: unique on one run of a node), asked a few times: right
+// after the node is back, the way to it may not be matched yet. Nothing when it is lost again,
+// the domain stops, or it does not answer.
+std::optional<std::set<long>> DomainManager::Impl::processes_on(const std::string &node,
+                                                                std::uint64_t epoch) {
+  constexpr int kAttempts = 5;
+  for (int attempt = 1; attempt <= kAttempts; ++attempt) {
+    const auto address = nodes.address_of(node);
+    if (!address || stopping_node_returns.load() || node_epoch(node) != epoch)
+      return std::nullopt;
+    auto status = control::call<protocol::node::Status>(*endpoint, *address, {},
+                                                        std::chrono::milliseconds(1000));
+    if (status) {
+      std::set<long> pids;
+      for (const auto &p : status->processes)
+        pids.insert(static_cast<long>(p.pid));
+      return pids;
+    }
+    spdlog::warn("node {} is back but does not say what it runs ({}; attempt {} of {})", node,
+                 status.error().message, attempt, kAttempts);
+  }
+  return std::nullopt;
+}
+
+// Runs on its own thread (node_returns): it waits for the node's answer. `epoch`: the node's
+// when it came back; if it is lost again meanwhile, this return is over and changes nothing.
+void DomainManager::Impl::node_back(const std::string &node, std::uint64_t epoch) {
+  const auto running = processes_on(node, epoch);
   std::vector<LostProcess> lost;
   {
     std::lock_guard lock(lost_mutex);
+    if (node_epochs[node] != epoch || !nodes.address_of(node) || stopping_node_returns.load())
+      return; // its processes stay unreachable, to be settled at its next return
     auto it = lost_processes.find(node);
     if (it == lost_processes.end())
       return;
     lost = std::move(it->second);
     lost_processes.erase(it);
+    // One pass under lost_mutex: a loss meanwhile (mark_unreachable) waits for it.
+    std::set<long> claimed;
+    applications.update_all([&](Application &app) {
+      for (auto &c : app.components) {
+        if (c.node != node || c.state != ComponentState::Unreachable)
+          continue;
+        claimed.insert(c.pid);
+        if (!running || running->count(c.pid) == 0)
+          continue; // marked exited below, as every other exit
+        c.state = c.state_before_lost;
+        components.reachable_again(c.address);
+        spdlog::info("component {} of application {} is reachable again (pid {})", c.id, app.name,
+                     c.pid);
+        events->publish("component.reachable",
+                        {{"application", app.name}, {"component", c.id}, {"node", node}});
+      }
+    });
+    mark_exited(
+        [&](const ComponentInstance &c) {
+          return c.node == node && c.state == ComponentState::Unreachable;
+        },
+        fmt::format("it ended while its node {} was lost", node));
+    std::erase_if(lost, [&](const LostProcess &p) {
+      return claimed.count(p.pid) != 0 || !running || running->count(p.pid) == 0;
+    });
   }
-  const auto address = nodes.address_of(node);
-  auto status =
-      address ? control::call<protocol::node::Status>(*endpoint, *address, {}, options.call_timeout)
-              : control::call_error(control::Status::Unavailable, "lost again");
-  std::set<std::pair<long, std::string>> running;
-  if (status)
-    for (const auto &p : status->processes)
-      running.insert({static_cast<long>(p.pid), p.label});
-  else
-    spdlog::warn("node {} is back but its status is not known ({}): its unreachable components "
-                 "are taken for exited",
-                 node, status.error().message);
-  std::set<std::pair<long, std::string>> claimed;
-  applications.update_all([&](Application &app) {
-    for (auto &c : app.components) {
-      if (c.node != node || c.state != ComponentState::Unreachable)
-        continue;
-      const std::pair<long, std::string> process{c.pid, fmt::format("{}/{}", app.name, c.id)};
-      claimed.insert(process);
-      if (running.count(process) == 0)
-        continue; // marked exited below, as every other exit
-      c.state = c.state_before_lost;
-      components.reachable_again(c.address);
-      spdlog::info("component {} of application {} is reachable again (pid {})", c.id, app.name,
-                   c.pid);
-      events->publish("component.reachable",
-                      {{"application", app.name}, {"component", c.id}, {"node", node}});
-    }
-  });
-  mark_exited(
-      [&](const ComponentInstance &c) {
-        return c.node == node && c.state == ComponentState::Unreachable;
-      },
-      fmt::format("it ended while its node {} was lost", node));
   // A process of an application released while its node was lost runs for nobody: ended.
+  const auto address = nodes.address_of(node);
   for (const auto &p : lost) {
-    const std::pair<long, std::string> process{p.pid, p.label};
-    if (claimed.count(process) != 0 || running.count(process) == 0 || !address)
-      continue;
+    if (!address)
+      break;
     spdlog::info("node {}: ending {} (pid {}): its application was released while the node was "
                  "lost",
                  node, p.label, p.pid);

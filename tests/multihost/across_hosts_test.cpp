@@ -30,8 +30,8 @@ Json connection_state(HostsDomain &domain, const std::string &app, const std::st
 }
 
 // Whether the consumer's end of `samples` has had data from a matched producer.
-bool samples_flow(HostsDomain &domain) {
-  const auto c = connection_state(domain, "ProducerConsumer", "samples");
+bool samples_flow(HostsDomain &domain, const std::string &app = "ProducerConsumer") {
+  const auto c = connection_state(domain, app, "samples");
   if (c.is_null() || !c.contains("provides_state"))
     return false;
   const auto &provides = c.at("provides_state");
@@ -80,9 +80,14 @@ TEST_CASE("ProducerConsumer spread over two network hosts: launched, matched, it
 TEST_CASE("a host's link down for 5 s and back: its node lost and back, its component reachable "
           "again, the connection carrying data again, nothing twice",
           "[multihost]") {
+  // As processes, and as libraries in component hosts (one process for the node's components).
+  const std::string app =
+      GENERATE(std::string("ProducerConsumer"), std::string("ProducerConsumerHosted"));
+  INFO(app);
   HostsDomain domain(2);
+  const auto sad = (kSource / fmt::format("profiles/dom/waveforms/{0}/{0}.sad.xml", app)).string();
   const auto launched =
-      domain.cli(1, {"launch", kProducerConsumer, "--strategy", "spread"}, HostsDomain::over_dds());
+      domain.cli(1, {"launch", sad, "--strategy", "spread"}, HostsDomain::over_dds());
   INFO(launched.out << launched.err);
   REQUIRE(launched.rc == 0);
   const auto reply = launched.json();
@@ -93,7 +98,7 @@ TEST_CASE("a host's link down for 5 s and back: its node lost and back, its comp
     if (c.at("id") == "Consumer_1")
       consumer_node = c.at("node") == "node1" ? 1 : 2;
   }
-  REQUIRE(HostsDomain::wait_for([&] { return samples_flow(domain); }));
+  REQUIRE(HostsDomain::wait_for([&] { return samples_flow(domain, app); }));
 
   // The cable of the consumer's host pulled: the domain (over DDS, on its own host) sees the
   // node lost and its component unreachable, not exited.
@@ -108,25 +113,30 @@ TEST_CASE("a host's link down for 5 s and back: its node lost and back, its comp
                : Json();
   };
   REQUIRE(HostsDomain::wait_for([&] {
-    const auto app = app_summary();
-    return !app.is_null() && app.value("unreachable", Json::array()) == Json::array({"Consumer_1"});
+    const auto summary = app_summary();
+    return !summary.is_null() &&
+           summary.value("unreachable", Json::array()) == Json::array({"Consumer_1"});
   }));
   CHECK(app_summary().at("state") == "degraded");
   CHECK(app_summary().at("exited").empty());
+  // Its unreachable component could not follow a stop: refused, said why.
+  const auto stopped = domain.cli(1, {"stop", app}, HostsDomain::over_dds());
+  CHECK(stopped.rc != 0);
+  CHECK_THAT(stopped.out + stopped.err, Catch::Contains("unreachable"));
   // Down for 5 s in all, as the issue's scenario: the time is the scenario, not a wait.
   std::this_thread::sleep_until(pulled_at + 5s);
   domain.hosts().set_link(HostsDomain::host_of_node(consumer_node), true);
 
   // Back: the component is reachable again in the state it had, nothing exited.
   REQUIRE(HostsDomain::wait_for([&] {
-    const auto app = app_summary();
-    return !app.is_null() && app.at("state") == "running" &&
-           app.value("unreachable", Json::array()).empty();
+    const auto summary = app_summary();
+    return !summary.is_null() && summary.at("state") == "running" &&
+           summary.value("unreachable", Json::array()).empty();
   }));
   CHECK(app_summary().at("exited").empty());
   // Data flows again on the one connection there is: the consumer's count grows.
   const auto samples_now = [&] {
-    const auto c = connection_state(domain, "ProducerConsumer", "samples");
+    const auto c = connection_state(domain, app, "samples");
     return c.is_null() || !c.contains("provides_state") || c.at("provides_state").is_null()
                ? -1
                : c.at("provides_state").at("samples").get<int>();
@@ -134,10 +144,10 @@ TEST_CASE("a host's link down for 5 s and back: its node lost and back, its comp
   const int after_heal = samples_now();
   REQUIRE(after_heal >= 0);
   CHECK(HostsDomain::wait_for([&] { return samples_now() > after_heal; }));
-  const auto listed = domain.cli(1, {"ls", "connections", "ProducerConsumer"});
+  const auto listed = domain.cli(1, {"ls", "connections", app});
   REQUIRE(listed.rc == 0);
   CHECK(listed.json().at("connections").size() == 1);
-  const auto shown = domain.cli(1, {"show", "ProducerConsumer"}, HostsDomain::over_dds());
+  const auto shown = domain.cli(1, {"show", app}, HostsDomain::over_dds());
   INFO(shown.out << shown.err);
   REQUIRE(shown.rc == 0);
   for (const auto &c : shown.json().at("components")) {
@@ -145,7 +155,7 @@ TEST_CASE("a host's link down for 5 s and back: its node lost and back, its comp
     CHECK(c.at("pid").get<pid_t>() == pid_of.at(c.at("id").get<std::string>())); // not twice
   }
 
-  const auto released = domain.cli(1, {"release", "ProducerConsumer"}, HostsDomain::over_dds());
+  const auto released = domain.cli(1, {"release", app}, HostsDomain::over_dds());
   CHECK(released.rc == 0);
   CHECK(HostsDomain::wait_for([&] {
     return std::none_of(pid_of.begin(), pid_of.end(),

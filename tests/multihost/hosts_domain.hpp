@@ -40,14 +40,12 @@ struct CliRun {
 
 class HostsDomain {
 public:
-  explicit HostsDomain(int nodes)
-      : hosts_(nodes + 1), run_(fs::temp_directory_path() /
-                                fmt::format("rsca-mh-{}-{}", getpid(), std::random_device{}())) {
-    fs::create_directories(run_);
+  explicit HostsDomain(int nodes) : hosts_(nodes + 1) {
+    fs::create_directories(run_ / "logs");
     env_ = {{"RSCA_DDS_DOMAIN", std::to_string(isolated_domain_id())},
             {"RSCA_DDS_TAG", isolated_tag()},
             {"RSCA_DDS_INTERFACE", hosts_.interface(1)},
-            {"RSCA_RUN_DIR", run_.string()}};
+            {"RSCA_RUN_DIR", run_.path.string()}};
     domaind_ = start(1, "rsca-domaind",
                      {"--dmd", (kSource / "profiles/dom/domain/DomainManager.dmd.xml").string(),
                       "--repository", (run_ / "repository").string()});
@@ -56,7 +54,8 @@ public:
           i + 1, "rsca-noded",
           {"--dcd",
            (kSource / fmt::format("profiles/dev/nodes/node{}/DeviceManager.dcd.xml", i)).string(),
-           "--control-socket", (run_ / fmt::format("node{}.sock", i)).string()}));
+           "--control-socket", (run_ / fmt::format("node{}.sock", i)).string(), "--log-dir",
+           (run_ / "logs").string()}));
     // Known to the domain once it lists them all, asked over DDS from the domain's host.
     REQUIRE(wait_for([&] {
       const auto listed = cli(1, {"--timeout-ms", "1000", "ls", "nodes"}, over_dds());
@@ -72,8 +71,6 @@ public:
       }
     domaind_->signal(SIGTERM);
     domaind_->wait_exit(5s);
-    std::error_code ec;
-    fs::remove_all(run_, ec);
   }
 
   const NetHosts &hosts() const { return hosts_; }
@@ -130,8 +127,21 @@ private:
     return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
   }
 
+  // The run folder (node sockets, logs, the repository), removed when it goes, also when the
+  // constructor fails.
+  struct RunFolder {
+    fs::path path =
+        fs::temp_directory_path() / fmt::format("rsca-mh-{}-{}", getpid(), std::random_device{}());
+    ~RunFolder() {
+      std::error_code ec;
+      fs::remove_all(path, ec);
+    }
+    operator const fs::path &() const { return path; }
+    fs::path operator/(const std::string &name) const { return path / name; }
+  };
+
+  RunFolder run_; // before the hosts: removed after every process in them is gone
   NetHosts hosts_;
-  fs::path run_;
   ChildProcess::Environment env_;
   std::unique_ptr<ChildProcess> domaind_;
   std::vector<std::unique_ptr<ChildProcess>> nodes_;

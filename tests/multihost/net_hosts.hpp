@@ -69,9 +69,12 @@ public:
     std::string ns, address, interface;
     while (lines >> ns >> address >> interface)
       hosts_.push_back({ns, address, interface});
-    REQUIRE(static_cast<int>(hosts_.size()) == count);
+    if (static_cast<int>(hosts_.size()) != count) {
+      down(); // the destructor does not run when the constructor fails
+      FAIL("tools/hosts up " << count << " said: " << out);
+    }
   }
-  ~NetHosts() { run_command(fmt::format("{} down {} 2>&1", kHostsTool.string(), name_)); }
+  ~NetHosts() { down(); }
   NetHosts(const NetHosts &) = delete;
   NetHosts &operator=(const NetHosts &) = delete;
 
@@ -106,6 +109,8 @@ public:
   }
 
 private:
+  void down() const { run_command(fmt::format("{} down {} 2>&1", kHostsTool.string(), name_)); }
+
   struct Host {
     std::string ns, address, interface;
   };
