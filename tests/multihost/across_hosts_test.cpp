@@ -150,7 +150,8 @@ TEST_CASE("a host's link down for 5 s and back: its node lost and back, its comp
   const auto shown = domain.cli(1, {"show", app}, HostsDomain::over_dds());
   INFO(shown.out << shown.err);
   REQUIRE(shown.rc == 0);
-  for (const auto &c : shown.json().at("components")) {
+  const auto shown_json = shown.json(); // held: a range-for over a temporary's member dangles
+  for (const auto &c : shown_json.at("components")) {
     CHECK(c.at("state") == "running");
     CHECK(c.at("pid").get<pid_t>() == pid_of.at(c.at("id").get<std::string>())); // not twice
   }
