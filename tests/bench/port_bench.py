@@ -53,6 +53,13 @@ from port_bench_helpers import (FANOUT_LEASE_MS, SDRROOT, SIDES, LatencyIceoryx,
                                 raw_sizes)
 
 
+def run_rounds(sides, orders, rtts):
+    """Each round runs every side once, in that round's order; the round trips go to rtts."""
+    for index, order in enumerate(orders):
+        for name in order:
+            rtts[name].extend(sides[name].run(index))
+
+
 def bench_latency_hosts(args):
     """Round trips between two network hosts (tools/hosts): BenchPing_1 and BenchEcho_1 on node1
     and node2, each node on a host of its own, through the nodes and with direct DDS; the raw
@@ -82,9 +89,7 @@ def bench_latency_hosts(args):
             sides["raw"] = LatencyRaw(domain, raw, work, sides["rsca"].qos, count, warmup,
                                       "waitset", hosts=(net.hosts[1], net.hosts[2]))
             closing.callback(sides["raw"].close)
-            for index, order in enumerate(orders):
-                for name in order:
-                    rtts[name].extend(sides[name].run(index))
+            run_rounds(sides, orders, rtts)
     finally:
         if not args.keep:
             shutil.rmtree(work, ignore_errors=True)
@@ -143,9 +148,7 @@ def bench_latency(args):
                 sides[name] = LatencyRaw(domain, raw, work, sides["rsca"].qos, count, warmup,
                                          wake)
                 closing.callback(sides[name].close)
-            for index, order in enumerate(orders):
-                for name in order:
-                    rtts[name].extend(sides[name].run(index))
+            run_rounds(sides, orders, rtts)
     finally:
         if not args.keep:
             shutil.rmtree(work, ignore_errors=True)

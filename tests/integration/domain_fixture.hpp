@@ -17,6 +17,7 @@
 #include "../unit/test_domain.hpp"
 #include "child_process.hpp"
 #include "control/endpoint.hpp"
+#include "wait_for.hpp"
 
 namespace rsca::test {
 
@@ -276,13 +277,7 @@ public:
 
   template <typename Predicate>
   static bool wait_for(Predicate done, std::chrono::milliseconds limit = 10s) {
-    const auto deadline = std::chrono::steady_clock::now() + limit;
-    while (std::chrono::steady_clock::now() < deadline) {
-      if (done())
-        return true;
-      std::this_thread::sleep_for(20ms); // pacing a poll of real processes
-    }
-    return done();
+    return wait_until(done, limit);
   }
 
   const fs::path &run_dir() const { return run_; }

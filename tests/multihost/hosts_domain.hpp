@@ -19,6 +19,7 @@
 #include <nlohmann/json.hpp>
 
 #include "../integration/child_process.hpp"
+#include "../integration/wait_for.hpp"
 #include "../unit/test_domain.hpp"
 #include "net_hosts.hpp"
 
@@ -104,13 +105,7 @@ public:
 
   template <typename Predicate>
   static bool wait_for(Predicate done, std::chrono::milliseconds limit = 20s) {
-    const auto deadline = std::chrono::steady_clock::now() + limit;
-    while (std::chrono::steady_clock::now() < deadline) {
-      if (done())
-        return true;
-      std::this_thread::sleep_for(50ms);
-    }
-    return done();
+    return wait_until(done, limit, 50ms);
   }
 
   pid_t node_pid(int index) const { return nodes_.at(index - 1)->pid(); }
