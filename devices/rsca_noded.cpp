@@ -6,6 +6,7 @@
 #include <spdlog/spdlog.h>
 
 #include "common/daemon_heap.hpp"
+#include "common/own_folder.hpp"
 #include "common/process_priority.hpp"
 #include "common/termination_signals.hpp"
 #include "dds/participant.hpp"
@@ -14,16 +15,7 @@
 #include "node/device_manager.hpp"
 #include "robot/robot_devices.hpp"
 
-namespace {
-
-// The folder this executable is in: a development build keeps the components beside it.
-std::filesystem::path own_folder() {
-  std::error_code ec;
-  auto self = std::filesystem::read_symlink("/proc/self/exe", ec);
-  return ec ? std::filesystem::path() : self.parent_path();
-}
-
-} // namespace
+using rsca::own_folder;
 
 int main(int argc, char **argv) {
   const int nice = rsca::run_above_applications(); // before any thread exists
@@ -55,6 +47,16 @@ int main(int argc, char **argv) {
                  "Records in each same-host ring (a power of two, 16 to 1048576): the most a "
                  "reader may fall behind")
       ->capture_default_str();
+  std::string cache_dir;
+  app.add_option("--cache-dir", cache_dir,
+                 "Where the packages of the processes this node runs are kept, fetched from the "
+                 "domain (default: <log-dir>/../cache/<node name>)");
+  std::uint64_t cache_mib = options.cache.max_bytes >> 20U;
+  app.add_option("--cache-mib", cache_mib,
+                 "The most the package cache holds, in MiB: packages beyond it are evicted, least "
+                 "recently used first, never one a running process is inside")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   app.add_option("--log-level", level, "trace, debug, info, warn, error")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   spdlog::set_level(spdlog::level::from_str(level));
@@ -74,6 +76,8 @@ int main(int argc, char **argv) {
   if (options.exec_path.empty())
     options.exec_path.push_back(own_folder());
   options.log_dir = log_dir;
+  options.cache.dir = cache_dir;
+  options.cache.max_bytes = cache_mib << 20U;
   if (!control_socket.empty())
     options.control_socket = control_socket;
 

@@ -18,6 +18,7 @@
 #include "domain/application.hpp"
 #include "domain/component_registry.hpp"
 #include "domain/event_channel_manager.hpp"
+#include "domain/file_manager.hpp"
 #include "protocol/addresses.hpp"
 #include "protocol/node_ops.hpp"
 
@@ -37,6 +38,7 @@ struct LaunchRequest {
   std::map<std::string, std::string> assignments; // instance id → device id
   std::optional<allocator::Strategy> strategy;    // the domain's when not given
   bool start = true;
+  std::string id; // the caller's id of the launch: its progress, and the files delivered for it
   // Set while the launch runs to have it stop and roll back (ComponentRegistry::interrupt() ends
   // a registration wait at once); checked before each step.
   std::shared_ptr<const std::atomic<bool>> cancelled;
@@ -67,6 +69,9 @@ struct DomainServices {
   // component addresses and topics carry it, so an application re-launched under the same name
   // never meets its predecessor's leftovers, not even those of a domain daemon that was killed.
   std::function<LaunchIdentity()> next_launch;
+  // Makes the package each process gets (domain/file_manager.hpp). Null (a unit test's): the
+  // processes get no package, and the paths of the domain's files.
+  FileManager *files = nullptr;
   std::chrono::milliseconds call_timeout{5000};
   std::chrono::milliseconds registration_timeout{10000};
   allocator::Strategy strategy = allocator::Strategy::Pack;

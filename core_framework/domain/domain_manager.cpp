@@ -76,6 +76,7 @@ ApplicationFactory DomainManager::Impl::factory() {
     return DevicePorts{std::move(device->address), std::move(device->ports)};
   };
   s.next_launch = [this] { return LaunchIdentity{incarnation, ++launch_counter}; };
+  s.files = &*files;
   s.call_timeout = options.call_timeout;
   s.registration_timeout = options.registration_timeout;
   s.strategy = options.strategy;
@@ -154,6 +155,7 @@ DomainManager::Impl::create_application(const app_ops::CreateRequest &wire) {
   request.assignments = wire.assign;
   request.strategy = *strategy;
   const std::string id = wire.launch_id.value_or(request.name);
+  request.id = id;
   const auto began = std::chrono::steady_clock::now();
   std::vector<LaunchStep> steps;
   auto app = launch(request, id, steps);
@@ -211,7 +213,19 @@ CallResult<app_ops::ProgressReply> DomainManager::Impl::progress(const app_ops::
   if (!progress)
     return control::call_error(Status::NotFound,
                                fmt::format("no launch {}", excerpt(request.launch_id)));
-  return app_ops::ProgressReply{steps_of(progress->steps), progress->done};
+  app_ops::ProgressReply reply{steps_of(progress->steps), progress->done, std::nullopt};
+  if (const auto bytes = files->delivered(request.launch_id); bytes > 0)
+    reply.delivered_bytes = bytes;
+  return reply;
+}
+
+// A node fetching a piece of a file of a package it was sent. Its launch names a launch only to
+// count the bytes for that launch's progress: bounded, as everything from the network.
+CallResult<protocol::file::ReadReply>
+DomainManager::Impl::read_file(const protocol::file::ReadRequest &request) {
+  if (request.launch && request.launch->size() > protocol::file::kMaxLaunchLength)
+    return control::call_error(Status::BadRequest, "launch: an id too long");
+  return files->read(request);
 }
 
 // A caller that stops waiting for its launch (the CLI's own deadline) cancels it, so that no
@@ -345,6 +359,7 @@ void DomainManager::Impl::serve() {
       *endpoint, [this](const auto &report, const auto &) { return component_exited(report); });
   control::serve<domain_ops::ConnectionProblem>(
       *endpoint, [this](const auto &report, const auto &) { return connection_problem(report); });
+  serve_op<protocol::file::Read>(&Impl::read_file);
   serve_op<app_ops::Create>(&Impl::create_application);
   serve_op<app_ops::Plan>(&Impl::plan_application);
   serve_op<app_ops::Progress>(&Impl::progress);
@@ -404,6 +419,7 @@ DomainManager::create(std::shared_ptr<dds::Participant> participant, DomainOptio
   impl->events = std::move(*events);
   impl->repository.emplace(impl->options.repository, *impl->store);
   impl->repository->load();
+  impl->files.emplace(impl->options.repository, impl->options.exec_path);
   Impl *raw = impl.get();
   impl->runtime_connections.emplace(
       impl->options.name, impl->endpoint,

@@ -10,6 +10,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "allocator/resource_allocator.hpp"
 #include "control/endpoint.hpp"
@@ -22,6 +23,9 @@ namespace rsca::domain {
 struct DomainOptions {
   std::string name = "rsca";        // the DMD's name
   std::filesystem::path repository; // installed profiles are kept here
+  // Where code an SPD names that its install did not carry is found, by file name (executables;
+  // libraries also in the lib folder beside each): rsca's own component folders.
+  std::vector<std::filesystem::path> exec_path;
   std::chrono::milliseconds registration_timeout{10000};
   std::chrono::milliseconds call_timeout{5000};
   allocator::Strategy strategy = allocator::Strategy::Pack; // placement, unless a launch says

@@ -22,6 +22,7 @@
 #include "domain/application_registry.hpp"
 #include "domain/connection_manager.hpp"
 #include "domain/domain_manager.hpp"
+#include "domain/file_manager.hpp"
 #include "domain/installed_repository.hpp"
 #include "domain/launch_tracker.hpp"
 #include "domain/node_directory.hpp"
@@ -29,6 +30,7 @@
 #include "protocol/component_ops.hpp"
 #include "protocol/connection_ops.hpp"
 #include "protocol/domain_ops.hpp"
+#include "protocol/file_ops.hpp"
 
 namespace rsca::domain {
 
@@ -62,6 +64,7 @@ struct DomainManager::Impl {
   std::optional<EventChannelManager> channels;          // made when the domain's name is known
   std::optional<DomainStore> store;
   std::optional<InstalledRepository> repository;
+  std::optional<FileManager> files; // the repository's files, as nodes get them
   ApplicationRegistry applications;
   LaunchTracker launches;
   std::uint64_t incarnation = 0; // this run of the daemon, counted in the store
@@ -94,6 +97,7 @@ struct DomainManager::Impl {
   CallResult<std::shared_ptr<Application>>
   launch(LaunchRequest &request, const std::string &launch_id, std::vector<LaunchStep> &steps);
   CallResult<app_ops::ProgressReply> progress(const app_ops::LaunchId &request);
+  CallResult<protocol::file::ReadReply> read_file(const protocol::file::ReadRequest &request);
   CallResult<app_ops::CancelReply> cancel_launch(const app_ops::LaunchId &request);
   CallResult<app_ops::ReleaseReply> release(const app_ops::AppRequest &request);
   CallResult<app_ops::ApplicationView> start_or_stop(const app_ops::AppRequest &request,

@@ -64,6 +64,13 @@ inline CallResult<void> call_all(control::Caller &endpoint, const std::vector<Ca
 }
 
 // The processes an application's components run in: the components of a host share its process.
+// What a node.execute may take beyond a call's time, to fetch `bytes` of files its cache lacks:
+// at 4 MB/s, far below what a transfer runs at (docs/measurements.md), so that only a node that
+// stopped fetching misses it.
+inline std::chrono::milliseconds delivery_allowance(std::uint64_t bytes) {
+  return std::chrono::milliseconds(bytes / 4000);
+}
+
 inline std::set<long> process_ids(const Application &app) {
   std::set<long> pids;
   for (const auto &c : app.components)

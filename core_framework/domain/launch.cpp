@@ -218,10 +218,13 @@ CallResult<void> ApplicationFactory::Launch::execute() {
   }
   for (const auto &[k, params] : hosts)
     requests[k].args = protocol::to_args(params);
+  auto bytes = add_packages(requests, started_by);
+  if (!bytes)
+    return tl::unexpected(bytes.error());
   std::vector<Call> calls;
   for (std::size_t k = 0; k < requests.size(); ++k)
     calls.push_back(call_of<protocol::node::Execute>(to[k].first, requests[k], to[k].second));
-  auto replies = call_each_of(*s_.endpoint, calls, s_.call_timeout);
+  auto replies = call_each_of(*s_.endpoint, calls, s_.call_timeout + delivery_allowance(*bytes));
   // Record every process that did start, even when another failed, so rollback finds it.
   std::vector<CallResult<protocol::node::ExecuteReply>> started;
   for (std::size_t k = 0; k < calls.size(); ++k) {
@@ -236,7 +239,40 @@ CallResult<void> ApplicationFactory::Launch::execute() {
   if (auto ok = first_failure(calls, started); !ok)
     return ok;
   detail_ = fmt::format("{} processes for {} components", calls.size(), app_->components.size());
+  if (s_.files != nullptr)
+    if (const auto delivered = s_.files->delivered(request_.id); delivered > 0)
+      detail_ += fmt::format("; {:.1f} MB of their files delivered", delivered / 1e6);
   return {};
+}
+
+CallResult<std::uint64_t> ApplicationFactory::Launch::add_packages(
+    std::vector<protocol::node::ExecuteRequest> &requests,
+    const std::vector<std::vector<std::size_t>> &started_by) const {
+  if (s_.files == nullptr)
+    return 0;
+  std::uint64_t bytes = 0;
+  for (std::size_t k = 0; k < requests.size(); ++k) {
+    std::vector<PackagedComponent> components;
+    for (auto i : started_by[k]) {
+      const auto &c = app_->components[i];
+      const profile::ComponentPlacement *placement = nullptr;
+      instantiation_of(c.id, &placement);
+      components.push_back(
+          {c.id, request_.profile->softpkg_of(*placement), placement_of(c.id)->implementation});
+    }
+    auto package = s_.files->package_of(components);
+    if (!package)
+      return tl::unexpected(package.error());
+    for (const auto &f : package->files)
+      bytes += f.size;
+    requests[k].package = std::move(*package);
+    requests[k].launch = request_.id;
+  }
+  return bytes;
+}
+
+std::string ApplicationFactory::Launch::in_package(const std::filesystem::path &file) const {
+  return s_.files == nullptr ? file.string() : s_.files->package_path(file);
 }
 
 CallResult<void> ApplicationFactory::Launch::await_registration() {
@@ -303,7 +339,7 @@ protocol::ExecParams ApplicationFactory::Launch::exec_params(const ComponentInst
   protocol::ExecParams p;
   p.identifier = c.id;
   p.name_binding = c.usage_name;
-  p.profile = c.spd;
+  p.profile = in_package(c.spd);
   p.domain = s_.domain_name;
   p.application = app_->name;
   p.control_address = c.address;
@@ -329,15 +365,18 @@ ApplicationFactory::Launch::execute_request(const ComponentInstance &c) const {
           c.id,
           c.device,
           impl->code.entrypoint.empty() ? impl->code.file.name : impl->code.entrypoint,
-          spd_dir.string(),
-          protocol::to_args(exec_params(c))};
+          in_package(spd_dir),
+          protocol::to_args(exec_params(c)),
+          std::nullopt,
+          std::nullopt};
 }
 
 protocol::node::ExecuteRequest
 ApplicationFactory::Launch::host_request(const ComponentInstance &first) const {
   return {app_->name,   fmt::format("ComponentHost_{}", first.device),
           first.device, "rsca-component-host",
-          "",           {}};
+          "",           {},
+          std::nullopt, std::nullopt};
 }
 
 std::vector<std::pair<std::string, std::string>>

@@ -108,6 +108,13 @@ private:
   static bool is_hosted(const ComponentInstance &c) { return !c.host.empty(); }
 
   protocol::node::ExecuteRequest execute_request(const ComponentInstance &c) const;
+  // Gives each request the package of the components it starts (started_by, by request); the
+  // bytes they hold.
+  CallResult<std::uint64_t>
+  add_packages(std::vector<protocol::node::ExecuteRequest> &requests,
+               const std::vector<std::vector<std::size_t>> &started_by) const;
+  // How a process names a file of the domain's: its path in its package.
+  std::string in_package(const std::filesystem::path &file) const;
 
   // A component host's process at its own address; its components' exec parameters follow.
   protocol::node::ExecuteRequest host_request(const ComponentInstance &first) const;

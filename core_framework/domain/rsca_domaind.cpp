@@ -4,6 +4,7 @@
 #include <spdlog/spdlog.h>
 
 #include "common/daemon_heap.hpp"
+#include "common/own_folder.hpp"
 #include "common/process_priority.hpp"
 #include "common/termination_signals.hpp"
 #include "dds/participant.hpp"
@@ -34,6 +35,10 @@ int main(int argc, char **argv) {
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   app.add_option("--log-level", level, "trace, debug, info, warn, error")->capture_default_str();
+  std::vector<std::string> exec_path;
+  app.add_option("--exec-path", exec_path,
+                 "Folders where code an SPD names is looked for when its install did not carry it "
+                 "(default: this program's folder; libraries also in ../lib beside each)");
   std::string strategy = "pack";
   app.add_option("--strategy", strategy,
                  "Placement: pack (fewest devices) or spread (balance load)")
@@ -49,6 +54,10 @@ int main(int argc, char **argv) {
   options.registration_timeout = std::chrono::milliseconds(registration_ms);
   options.call_timeout = std::chrono::milliseconds(call_ms);
   options.strategy = *rsca::allocator::parse_strategy(strategy);
+  for (const auto &p : exec_path)
+    options.exec_path.emplace_back(p);
+  if (options.exec_path.empty())
+    options.exec_path.push_back(rsca::own_folder());
   if (!dmd.empty()) {
     rsca::profile::ProfileLoader loader;
     auto domain = loader.load_domain(dmd);

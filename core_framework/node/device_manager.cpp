@@ -13,6 +13,7 @@
 #include "profile/property_binding.hpp"
 #include "profile/property_json.hpp"
 #include "protocol/addresses.hpp"
+#include "protocol/file_ops.hpp"
 
 namespace rsca::node {
 namespace {
@@ -57,6 +58,7 @@ struct DeviceManager::Impl {
   std::unique_ptr<control::Endpoint> endpoint;
   std::unique_ptr<HostData> host_data; // outlives the links, which use it
   std::unique_ptr<ProcessLinks> links; // relays through the endpoint
+  std::unique_ptr<PackageCache> cache; // fetches through the endpoint
   std::shared_ptr<const profile::DeviceConfiguration> dcd;
   profile::ResolvedNode node;
   std::vector<RunningDevice> devices;
@@ -69,6 +71,7 @@ struct DeviceManager::Impl {
   ExecutableDevice *executable_device(const std::string &id) const;
   void report_exit(const protocol::domain::ComponentExitedReport &report);
   CallResult<op::ExecuteReply> execute(const op::ExecuteRequest &request) const;
+  Expected<void> open_cache();
   CallResult<op::TerminateReply> terminate(const op::TerminateRequest &request) const;
   op::StatusReply status() const;
 };
@@ -159,7 +162,37 @@ CallResult<op::ExecuteReply> DeviceManager::Impl::execute(const op::ExecuteReque
   if (device == nullptr)
     return control::call_error(Status::NotFound, fmt::format("node {} has no executable device {}",
                                                              dcd->name, request.device));
-  return device->execute(request);
+  if (request.launch && request.launch->size() > protocol::file::kMaxLaunchLength)
+    return control::call_error(Status::BadRequest, "launch: an id too long");
+  std::shared_ptr<const PackageLease> package;
+  if (request.package) {
+    auto acquired = cache->acquire(*request.package, request.launch.value_or(""));
+    if (!acquired) {
+      spdlog::warn("{}/{} not started: its package: {}", request.application, request.component,
+                   acquired.error().message);
+      return control::call_error(acquired.error().status,
+                                 fmt::format("node {}: {}", dcd->name, acquired.error().message));
+    }
+    package = std::move(*acquired);
+  }
+  return device->execute(request, std::move(package));
+}
+
+Expected<void> DeviceManager::Impl::open_cache() {
+  CacheOptions cache_options = options.cache;
+  if (cache_options.dir.empty())
+    cache_options.dir = (options.log_dir / ".." / "cache" / dcd->name).lexically_normal();
+  const auto domain = protocol::domain_address(options.domain_name);
+  auto opened = PackageCache::open(
+      cache_options,
+      [this, domain, timeout = cache_options.piece_timeout](const protocol::file::ReadRequest &r) {
+        return endpoint->call(domain, std::string(protocol::file::Read::name), protocol::encode(r),
+                              timeout);
+      });
+  if (!opened)
+    return tl::unexpected(opened.error());
+  cache = std::move(*opened);
+  return {};
 }
 
 CallResult<op::TerminateReply>
@@ -177,7 +210,8 @@ DeviceManager::Impl::terminate(const op::TerminateRequest &request) const {
 
 op::StatusReply DeviceManager::Impl::status() const {
   auto a = announcement();
-  op::StatusReply status{std::move(a.node), a.pid, std::move(a.host), std::move(a.devices), {}, {}};
+  op::StatusReply status{
+      std::move(a.node), a.pid, std::move(a.host), std::move(a.devices), {}, {}, {}};
   for (const auto &d : devices)
     if (d.executable() != nullptr)
       for (auto &p : d.executable()->processes())
@@ -187,6 +221,10 @@ op::StatusReply DeviceManager::Impl::status() const {
     status.shared_memory =
         op::SharedMemoryStatus{held.rings, held.ends, held.pages, held.bytes_in_use, held.relays};
   }
+  const auto cached = cache->counts();
+  status.cache =
+      op::PackageCacheStatus{cached.packages, cached.bytes,         options.cache.max_bytes,
+                             cached.fetched,  cached.fetched_bytes, cached.reused};
   return status;
 }
 
@@ -269,6 +307,8 @@ DeviceManager::create(std::shared_ptr<dds::Participant> participant, NodeOptions
   if (impl->options.control_socket)
     if (auto ok = impl->links->listen(impl->options.control_socket->string()); !ok)
       return tl::unexpected(ok.error());
+  if (auto ok = impl->open_cache(); !ok)
+    return tl::unexpected(ok.error());
   if (auto ok = impl->start_devices(registry); !ok)
     return tl::unexpected(ok.error());
   impl->serve();

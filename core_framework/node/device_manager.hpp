@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "node/logical_device.hpp"
+#include "node/package_cache.hpp"
 #include "shm/ring.hpp"
 
 namespace rsca::node {
@@ -26,6 +27,9 @@ struct NodeOptions {
   // Each ring of same-host data (one per topic with ends on this host): its bytes of data (a
   // sample takes at most half) and records (the most a reader may fall behind).
   shm::RingLimits rings;
+  // The cache of the packages its processes run inside (node/package_cache.hpp). Its folder
+  // empty: <log_dir>/../cache/<node name>.
+  CacheOptions cache;
 };
 
 class DeviceManager {

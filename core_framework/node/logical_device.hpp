@@ -12,6 +12,7 @@
 #include "control/endpoint.hpp"
 #include "dds/dds_settings.hpp"
 #include "dds/participant.hpp"
+#include "node/package_cache.hpp"
 #include "node/process_links.hpp"
 #include "profile/profile_loader.hpp"
 #include "protocol/domain_ops.hpp"
@@ -58,8 +59,12 @@ public:
 
 class ExecutableDevice : public LogicalDevice {
 public:
+  // Starts the process the request names. With a package (node/package_cache.hpp), inside it:
+  // the process runs in the package's folder, the paths the request names relative to it, and
+  // the lease is kept for as long as the process runs.
   virtual CallResult<protocol::node::ExecuteReply>
-  execute(const protocol::node::ExecuteRequest &request) = 0;
+  execute(const protocol::node::ExecuteRequest &request,
+          std::shared_ptr<const PackageLease> package) = 0;
   // Fails with NotFound for a process this device did not start.
   virtual CallResult<protocol::node::TerminateReply>
   terminate(const protocol::node::TerminateRequest &request) = 0;

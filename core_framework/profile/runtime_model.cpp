@@ -124,15 +124,10 @@ Expected<std::shared_ptr<const ResolvedSoftPkg>> from_runtime_model(const Json &
   }
 }
 
-Expected<void> write_runtime_model(const ResolvedSoftPkg &softpkg) {
-  const fs::path target = runtime_model_path(softpkg.spd_path);
+// Writes `text` to `target` through a temporary beside it, renamed over it: a reader sees the old
+// file or the new one, never half of one, and a file linked elsewhere keeps its content.
+Expected<void> replace_file(const fs::path &target, const std::string &text) {
   const fs::path temporary = fs::path(target).concat(fmt::format(".{}.tmp", ::getpid()));
-  std::string text;
-  try {
-    text = to_runtime_model(softpkg).dump();
-  } catch (const std::exception &e) { // e.g. a path that is not UTF-8
-    return model_error(target, e.what());
-  }
   {
     std::ofstream out(temporary, std::ios::trunc);
     out << text;
@@ -150,6 +145,51 @@ Expected<void> write_runtime_model(const ResolvedSoftPkg &softpkg) {
     return model_error(target, fmt::format("cannot store it: {}", ec.message()));
   }
   return {};
+}
+
+Expected<void> write_runtime_model(const ResolvedSoftPkg &softpkg) {
+  const fs::path target = runtime_model_path(softpkg.spd_path);
+  std::string text;
+  try {
+    text = to_runtime_model(softpkg).dump();
+  } catch (const std::exception &e) { // e.g. a path that is not UTF-8
+    return model_error(target, e.what());
+  }
+  return replace_file(target, text);
+}
+
+bool is_runtime_model_path(const fs::path &file) {
+  const std::string name = file.filename().string();
+  constexpr std::string_view suffix = ".model.json";
+  return name.size() > suffix.size() && name.compare(name.size() - suffix.size(), suffix.size(),
+                                                     suffix.data(), suffix.size()) == 0;
+}
+
+Expected<void> relocate_runtime_model(const fs::path &root, const fs::path &model_file,
+                                      const std::string &origin) {
+  const fs::path file = root / model_file;
+  std::ifstream in(file);
+  Json model = Json::parse(in, nullptr, /*allow_exceptions=*/false);
+  if (model.is_discarded() || !model.is_object() || !model.contains("sources") ||
+      !model["sources"].is_array())
+    return model_error(file, "it is not a runtime model");
+  const std::string prefix = origin.empty() || origin.back() == '/' ? origin : origin + "/";
+  std::vector<SourceFile> sources;
+  try {
+    sources = sources_from(model["sources"]);
+  } catch (const std::exception &e) { // the model's own fields: nlohmann's errors
+    return model_error(file, e.what());
+  }
+  for (auto &source : sources) {
+    // A source outside the origin is not in the package: the model stays stale, and a
+    // component that reads it falls back to its XML, as it would anywhere else.
+    if (prefix.empty() || source.path.compare(0, prefix.size(), prefix) != 0)
+      continue;
+    source.path.erase(0, prefix.size());
+    source.stamp = stamp_of(root / source.path);
+  }
+  model["sources"] = sources_json(sources);
+  return replace_file(file, model.dump());
 }
 
 Expected<std::shared_ptr<const ResolvedSoftPkg>> read_runtime_model(const fs::path &spd_file) {

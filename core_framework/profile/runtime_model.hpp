@@ -34,6 +34,18 @@ from_runtime_model(const nlohmann::json &model, const std::filesystem::path &spd
 // starting meanwhile reads the old model or the new one, never half of one).
 Expected<void> write_runtime_model(const ResolvedSoftPkg &softpkg);
 
+// Whether `file` is named as a runtime model is.
+bool is_runtime_model_path(const std::filesystem::path &file);
+
+// Makes the model at `root`/`model_file`, a copy of one the domain wrote under `origin`, the model
+// of the copies of its sources under `root`: each source under `origin` is named by its path
+// relative to `root` (as a process started in `root` is given its SPD) and stamped as the copy is
+// now. A node does it for the packages in its cache (node/package_cache.hpp), whose files never
+// change once there. The file is replaced, not rewritten: another link to it keeps its content.
+Expected<void> relocate_runtime_model(const std::filesystem::path &root,
+                                      const std::filesystem::path &model_file,
+                                      const std::string &origin);
+
 // The software package of `spd_file` from its runtime model; an error says why there is none
 // to use (missing, unreadable, or older than a file it came from).
 Expected<std::shared_ptr<const ResolvedSoftPkg>>

@@ -187,9 +187,11 @@ struct LaunchId {
 struct ProgressReply {
   std::vector<StepView> steps;
   bool done = false;
+  std::optional<std::uint64_t> delivered_bytes; // files the nodes fetched for it so far
   static constexpr auto fields() {
     return std::tuple{required("steps", &ProgressReply::steps),
-                      required("done", &ProgressReply::done)};
+                      required("done", &ProgressReply::done),
+                      optional("delivered_bytes", &ProgressReply::delivered_bytes)};
   }
 };
 

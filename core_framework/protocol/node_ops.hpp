@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "protocol/codec.hpp"
+#include "protocol/package.hpp"
 
 namespace rsca::protocol::node {
 
@@ -18,14 +19,22 @@ struct ExecuteRequest {
   std::string component; // the component's id, or the host's name: names its log
   std::string device;    // the executable device; empty: the node's first
   std::string entrypoint;
-  std::string spd_dir;           // where the SPD is, that a relative entry point is found from
+  // Where the SPD is, that a relative entry point is found from. Empty: the entry point is an
+  // rsca program the node has (the component host), found in the node's exec path.
+  std::string spd_dir;
   std::vector<std::string> args; // the exec parameters (protocol/exec_params.hpp)
+  // The files the process needs: the node runs it inside the package, from its cache, with
+  // spd_dir and the paths in args relative to the package. None: an rsca program the node has
+  // installed (the component host), found in the node's exec path.
+  std::optional<Package> package;
+  std::optional<std::string> launch; // the launch it is part of (its progress shows transfers)
   static constexpr auto fields() {
     using R = ExecuteRequest;
     return std::tuple{
         required("application", &R::application), required("component", &R::component),
         optional("device", &R::device),           required("entrypoint", &R::entrypoint),
-        optional("spd_dir", &R::spd_dir),         required("args", &R::args)};
+        optional("spd_dir", &R::spd_dir),         required("args", &R::args),
+        optional("package", &R::package),         optional("launch", &R::launch)};
   }
 };
 
@@ -131,6 +140,23 @@ struct SharedMemoryStatus {
   }
 };
 
+// What the node's package cache holds (node/package_cache.hpp).
+struct PackageCacheStatus {
+  std::uint64_t packages = 0;
+  std::uint64_t bytes = 0;
+  std::uint64_t max_bytes = 0;
+  std::uint64_t fetched = 0;       // packages fetched since the node started
+  std::uint64_t fetched_bytes = 0; // their bytes that came over the network
+  std::uint64_t reused = 0;        // launches that found their package in the cache
+  static constexpr auto fields() {
+    using R = PackageCacheStatus;
+    return std::tuple{
+        required("packages", &R::packages),           required("bytes", &R::bytes),
+        required("max_bytes", &R::max_bytes),         required("fetched", &R::fetched),
+        required("fetched_bytes", &R::fetched_bytes), required("reused", &R::reused)};
+  }
+};
+
 struct StatusReply {
   std::string node;
   std::int64_t pid = 0;
@@ -138,12 +164,14 @@ struct StatusReply {
   std::vector<DeviceRecord> devices;
   std::vector<ProcessRecord> processes;
   std::optional<SharedMemoryStatus> shared_memory; // none: the node has no shared memory
+  std::optional<PackageCacheStatus> cache;
   static constexpr auto fields() {
     using R = StatusReply;
     return std::tuple{
         required("node", &R::node),           required("pid", &R::pid),
         required("host", &R::host),           required("devices", &R::devices),
-        required("processes", &R::processes), optional("shared_memory", &R::shared_memory)};
+        required("processes", &R::processes), optional("shared_memory", &R::shared_memory),
+        optional("cache", &R::cache)};
   }
 };
 

@@ -70,12 +70,38 @@ std::filesystem::path GppDevice::find_executable(const std::string &entrypoint,
   return std::filesystem::path(spd_dir) / ep;
 }
 
+// The entry point beside the SPD inside the package. An absolute one is on the node itself (as
+// REDHAWK allows), and one without an SPD is an rsca program (the component host): both run
+// inside the package all the same. One that would lie outside the package is refused.
+CallResult<std::filesystem::path>
+GppDevice::packaged_executable(const protocol::node::ExecuteRequest &r,
+                               const node::PackageLease &package) const {
+  const std::filesystem::path ep(r.entrypoint);
+  if (ep.is_absolute() || r.spd_dir.empty())
+    return find_executable(r.entrypoint, "");
+  const auto inside = (std::filesystem::path(r.spd_dir) / ep).lexically_normal();
+  if (inside.is_absolute() || inside.empty() || *inside.begin() == "..")
+    return control::call_error(
+        Status::BadRequest,
+        fmt::format("{}: entry point {} lies outside its package", context_.id, inside.string()));
+  return package.root() / inside;
+}
+
 CallResult<protocol::node::ExecuteReply>
-GppDevice::execute(const protocol::node::ExecuteRequest &r) {
+GppDevice::execute(const protocol::node::ExecuteRequest &r,
+                   std::shared_ptr<const node::PackageLease> package) {
   const std::string &application = r.application;
   const std::string &component = r.component;
   ExecRequest request;
-  request.program = find_executable(r.entrypoint, r.spd_dir);
+  if (package) {
+    auto program = packaged_executable(r, *package);
+    if (!program)
+      return tl::unexpected(program.error());
+    request.program = std::move(*program);
+    request.working_dir = package->root();
+  } else {
+    request.program = find_executable(r.entrypoint, r.spd_dir);
+  }
   request.args = r.args;
   request.env = context_.dds.component_environment();
   // The component dies with this node: it checks that its parent is still this process.
@@ -125,6 +151,8 @@ GppDevice::execute(const protocol::node::ExecuteRequest &r) {
     owner.component = component;
     owner.addresses = std::move(addresses);
     owners_[*pid] = std::move(owner);
+    if (package)
+      packages_[*pid] = std::move(package);
   }
   spdlog::info("{}: executed {} as pid {} (log {})", context_.id, request.program.string(), *pid,
                request.log_file.string());
@@ -147,6 +175,7 @@ GppDevice::terminate(const protocol::node::TerminateRequest &r) {
     return control::call_error(Status::Failed, ok.error().to_string());
   std::lock_guard lock(mutex_);
   owners_.erase(pid);
+  packages_.erase(pid);
   return protocol::node::TerminateReply{pid};
 }
 
@@ -161,6 +190,14 @@ std::vector<protocol::node::ProcessRecord> GppDevice::processes() const {
 void GppDevice::on_exit(ProcessId pid, const ExitStatus &status) {
   if (context_.links != nullptr)
     context_.links->detach(pid);
+  std::shared_ptr<const node::PackageLease> package; // let go outside the lock
+  {
+    std::lock_guard lock(mutex_);
+    if (auto it = packages_.find(pid); it != packages_.end()) {
+      package = std::move(it->second);
+      packages_.erase(it);
+    }
+  }
   if (status.requested)
     return;
   protocol::domain::ComponentExitedReport report;

@@ -19,7 +19,8 @@ public:
   node::Json properties() const override { return properties_; }
   node::Json capacity() const override { return capacity_; }
   node::CallResult<protocol::node::ExecuteReply>
-  execute(const protocol::node::ExecuteRequest &request) override;
+  execute(const protocol::node::ExecuteRequest &request,
+          std::shared_ptr<const node::PackageLease> package) override;
   node::CallResult<protocol::node::TerminateReply>
   terminate(const protocol::node::TerminateRequest &request) override;
   std::vector<protocol::node::ProcessRecord> processes() const override;
@@ -29,6 +30,9 @@ public:
 private:
   std::filesystem::path find_executable(const std::string &entrypoint,
                                         const std::string &spd_dir) const;
+  node::CallResult<std::filesystem::path>
+  packaged_executable(const protocol::node::ExecuteRequest &request,
+                      const node::PackageLease &package) const;
   void on_exit(ProcessId pid, const ExitStatus &status);
 
   node::DeviceContext context_;
@@ -38,6 +42,8 @@ private:
   // What each process started is, for the report of its exit: its application, component and
   // the control addresses it serves.
   std::map<ProcessId, protocol::domain::ComponentExitedReport> owners_;
+  // The package each process runs inside, kept in the node's cache while it runs.
+  std::map<ProcessId, std::shared_ptr<const node::PackageLease>> packages_;
   ProcessLauncher launcher_; // last: destroyed (terminating children) first
 };
 

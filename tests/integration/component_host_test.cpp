@@ -183,7 +183,8 @@ TEST_CASE("a component host that cannot load a library fails the launch, which r
   CHECK(rc == 6);
   CHECK_THAT(out, Catch::Contains("failed at step"));
   CHECK_THAT(out, Catch::Contains("Consumer_1"));
-  // The producers' processes and the host were started and are gone again, nothing stays
-  // allocated, no application is left.
+  // The domain finds no library to deliver for Consumer_1 before any process starts: nothing
+  // stays allocated, no application is left.
+  CHECK_THAT(out, Catch::Contains("librsca-not-built.so"));
   domain.require_clean({});
 }

@@ -240,13 +240,22 @@ public:
 
   // A domain daemon on this domain's repository.
   void start_domaind(int registration_timeout_ms) {
-    domaind_ = std::make_unique<ChildProcess>(
-        (kBin / "rsca-domaind").string(),
-        std::vector<std::string>{
-            "--dmd", (kSource / "profiles/dom/domain/DomainManager.dmd.xml").string(),
-            "--repository", (run_ / "repository").string(), "--registration-timeout-ms",
-            std::to_string(registration_timeout_ms)},
-        env_);
+    std::vector<std::string> args{"--dmd",
+                                  (kSource / "profiles/dom/domain/DomainManager.dmd.xml").string(),
+                                  "--repository",
+                                  (run_ / "repository").string(),
+                                  "--registration-timeout-ms",
+                                  std::to_string(registration_timeout_ms)};
+    for (const auto &dir : exec_path_)
+      args.insert(args.end(), {"--exec-path", dir.string()});
+    domaind_ = std::make_unique<ChildProcess>((kBin / "rsca-domaind").string(), args, env_);
+  }
+
+  // Restarts the domain daemon finding component code in `dirs` first, then in the build's.
+  void use_exec_path(const std::vector<fs::path> &dirs) {
+    exec_path_ = dirs;
+    exec_path_.push_back(kBin);
+    restart_domaind();
   }
 
   // Starts one more node daemon (index: nodes so far + 1) and waits until the domain knows it.
@@ -302,6 +311,7 @@ private:
   fs::path run_;
   ChildProcess::Environment env_;
   std::unique_ptr<ChildProcess> domaind_;
+  std::vector<fs::path> exec_path_; // the domain daemon's; empty: its default
   std::vector<std::unique_ptr<ChildProcess>> nodes_;
   std::shared_ptr<rsca::dds::Participant> participant_;
   std::unique_ptr<rsca::control::Endpoint> client_;

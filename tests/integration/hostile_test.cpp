@@ -117,7 +117,7 @@ TEST_CASE("an application name that is a path never makes the domain act outside
   CHECK(installed->at("applications")[0].at("name") == "Healthy");
 }
 
-TEST_CASE("uninstall while a launch of the application is under way is refused; the domain lives "
+TEST_CASE("uninstall while a launch of the application is under way is refused, the domain lives "
           "on and forgets the application for good once uninstalled",
           "[integration][hostile]") {
   TestDomain domain(2, /*registration_timeout_ms=*/60000); // the launch waits until cancelled
@@ -208,7 +208,7 @@ TEST_CASE("a restarted domain daemon never collides with what a killed one left 
   domain.require_clean(all);
 }
 
-TEST_CASE("an application with a dead component is degraded; listing its connections and "
+TEST_CASE("an application with a dead component is degraded, listing its connections and "
           "stopping it answer at once",
           "[integration][hostile]") {
   TestDomain domain;

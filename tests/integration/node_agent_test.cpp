@@ -217,7 +217,7 @@ TEST_CASE("with its node's socket gone, the CLI tries the next and then DDS",
   CHECK(over_dds == 0); // the domain daemon answers over DDS
 }
 
-TEST_CASE("a hung node's socket still accepts; the CLI finds it silent and goes on to the next",
+TEST_CASE("a hung node's socket still accepts, the CLI finds it silent and goes on to the next",
           "[integration][node-agent]") {
   TestDomain domain(2);
   ::kill(domain.node_pid(1), SIGSTOP); // the kernel still accepts on its socket

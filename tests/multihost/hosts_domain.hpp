@@ -8,6 +8,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <memory>
 #include <random>
 #include <string>
@@ -39,9 +40,16 @@ struct CliRun {
   Json json() const { return Json::parse(out, nullptr, false); }
 };
 
+// What a test changes of the daemons it gets.
+struct HostsOptions {
+  // Node index → the size of a tmpfs (as mount's size=, "8m") its package cache is on: mounted in
+  // the node's own mount namespace (ip netns exec makes one), gone with it.
+  std::map<int, std::string> cache_tmpfs;
+};
+
 class HostsDomain {
 public:
-  explicit HostsDomain(int nodes) : hosts_(nodes + 1) {
+  explicit HostsDomain(int nodes, HostsOptions options = {}) : hosts_(nodes + 1) {
     fs::create_directories(run_ / "logs");
     env_ = {{"RSCA_DDS_DOMAIN", std::to_string(isolated_domain_id())},
             {"RSCA_DDS_TAG", isolated_tag()},
@@ -51,12 +59,7 @@ public:
                      {"--dmd", (kSource / "profiles/dom/domain/DomainManager.dmd.xml").string(),
                       "--repository", (run_ / "repository").string()});
     for (int i = 1; i <= nodes; ++i)
-      nodes_.push_back(start(
-          i + 1, "rsca-noded",
-          {"--dcd",
-           (kSource / fmt::format("profiles/dev/nodes/node{}/DeviceManager.dcd.xml", i)).string(),
-           "--control-socket", (run_ / fmt::format("node{}.sock", i)).string(), "--log-dir",
-           (run_ / "logs").string()}));
+      nodes_.push_back(start_node(i, options));
     // Known to the domain once it lists them all, asked over DDS from the domain's host.
     REQUIRE(wait_for([&] {
       const auto listed = cli(1, {"--timeout-ms", "1000", "ls", "nodes"}, over_dds());
@@ -109,8 +112,44 @@ public:
   }
 
   pid_t node_pid(int index) const { return nodes_.at(index - 1)->pid(); }
+  // Where node `index` keeps its package cache (inside its own mount namespace when on a tmpfs).
+  fs::path cache_dir(int index) const { return run_ / fmt::format("cache-node{}", index); }
+  const fs::path &run_dir() const { return run_.path; }
+
+  // Kills the domain daemon as a crash would.
+  void kill_domaind() {
+    domaind_->signal(SIGKILL);
+    domaind_->wait_exit(5s);
+  }
 
 private:
+  std::unique_ptr<ChildProcess> start_node(int i, const HostsOptions &options) {
+    const fs::path cache = cache_dir(i);
+    fs::create_directories(cache);
+    std::vector<std::string> args{
+        "--dcd",
+        (kSource / fmt::format("profiles/dev/nodes/node{}/DeviceManager.dcd.xml", i)).string(),
+        "--control-socket",
+        (run_ / fmt::format("node{}.sock", i)).string(),
+        "--log-dir",
+        (run_ / "logs").string(),
+        "--cache-dir",
+        cache.string()};
+    auto tmpfs = options.cache_tmpfs.find(i);
+    if (tmpfs == options.cache_tmpfs.end())
+      return start(i + 1, "rsca-noded", args);
+    // sh mounts the tmpfs in the namespace ip netns exec made, then becomes the node.
+    std::vector<std::string> sh{
+        "-c",
+        "size=$1 dir=$2; shift 2; mount -t tmpfs -o size=$size tmpfs \"$dir\" && exec \"$@\"",
+        "sh",
+        tmpfs->second,
+        cache.string(),
+        (kBin / "rsca-noded").string()};
+    sh.insert(sh.end(), args.begin(), args.end());
+    return std::make_unique<ChildProcess>(ip_program(), hosts_.on_host(i + 1, "/bin/sh", sh), env_);
+  }
+
   std::unique_ptr<ChildProcess> start(int host, const std::string &program,
                                       const std::vector<std::string> &args) {
     return std::make_unique<ChildProcess>(

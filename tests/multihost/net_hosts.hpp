@@ -108,6 +108,15 @@ public:
     REQUIRE(rc == 0);
   }
 
+  // Limits what host `index` sends to `rate` (tc's token bucket, "50mbit"): a slow link.
+  void limit_rate(int index, const std::string &rate) const {
+    auto [rc, out] = run_command(fmt::format(
+        "{} netns exec {} tc qdisc replace dev {} root tbf rate {} burst 64kb latency 200ms 2>&1",
+        ip_program(), ns(index), interface(index), rate));
+    INFO(out);
+    REQUIRE(rc == 0);
+  }
+
 private:
   void down() const { run_command(fmt::format("{} down {} 2>&1", kHostsTool.string(), name_)); }
 

@@ -51,7 +51,7 @@ TEST_CASE("a launching application holds its name but is not found until committ
   CHECK_FALSE(registry.launching("ProducerConsumer"));
 }
 
-TEST_CASE("a dropped reservation frees the name; drop never removes a running application",
+TEST_CASE("a dropped reservation frees the name, drop never removes a running application",
           "[unit][application-registry]") {
   ApplicationRegistry registry;
   REQUIRE(registry.reserve("A", true, "X").has_value());

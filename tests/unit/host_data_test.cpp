@@ -30,7 +30,7 @@ protocol::component::ConnectRequest same_host_connect(const std::string &directi
 
 } // namespace
 
-TEST_CASE("host data: two ends of a topic share one ring; it goes with its last end",
+TEST_CASE("host data: two ends of a topic share one ring, it goes with its last end",
           "[host-data]") {
   auto data = node::HostData::create({}, 64 << 20).value();
   const auto writer = data->connect(100, "a", same_host_connect("uses", "out"));
@@ -75,7 +75,7 @@ TEST_CASE("host data: a same-host connect without its topic is refused, holding 
   CHECK(data->counts().ends == 0);
 }
 
-TEST_CASE("host data: a process that ends lets go of its page and its ends; its readers see a "
+TEST_CASE("host data: a process that ends lets go of its page and its ends, its readers see a "
           "lost writer",
           "[host-data]") {
   auto data = node::HostData::create({}, 64 << 20).value();
@@ -203,7 +203,7 @@ TEST_CASE("host data: without a relay, a relayed connect is refused", "[host-dat
   CHECK(data->counts().ends == 0);
 }
 
-TEST_CASE("host data: rings are made as the node was told; limits no ring can have are refused",
+TEST_CASE("host data: rings are made as the node was told, limits no ring can have are refused",
           "[host-data]") {
   CHECK_FALSE(node::HostData::create({3000, 64}, 64 << 20).has_value()); // not a power of two
   CHECK_FALSE(node::HostData::create({1U << 30U, 64}, 64 << 20).has_value());

@@ -24,7 +24,7 @@ TEST_CASE("a launch's steps are its progress until it is done", "[unit][launch-t
   CHECK_FALSE(launches.progress("l2").has_value());
 }
 
-TEST_CASE("a cancel reaches a running launch; after its end it says so", "[unit][launch-tracker]") {
+TEST_CASE("a cancel reaches a running launch, after its end it says so", "[unit][launch-tracker]") {
   LaunchTracker launches;
   auto cancelled = launches.begin("l1");
   REQUIRE(cancelled != nullptr);

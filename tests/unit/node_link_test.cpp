@@ -141,7 +141,7 @@ TEST_CASE("node link: announcements, withdrawals and routes go to the node as fr
   CHECK(std::holds_alternative<link_frames::Withdraw>(node->next()));
 }
 
-TEST_CASE("node link: frames are cut whole from partial reads; an oversized or foreign one ends "
+TEST_CASE("node link: frames are cut whole from partial reads, an oversized or foreign one ends "
           "the link",
           "[node-link]") {
   auto pair = control::make_link_pair();

@@ -282,7 +282,7 @@ TEST_CASE("process links: a control socket another node listens on is not taken 
   CHECK(control::connect_link(stale.string()).has_value());
 }
 
-TEST_CASE("process links: a client has at most 8 calls under way; one more is refused at once",
+TEST_CASE("process links: a client has at most 8 calls under way, one more is refused at once",
           "[process-links]") {
   LinksRig rig;
   std::promise<void> gate;

@@ -52,7 +52,8 @@ TEST_CASE("protocol: nested messages round-trip", "[protocol]") {
                                      "robot",
                                      {},
                                      {{7, "app/C_1", "/tmp/c.log"}},
-                                     protocol::node::SharedMemoryStatus{1, 2, 3, 4096}};
+                                     protocol::node::SharedMemoryStatus{1, 2, 3, 4096},
+                                     protocol::node::PackageCacheStatus{2, 100, 1000, 1, 50, 3}};
   protocol::node::DeviceRecord gpp{
       "node1:GPP_1",  "GPP_1",        "GPP",          "gpp", Json{{"os_name", "Linux"}},
       Json::object(), Json::object(), Json::object(), "",    {}};
@@ -70,6 +71,9 @@ TEST_CASE("protocol: nested messages round-trip", "[protocol]") {
   CHECK(back.shared_memory->bytes == 4096);
   REQUIRE(back.processes.size() == 1);
   CHECK(back.processes[0].pid == 7);
+  REQUIRE(back.cache.has_value());
+  CHECK(back.cache->fetched_bytes == 50);
+  CHECK(back.cache->reused == 3);
 }
 
 TEST_CASE("protocol: a component's announcement round-trips, and one without its pid is refused",

@@ -40,7 +40,7 @@ TEST_CASE("a wake runs the poll on the loop's thread", "[unit][receive-loop]") {
   CHECK(other_thread);
 }
 
-TEST_CASE("a watching loop polls on its own; once it stops watching it waits for a wake",
+TEST_CASE("a watching loop polls on its own, once it stops watching it waits for a wake",
           "[unit][receive-loop]") {
   std::atomic<int> polls{0};
   auto loop = ReceiveLoop::start([&] { ++polls; });

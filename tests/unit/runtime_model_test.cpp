@@ -232,6 +232,30 @@ TEST_CASE("a runtime model copied along with its package is not used for the cop
   CHECK_THAT(read.error().to_string(), Contains("it was written for another SPD"));
 }
 
+TEST_CASE("a runtime model relocated into a node's package is used there, by the path a process "
+          "started in the package gives",
+          "[profile][runtime-model]") {
+  ProducerCopy copy;
+  // The package as a node lays it out: the domain's files under their path from its origin.
+  const fs::path package = copy.root / "package";
+  const fs::path inside = fs::path("dom/components/Producer");
+  fs::create_directories(package / inside);
+  for (const auto &entry : fs::directory_iterator(copy.dir))
+    fs::copy_file(entry.path(), package / inside / entry.path().filename());
+  const fs::path model = inside / "Producer.spd.xml.model.json";
+  REQUIRE(is_runtime_model_path(model));
+  REQUIRE(relocate_runtime_model(package, model, copy.root.string()).has_value());
+  // The component runs in the package and is given its SPD relative to it.
+  const fs::path before = fs::current_path();
+  fs::current_path(package);
+  auto read = read_runtime_model(inside / "Producer.spd.xml");
+  fs::current_path(before);
+  INFO((read ? "" : read.error().to_string()));
+  CHECK(read.has_value());
+  // Not the domain's copy: its model still names its own files.
+  CHECK(read_runtime_model(copy.spd).has_value());
+}
+
 TEST_CASE("a missing or broken runtime model makes the component loader read the XML",
           "[profile][runtime-model]") {
   ProducerCopy copy;

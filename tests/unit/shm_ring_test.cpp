@@ -136,7 +136,7 @@ TEST_CASE("shm: a writer never waits: a reader that fell behind loses the oldest
   CHECK(take_numbers(reader).empty());
 }
 
-TEST_CASE("shm: a ring has at most kMaxRingReaders readers; a slot released is claimed again",
+TEST_CASE("shm: a ring has at most kMaxRingReaders readers, a slot released is claimed again",
           "[shm]") {
   RingFixture f;
   auto [owner, at] = f.make();
@@ -245,7 +245,7 @@ TEST_CASE("shm: a ring carries records between two processes, the reader asleep 
     REQUIRE(got[i] > got[i - 1]);
 }
 
-TEST_CASE("shm: port values round-trip as ring records; a short record is refused", "[shm]") {
+TEST_CASE("shm: port values round-trip as ring records, a short record is refused", "[shm]") {
   port::Samples s;
   s.timestamp_ns = 12;
   s.sequence = 3;

@@ -115,7 +115,7 @@ TEST_CASE("wiring: both ends in one component host take the in-host path", "[wir
     CHECK(r.local == false);
 }
 
-TEST_CASE("wiring: a process a node relays for goes through that node; across nodes, relayed",
+TEST_CASE("wiring: a process a node relays for goes through that node, across nodes, relayed",
           "[wiring]") {
   using rsca::protocol::component::Connect;
   auto wire = [](std::string uses_host, std::string uses_node, std::string provides_host,

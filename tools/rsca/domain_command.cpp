@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 
 #include "commands.hpp"
+#include "common/own_folder.hpp"
 #include "domain_client.hpp"
 #include "exit_codes.hpp"
 #include "process/spawn.hpp"
@@ -22,12 +23,6 @@ namespace {
 namespace fs = std::filesystem;
 using control::Json;
 using namespace std::chrono_literals;
-
-fs::path own_folder() {
-  std::error_code ec;
-  auto self = fs::read_symlink("/proc/self/exe", ec);
-  return ec ? fs::path() : self.parent_path();
-}
 
 // sockaddr_un's sun_path holds 108 bytes, the terminating zero included.
 constexpr std::size_t kMaxSocketPath = 108;

@@ -1,0 +1,269 @@
+#include "domain/file_manager.hpp"
+
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <fmt/format.h>
+
+#include "content/base64.hpp"
+#include "content/sha256.hpp"
+#include "process/fd.hpp"
+#include "profile/runtime_model.hpp"
+
+namespace rsca::domain {
+
+namespace fs = std::filesystem;
+using protocol::Status;
+
+namespace {
+
+constexpr int kMaxDependencyDepth = 8;       // as the planner's softpkg dependency check
+constexpr std::size_t kMaxHashesKept = 4096; // files whose hash is remembered, then forgotten
+constexpr std::size_t kLaunchesKept = 64;    // launches whose delivered bytes are remembered
+
+CallResult<void> fail(Status status, std::string message) {
+  return protocol::call_error(status, std::move(message));
+}
+
+bool is_executable_file(const fs::path &file) {
+  struct stat st {};
+  return ::stat(file.c_str(), &st) == 0 && (st.st_mode & S_IXUSR) != 0;
+}
+
+} // namespace
+
+FileManager::FileManager(fs::path repository, std::vector<fs::path> exec_path)
+    : repository_(fs::weakly_canonical(repository)), exec_path_(std::move(exec_path)) {}
+
+std::string FileManager::package_path(const fs::path &file) const {
+  const fs::path relative = file.lexically_normal().lexically_relative(repository_);
+  if (relative.empty() || *relative.begin() == "..")
+    return {};
+  return relative.generic_string();
+}
+
+CallResult<protocol::Package>
+FileManager::package_of(const std::vector<PackagedComponent> &components) {
+  std::map<std::string, protocol::PackageFile> files; // by path: a file shared is there once
+  for (const auto &c : components) {
+    const auto &implementations = c.softpkg->implementations;
+    auto placed = std::find_if(implementations.begin(), implementations.end(),
+                               [&](const auto &i) { return i.implementation == c.implementation; });
+    if (placed == implementations.end())
+      return protocol::call_error(Status::Failed, fmt::format("{}: the implementation placed is "
+                                                              "not its SPD's",
+                                                              c.name));
+    if (auto ok = add_softpkg(*c.softpkg, *placed, 0, files); !ok)
+      return protocol::call_error(Status::Failed,
+                                  fmt::format("{}: {}", c.name, ok.error().message));
+  }
+  protocol::Package package{repository_.string(), {}};
+  for (auto &[path, file] : files)
+    package.files.push_back(std::move(file));
+  if (auto why = protocol::package_problem(package))
+    return protocol::call_error(Status::Failed, fmt::format("its package: {}", *why));
+  return package;
+}
+
+// Its profile files and runtime model, the implementation's code, and its softpkg dependencies'
+// code with their profiles.
+CallResult<void> FileManager::add_softpkg(const profile::ResolvedSoftPkg &softpkg,
+                                          const profile::ResolvedImplementation &implementation,
+                                          int depth,
+                                          std::map<std::string, protocol::PackageFile> &files) {
+  if (depth > kMaxDependencyDepth)
+    return fail(Status::BadRequest, "softpkg dependencies nest too deep");
+  for (const auto &source : softpkg.sources)
+    if (auto ok = add_file(source.path, package_path(source.path), files); !ok)
+      return ok;
+  const fs::path model = profile::runtime_model_path(softpkg.spd_path);
+  if (std::error_code ec; fs::exists(model, ec))
+    if (auto ok = add_file(model, package_path(model), files); !ok)
+      return ok;
+  if (auto ok = add_code(softpkg, implementation, files); !ok)
+    return ok;
+  for (const auto &dependency : implementation.dependencies) {
+    const auto &pkg = *dependency.softpkg;
+    for (const auto &candidate : pkg.implementations) {
+      if (dependency.implref && candidate.implementation->id != *dependency.implref)
+        continue;
+      if (auto ok = add_softpkg(pkg, candidate, depth + 1, files); !ok)
+        return ok;
+    }
+  }
+  return {};
+}
+
+// The code file (or folder) the implementation names, at its place beside the SPD in the package
+// wherever the domain found it.
+CallResult<void> FileManager::add_code(const profile::ResolvedSoftPkg &softpkg,
+                                       const profile::ResolvedImplementation &implementation,
+                                       std::map<std::string, protocol::PackageFile> &files) {
+  const auto &code = implementation.implementation->code;
+  if (code.file.name.empty())
+    return {};
+  if (fs::path(code.file.name).is_absolute())
+    return {}; // installed on the node itself, as REDHAWK allows: nothing to deliver
+  const fs::path spd_dir = softpkg.spd_path.parent_path();
+  const std::string path = package_path(spd_dir / code.file.name);
+  if (path.empty())
+    return fail(Status::BadRequest,
+                fmt::format("{}: code file {} lies outside the application's folder",
+                            softpkg.spd_path.string(), code.file.name));
+  auto found = find_code(spd_dir, code.file.name);
+  if (!found)
+    return fail(Status::NotFound,
+                fmt::format("{}: code file {} is neither beside the SPD nor in the domain's exec "
+                            "path",
+                            softpkg.spd_path.string(), code.file.name));
+  std::error_code ec;
+  if (!fs::is_directory(*found, ec))
+    return add_file(*found, path, files);
+  for (auto it = fs::recursive_directory_iterator(*found, ec); !ec && it != fs::end(it);
+       it.increment(ec)) {
+    if (!it->is_regular_file(ec))
+      continue;
+    if (files.size() > protocol::kMaxPackageFiles)
+      return fail(Status::BadRequest, fmt::format("{}: too many files", found->string()));
+    const std::string inside = it->path().lexically_relative(*found).generic_string();
+    if (auto ok = add_file(it->path(), path + "/" + inside, files); !ok)
+      return ok;
+  }
+  if (ec)
+    return fail(Status::Failed, fmt::format("{}: {}", found->string(), ec.message()));
+  return {};
+}
+
+// Beside the SPD, where an install that carries code puts it; else by its file name in the exec
+// path, executables in a folder of it and libraries also in the lib folder beside it.
+std::optional<fs::path> FileManager::find_code(const fs::path &spd_dir,
+                                               const std::string &name) const {
+  std::error_code ec;
+  if (fs::exists(spd_dir / name, ec))
+    return spd_dir / name;
+  const fs::path file = fs::path(name).filename();
+  for (const auto &dir : exec_path_)
+    for (const auto &candidate : {dir / file, dir / ".." / "lib" / file})
+      if (fs::exists(candidate, ec))
+        return candidate.lexically_normal();
+  return std::nullopt;
+}
+
+CallResult<void> FileManager::add_file(const fs::path &file, const std::string &path,
+                                       std::map<std::string, protocol::PackageFile> &files) {
+  if (path.empty())
+    return fail(Status::BadRequest, fmt::format("{} lies outside the domain's repository {}",
+                                                file.string(), repository_.string()));
+  if (files.count(path) != 0)
+    return {};
+  auto described = describe(file, path);
+  if (!described)
+    return tl::unexpected(described.error());
+  files.emplace(path, std::move(*described));
+  return {};
+}
+
+// The file's hash (computed again only when its stamp changed), and its name in the package. It
+// is served from now on.
+CallResult<protocol::PackageFile> FileManager::describe(const fs::path &file,
+                                                        const std::string &path) {
+  const auto stamp = profile::stamp_of(file);
+  if (!stamp)
+    return protocol::call_error(Status::NotFound, fmt::format("{} cannot be read", file.string()));
+  std::string sha256;
+  {
+    std::lock_guard lock(mutex_);
+    if (auto it = hashes_.find(file); it != hashes_.end() && it->second.stamp == *stamp)
+      sha256 = it->second.sha256;
+  }
+  if (sha256.empty()) {
+    auto hashed = content::sha256_of_file(file);
+    if (!hashed)
+      return protocol::call_error(Status::Failed, hashed.error().to_string());
+    sha256 = std::move(*hashed);
+  }
+  std::lock_guard lock(mutex_);
+  if (hashes_.size() >= kMaxHashesKept)
+    hashes_.clear();
+  hashes_[file] = {*stamp, sha256};
+  served_[sha256] = file;
+  return protocol::PackageFile{path, sha256, stamp->size, is_executable_file(file)};
+}
+
+CallResult<protocol::file::ReadReply>
+FileManager::read(const protocol::file::ReadRequest &request) {
+  if (!content::is_sha256_hex(request.sha256))
+    return protocol::call_error(Status::BadRequest, "sha256: not a SHA-256 in lowercase hex");
+  if (request.length > protocol::file::kMaxReadBytes)
+    return protocol::call_error(
+        Status::BadRequest,
+        fmt::format("length {} is over {}", request.length, protocol::file::kMaxReadBytes));
+  fs::path file;
+  std::optional<profile::FileStamp> hashed_as;
+  {
+    std::lock_guard lock(mutex_);
+    auto it = served_.find(request.sha256);
+    if (it == served_.end())
+      return protocol::call_error(Status::NotFound,
+                                  fmt::format("no file {} in a package", request.sha256));
+    file = it->second;
+    if (auto h = hashes_.find(file); h != hashes_.end() && h->second.sha256 == request.sha256)
+      hashed_as = h->second.stamp;
+  }
+  if (!hashed_as || profile::stamp_of(file) != hashed_as)
+    return protocol::call_error(Status::Failed,
+                                fmt::format("{} changed since it was put into the package; launch "
+                                            "again",
+                                            file.string()));
+  if (request.offset > hashed_as->size)
+    return protocol::call_error(Status::BadRequest,
+                                fmt::format("offset {} is past the end of {} ({} bytes)",
+                                            request.offset, file.string(), hashed_as->size));
+  process::Fd fd(::open(file.c_str(), O_RDONLY | O_CLOEXEC));
+  if (!fd)
+    return protocol::call_error(Status::Failed,
+                                fmt::format("{}: {}", file.string(), std::strerror(errno)));
+  const auto wanted = std::min<std::uint64_t>(request.length, hashed_as->size - request.offset);
+  std::string bytes(wanted, '\0');
+  std::size_t got = 0;
+  while (got < wanted) {
+    const ssize_t n = ::pread(fd.get(), bytes.data() + got, wanted - got,
+                              static_cast<off_t>(request.offset + got));
+    if (n < 0 && errno == EINTR)
+      continue;
+    if (n <= 0)
+      break; // cut short: the node sees fewer bytes than it asked for, and the hash tells
+    got += static_cast<std::size_t>(n);
+  }
+  bytes.resize(got);
+  count(request.launch, got);
+  return protocol::file::ReadReply{content::base64_encode(bytes), hashed_as->size};
+}
+
+void FileManager::count(const std::optional<std::string> &launch, std::uint64_t bytes) {
+  if (!launch)
+    return;
+  std::lock_guard lock(mutex_);
+  auto [it, fresh] = delivered_.try_emplace(*launch, 0);
+  it->second += bytes;
+  if (!fresh)
+    return;
+  launches_.push_back(*launch);
+  if (launches_.size() > kLaunchesKept) {
+    delivered_.erase(launches_.front());
+    launches_.pop_front();
+  }
+}
+
+std::uint64_t FileManager::delivered(const std::string &launch) const {
+  std::lock_guard lock(mutex_);
+  auto it = delivered_.find(launch);
+  return it == delivered_.end() ? 0 : it->second;
+}
+
+} // namespace rsca::domain

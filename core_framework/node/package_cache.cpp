@@ -1,0 +1,301 @@
+#include "node/package_cache.hpp"
+
+#include <condition_variable>
+#include <fstream>
+#include <map>
+#include <mutex>
+#include <optional>
+
+#include <signal.h>
+#include <unistd.h>
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include "content/sha256.hpp"
+#include "node/package_fetch.hpp"
+#include "profile/runtime_model.hpp"
+
+namespace rsca::node {
+
+namespace fs = std::filesystem;
+using protocol::Status;
+
+std::string package_id(const protocol::Package &package) {
+  return content::sha256_hex(protocol::encode(package).dump());
+}
+
+namespace {
+
+std::uint64_t bytes_of(const protocol::Package &package) {
+  std::uint64_t bytes = 0;
+  for (const auto &f : package.files)
+    bytes += f.size;
+  return bytes;
+}
+
+// "<id>.<pid>.<n>" of a folder in incoming/: the pid of the node that made it.
+std::optional<pid_t> maker_of(const std::string &name) {
+  const auto first = name.find('.');
+  const auto second = name.find('.', first + 1);
+  if (first == std::string::npos || second == std::string::npos)
+    return std::nullopt;
+  try {
+    return static_cast<pid_t>(std::stol(name.substr(first + 1, second - first - 1)));
+  } catch (const std::exception &) {
+    return std::nullopt;
+  }
+}
+
+bool alive(pid_t pid) {
+  return pid > 0 && (::kill(pid, 0) == 0 || errno == EPERM);
+}
+
+void remove_folder(const fs::path &folder) {
+  std::error_code ec;
+  // Its files are read-only, not its folders: remove_all needs only the folders' write bit.
+  fs::remove_all(folder, ec);
+  if (ec)
+    spdlog::warn("package cache: cannot remove {}: {}", folder.string(), ec.message());
+}
+
+} // namespace
+
+struct PackageCache::State {
+  struct Entry {
+    protocol::Package manifest;
+    std::uint64_t bytes = 0;
+    std::uint64_t last_use = 0; // a counter: larger is more recent
+    unsigned leases = 0;
+  };
+
+  CacheOptions options;
+  FetchPiece fetch;
+  mutable std::mutex mutex; // guards what follows
+  std::condition_variable fetched_cv;
+  std::map<std::string, Entry> packages;     // by id
+  std::map<std::string, bool> fetching;      // ids being fetched
+  std::map<std::string, std::string> copies; // file hash → a package holding it, by id
+  std::uint64_t uses = 0;
+  std::uint64_t incoming = 0;
+  CacheCounts counts;
+
+  fs::path packages_dir() const { return options.dir / "packages"; }
+  fs::path manifests_dir() const { return options.dir / "manifests"; }
+  fs::path incoming_dir() const { return options.dir / "incoming"; }
+  fs::path root_of(const std::string &id) const { return packages_dir() / id; }
+
+  void load();
+  void add_locked(const std::string &id, protocol::Package manifest);
+  void evict_locked();
+  std::optional<fs::path> copy_of(const protocol::PackageFile &file) const;
+  CallResult<void> fetch_into_place(const std::string &id, const protocol::Package &package,
+                                    const std::string &launch);
+  CallResult<void> write_manifest(const std::string &id, const protocol::Package &package) const;
+};
+
+class CachedPackage final : public PackageLease {
+public:
+  CachedPackage(std::shared_ptr<PackageCache::State> state, std::string id)
+      : state_(std::move(state)), id_(std::move(id)), root_(state_->root_of(id_)) {}
+  ~CachedPackage() override {
+    std::lock_guard lock(state_->mutex);
+    if (auto it = state_->packages.find(id_); it != state_->packages.end() && it->second.leases > 0)
+      --it->second.leases;
+    state_->evict_locked(); // one it kept over the limit may go now
+  }
+  const fs::path &root() const override { return root_; }
+
+private:
+  std::shared_ptr<PackageCache::State> state_;
+  std::string id_;
+  fs::path root_;
+};
+
+// What a node left: folders it was fetching into (when it is gone), packages without their
+// manifest (it stopped before writing it) and manifests without their package.
+void PackageCache::State::load() {
+  std::error_code ec;
+  for (const auto &entry : fs::directory_iterator(incoming_dir(), ec)) {
+    const auto maker = maker_of(entry.path().filename().string());
+    if (!maker || !alive(*maker))
+      remove_folder(entry.path());
+  }
+  for (const auto &entry : fs::directory_iterator(packages_dir(), ec)) {
+    const std::string id = entry.path().filename().string();
+    std::ifstream in(manifests_dir() / (id + ".json"));
+    const auto json = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+    auto manifest = protocol::decode<protocol::Package>(json);
+    if (json.is_discarded() || !manifest || package_id(*manifest) != id) {
+      spdlog::info("package cache: {} has no manifest; removed", id);
+      remove_folder(entry.path());
+      fs::remove(manifests_dir() / (id + ".json"), ec);
+      continue;
+    }
+    add_locked(id, std::move(*manifest));
+  }
+  for (const auto &entry : fs::directory_iterator(manifests_dir(), ec))
+    if (!fs::exists(packages_dir() / entry.path().stem(), ec))
+      fs::remove(entry.path(), ec);
+}
+
+void PackageCache::State::add_locked(const std::string &id, protocol::Package manifest) {
+  for (const auto &f : manifest.files)
+    if (!profile::is_runtime_model_path(f.path)) // rewritten here: not the hash's content
+      copies[f.sha256] = id;
+  Entry entry{std::move(manifest), 0, ++uses, 0};
+  entry.bytes = bytes_of(entry.manifest);
+  counts.bytes += entry.bytes;
+  ++counts.packages;
+  packages[id] = std::move(entry);
+}
+
+// Least recently used first, until the cache fits its size; a package in use stays.
+void PackageCache::State::evict_locked() {
+  while (counts.bytes > options.max_bytes) {
+    auto victim = packages.end();
+    for (auto it = packages.begin(); it != packages.end(); ++it)
+      if (it->second.leases == 0 &&
+          (victim == packages.end() || it->second.last_use < victim->second.last_use))
+        victim = it;
+    if (victim == packages.end())
+      return; // everything left is in use
+    spdlog::info("package cache: evicting {} ({} bytes) to stay under {} bytes", victim->first,
+                 victim->second.bytes, options.max_bytes);
+    std::error_code ec;
+    fs::remove(manifests_dir() / (victim->first + ".json"), ec);
+    remove_folder(root_of(victim->first));
+    for (auto it = copies.begin(); it != copies.end();)
+      it = it->second == victim->first ? copies.erase(it) : std::next(it);
+    counts.bytes -= victim->second.bytes;
+    --counts.packages;
+    packages.erase(victim);
+  }
+}
+
+std::optional<fs::path> PackageCache::State::copy_of(const protocol::PackageFile &file) const {
+  std::lock_guard lock(mutex);
+  auto it = copies.find(file.sha256);
+  if (it == copies.end())
+    return std::nullopt;
+  auto package = packages.find(it->second);
+  if (package == packages.end())
+    return std::nullopt;
+  for (const auto &f : package->second.manifest.files)
+    if (f.sha256 == file.sha256)
+      return root_of(it->second) / f.path;
+  return std::nullopt;
+}
+
+CallResult<void> PackageCache::State::write_manifest(const std::string &id,
+                                                     const protocol::Package &package) const {
+  const fs::path target = manifests_dir() / (id + ".json");
+  const fs::path temporary = fs::path(target).concat(fmt::format(".{}.tmp", ::getpid()));
+  std::ofstream out(temporary, std::ios::trunc);
+  out << protocol::encode(package).dump();
+  out.close();
+  std::error_code ec;
+  if (out)
+    fs::rename(temporary, target, ec);
+  if (!out || ec) {
+    fs::remove(temporary, ec);
+    return protocol::call_error(
+        Status::Failed, fmt::format("cannot write {} (is the disk full?)", target.string()));
+  }
+  return {};
+}
+
+// Fetched into a folder of its own in incoming/, then renamed into place; on failure nothing of
+// it is left.
+CallResult<void> PackageCache::State::fetch_into_place(const std::string &id,
+                                                       const protocol::Package &package,
+                                                       const std::string &launch) {
+  fs::path folder;
+  {
+    std::lock_guard lock(mutex);
+    folder = incoming_dir() / fmt::format("{}.{}.{}", id, ::getpid(), ++incoming);
+  }
+  detail::FetchContext context{fetch, &options, launch,
+                               [this](const protocol::PackageFile &f) { return copy_of(f); }};
+  auto fetched = detail::lay_out(context, package, folder);
+  std::error_code ec;
+  if (fetched)
+    fs::rename(folder, root_of(id), ec);
+  if (!fetched || ec) {
+    remove_folder(folder);
+    if (fetched)
+      return protocol::call_error(Status::Failed, fmt::format("cannot move package {} into place: "
+                                                              "{}",
+                                                              id, ec.message()));
+    return tl::unexpected(fetched.error());
+  }
+  if (auto ok = write_manifest(id, package); !ok) {
+    remove_folder(root_of(id));
+    return ok;
+  }
+  std::lock_guard lock(mutex);
+  counts.fetched_bytes += *fetched;
+  ++counts.fetched;
+  spdlog::info("package {}: {} files in place, {} bytes fetched", id, package.files.size(),
+               *fetched);
+  return {};
+}
+
+PackageCache::PackageCache(std::shared_ptr<State> state) : state_(std::move(state)) {}
+PackageCache::~PackageCache() = default;
+
+Expected<std::unique_ptr<PackageCache>> PackageCache::open(CacheOptions options, FetchPiece fetch) {
+  auto state = std::make_shared<State>();
+  state->options = std::move(options);
+  state->fetch = std::move(fetch);
+  for (const auto &dir : {state->packages_dir(), state->manifests_dir(), state->incoming_dir()}) {
+    std::error_code ec;
+    fs::create_directories(dir, ec);
+    if (ec)
+      return make_error({dir.string(), 0, 0}, "cache", ec.message());
+  }
+  {
+    std::lock_guard lock(state->mutex);
+    state->load();
+    state->evict_locked();
+  }
+  spdlog::info("package cache {}: {} packages, {} bytes (at most {})", state->options.dir.string(),
+               state->counts.packages, state->counts.bytes, state->options.max_bytes);
+  return std::unique_ptr<PackageCache>(new PackageCache(std::move(state)));
+}
+
+CallResult<std::shared_ptr<const PackageLease>>
+PackageCache::acquire(const protocol::Package &package, const std::string &launch) {
+  if (auto why = protocol::package_problem(package))
+    return protocol::call_error(Status::BadRequest, fmt::format("package: {}", *why));
+  const std::string id = package_id(package);
+  State &s = *state_;
+  std::unique_lock lock(s.mutex);
+  // Another call fetching it: wait for its outcome, then look again.
+  s.fetched_cv.wait(lock, [&] { return s.fetching.count(id) == 0; });
+  if (auto it = s.packages.find(id); it != s.packages.end()) {
+    it->second.last_use = ++s.uses;
+    ++it->second.leases;
+    ++s.counts.reused;
+    return std::make_shared<CachedPackage>(state_, id);
+  }
+  s.fetching[id] = true;
+  lock.unlock();
+  auto fetched = s.fetch_into_place(id, package, launch);
+  lock.lock();
+  s.fetching.erase(id);
+  s.fetched_cv.notify_all();
+  if (!fetched)
+    return tl::unexpected(fetched.error());
+  s.add_locked(id, package);
+  ++s.packages[id].leases;
+  s.evict_locked();
+  return std::make_shared<CachedPackage>(state_, id);
+}
+
+CacheCounts PackageCache::counts() const {
+  std::lock_guard lock(state_->mutex);
+  return state_->counts;
+}
+
+} // namespace rsca::node

@@ -1,0 +1,46 @@
+// The file.* operations of the domain's FileManager: how a node fetches the files of a package
+// (protocol/package.hpp) it lacks. A file is asked for by its content hash, never by a path: the
+// domain serves only what it put into a package it sent.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include "protocol/codec.hpp"
+
+namespace rsca::protocol::file {
+
+// At most this much of a file travels in one reply (a DDS sample of about 1.4 times that once
+// encoded); a node asks for several pieces at once.
+inline constexpr std::uint64_t kMaxReadBytes = 1ULL << 20U;
+inline constexpr std::size_t kMaxLaunchLength = 256; // of ReadRequest::launch
+
+struct ReadRequest {
+  std::string sha256;
+  std::uint64_t offset = 0;
+  std::uint64_t length = 0;          // at most kMaxReadBytes
+  std::optional<std::string> launch; // the launch it is for: its progress counts the bytes
+  static constexpr auto fields() {
+    using R = ReadRequest;
+    return std::tuple{required("sha256", &R::sha256), required("offset", &R::offset),
+                      required("length", &R::length), optional("launch", &R::launch)};
+  }
+};
+
+struct ReadReply {
+  std::string data;       // base64 of the bytes from offset: `length` of them, fewer at the end
+  std::uint64_t size = 0; // the whole file's
+  static constexpr auto fields() {
+    return std::tuple{required("data", &ReadReply::data), required("size", &ReadReply::size)};
+  }
+};
+
+struct Read {
+  static constexpr std::string_view name = "file.read";
+  using Request = ReadRequest;
+  using Reply = ReadReply;
+};
+
+} // namespace rsca::protocol::file

@@ -1,0 +1,73 @@
+#include "protocol/package.hpp"
+
+#include <algorithm>
+
+#include <fmt/format.h>
+
+namespace rsca::protocol {
+
+namespace {
+
+bool lower_hex_sha256(const std::string &text) {
+  return text.size() == 64 && std::all_of(text.begin(), text.end(), [](char c) {
+           return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f');
+         });
+}
+
+} // namespace
+
+std::optional<std::string> package_path_problem(const std::string &path) {
+  if (path.empty())
+    return "an empty path";
+  if (path.size() > kMaxPackagePath)
+    return fmt::format("a path of {} characters (at most {})", path.size(), kMaxPackagePath);
+  if (path.find('\0') != std::string::npos)
+    return "a path with a NUL character";
+  if (path.front() == '/')
+    return fmt::format("an absolute path \"{}\"", path);
+  std::size_t begin = 0;
+  while (begin <= path.size()) {
+    const std::size_t end = std::min(path.find('/', begin), path.size());
+    const std::string_view part(path.data() + begin, end - begin);
+    if (part.empty() || part == "." || part == "..")
+      return fmt::format("\"{}\": every part of a path names a file or folder", path);
+    begin = end + 1;
+  }
+  return std::nullopt;
+}
+
+std::optional<std::string> package_problem(const Package &package) {
+  if (package.files.empty())
+    return "a package without files";
+  if (package.files.size() > kMaxPackageFiles)
+    return fmt::format("{} files (at most {})", package.files.size(), kMaxPackageFiles);
+  std::uint64_t bytes = 0;
+  for (std::size_t i = 0; i < package.files.size(); ++i) {
+    const auto &f = package.files[i];
+    if (auto why = package_path_problem(f.path))
+      return fmt::format("file {}: {}", i, *why);
+    if (!lower_hex_sha256(f.sha256))
+      return fmt::format("{}: \"{}\" is not a SHA-256 in lowercase hex", f.path, f.sha256);
+    if (i > 0 && !(package.files[i - 1].path < f.path))
+      return fmt::format("{}: paths are not sorted, or one is there twice", f.path);
+    if (f.size > kMaxPackageBytes - bytes)
+      return fmt::format("more than {} bytes", kMaxPackageBytes);
+    bytes += f.size;
+  }
+  // A file that is also a folder of another ("a" and "a/b") cannot be laid out.
+  for (std::size_t i = 1; i < package.files.size(); ++i) {
+    const auto &before = package.files[i - 1].path;
+    const auto &path = package.files[i].path;
+    if (path.size() > before.size() && path.compare(0, before.size(), before) == 0 &&
+        path[before.size()] == '/')
+      return fmt::format("{} is a file and a folder", before);
+  }
+  return std::nullopt;
+}
+
+void sort_files(Package &package) {
+  std::sort(package.files.begin(), package.files.end(),
+            [](const PackageFile &a, const PackageFile &b) { return a.path < b.path; });
+}
+
+} // namespace rsca::protocol

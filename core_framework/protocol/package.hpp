@@ -1,0 +1,57 @@
+// A component's package: the files a node needs to run a component process (its executable or
+// library, its softpkg dependencies' code, its SPD, PRFs and SCD, its runtime model), each named
+// by its path inside the package and its content hash. The domain builds it (domain/
+// file_manager.hpp) and sends it with node.execute; the node fetches what its cache lacks over
+// file.read (protocol/file_ops.hpp), verifies it and runs the process inside it (node/
+// package_cache.hpp). Checked here, once, for both parties: a node takes nothing from the network
+// on trust.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "protocol/codec.hpp"
+
+namespace rsca::protocol {
+
+struct PackageFile {
+  std::string path;   // relative, normal, inside the package: "components/Producer/rsca-producer"
+  std::string sha256; // lowercase hex of its content
+  std::uint64_t size = 0;
+  bool executable = false;
+  static constexpr auto fields() {
+    using F = PackageFile;
+    return std::tuple{required("path", &F::path), required("sha256", &F::sha256),
+                      required("size", &F::size), optional("executable", &F::executable)};
+  }
+  bool operator==(const PackageFile &) const = default;
+};
+
+struct Package {
+  // Where the domain's copies are (its repository): the runtime models it sent name their
+  // sources there, and the node rewrites them to the package's paths.
+  std::string origin;
+  std::vector<PackageFile> files; // sorted by path, no path twice
+  static constexpr auto fields() {
+    return std::tuple{required("origin", &Package::origin), required("files", &Package::files)};
+  }
+  bool operator==(const Package &) const = default;
+};
+
+// Bounds a node holds a package to: a request from the network is untrusted.
+inline constexpr std::size_t kMaxPackageFiles = 4096;
+inline constexpr std::uint64_t kMaxPackageBytes = 16ULL << 30U; // 16 GiB
+inline constexpr std::size_t kMaxPackagePath = 1024;
+
+// Why `path` may not name a file in a package (absolute, empty, "..", ".", "//", too long, a NUL);
+// none when it may.
+std::optional<std::string> package_path_problem(const std::string &path);
+// Why `package` is not one to fetch (a bad path or hash, a path twice or out of order, too many
+// files or bytes); none when it is.
+std::optional<std::string> package_problem(const Package &package);
+// Puts the files in the order package_problem() asks for.
+void sort_files(Package &package);
+
+} // namespace rsca::protocol

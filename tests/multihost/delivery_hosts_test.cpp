@@ -1,0 +1,113 @@
+// Code delivered across hosts (issue 21): a node on a host of its own fetches its components'
+// files from the domain over the network, verified, into its cache. A full disk and a transfer
+// cut off fail the launch at execute and leave nothing half written in the cache.
+#include <catch2/catch.hpp>
+
+#include <future>
+
+#include "hosts_domain.hpp"
+
+using namespace rsca::test;
+
+namespace {
+
+const std::string kDeliveredSad =
+    (kSource / "profiles/dom/waveforms/ProducerConsumer/ProducerConsumer.sad.xml").string();
+
+// Files under `dir`, counted inside the mount namespace of process `pid` (where a node's tmpfs
+// is); -1 when it cannot be looked into.
+int files_in_ns(pid_t pid, const fs::path &dir) {
+  auto [rc, out] = run_command(
+      fmt::format("nsenter -t {} -m -- find {} -type f 2>/dev/null | wc -l", pid, dir.string()));
+  return rc == 0 ? std::stoi(out) : -1;
+}
+
+std::vector<fs::path> files_under(const fs::path &dir) {
+  std::vector<fs::path> files;
+  std::error_code ec;
+  for (auto it = fs::recursive_directory_iterator(dir, ec);
+       !ec && it != fs::recursive_directory_iterator(); it.increment(ec))
+    if (it->is_regular_file(ec))
+      files.push_back(it->path());
+  return files;
+}
+
+} // namespace
+
+TEST_CASE("a node on another host runs its component from the files the domain delivered over "
+          "the network, and the next launch reuses them",
+          "[multihost][delivery]") {
+  HostsDomain domain(2);
+  const auto launched = domain.cli(
+      1, {"launch", kDeliveredSad, "--assign", "Consumer_1=node2:GPP_1"}, HostsDomain::over_dds());
+  INFO(launched.out << launched.err);
+  REQUIRE(launched.rc == 0);
+  const fs::path consumer_copy = [&] {
+    for (const auto &f : files_under(domain.cache_dir(2) / "packages"))
+      if (f.filename() == "rsca-consumer")
+        return f;
+    return fs::path();
+  }();
+  REQUIRE_FALSE(consumer_copy.empty());
+  CHECK(fs::file_size(consumer_copy) == fs::file_size(kBin / "rsca-consumer"));
+  const auto first = domain.hosts().received_bytes(HostsDomain::host_of_node(2));
+  // The file came over node2's network interface: at least its size more than it sent.
+  CHECK(first >= fs::file_size(kBin / "rsca-consumer"));
+
+  const auto again = domain.cli(
+      1, {"launch", "ProducerConsumer", "--name", "Again", "--assign", "Consumer_1=node2:GPP_1"},
+      HostsDomain::over_dds());
+  INFO(again.out << again.err);
+  REQUIRE(again.rc == 0);
+  // Reused: far less than the file crossed the link the second time.
+  CHECK(domain.hosts().received_bytes(HostsDomain::host_of_node(2)) - first <
+        fs::file_size(kBin / "rsca-consumer") / 4);
+  for (const char *app : {"ProducerConsumer", "Again"})
+    CHECK(domain.cli(1, {"release", app}, HostsDomain::over_dds()).rc == 0);
+}
+
+TEST_CASE(
+    "a node whose disk is full fails the launch at execute, which is rolled back, and the cache "
+    "keeps nothing half written",
+    "[multihost][delivery][failure]") {
+  // node2's cache on a tmpfs far smaller than a component executable of this build.
+  HostsDomain domain(2, {.cache_tmpfs = {{2, "4m"}}});
+  const auto launched = domain.cli(
+      1, {"launch", kDeliveredSad, "--assign", "Consumer_1=node2:GPP_1"}, HostsDomain::over_dds());
+  INFO(launched.out << launched.err);
+  CHECK(launched.rc == 6);
+  const auto error = launched.json().at("error").at("message").get<std::string>();
+  CHECK_THAT(error, Catch::Contains("failed at step 'execute'"));
+  CHECK_THAT(error, Catch::Contains("No space left on device"));
+  CHECK_THAT(error, Catch::Contains("rolled back"));
+  const auto apps = domain.cli(1, {"ls", "apps"}, HostsDomain::over_dds());
+  CHECK(apps.json().at("applications").empty());
+  CHECK(files_in_ns(domain.node_pid(2), domain.cache_dir(2)) == 0);
+}
+
+TEST_CASE("a transfer cut off (the domain daemon killed while a node fetches) leaves nothing half "
+          "written in the node's cache",
+          "[multihost][delivery][failure]") {
+  HostsDomain domain(2);
+  // Slow enough that the transfer is under way for seconds: what the domain's host sends.
+  domain.hosts().limit_rate(1, "40mbit");
+  auto launch = std::async(std::launch::async, [&] {
+    return domain.cli(1, {"launch", kDeliveredSad, "--assign", "Consumer_1=node2:GPP_1"},
+                      HostsDomain::over_dds());
+  });
+  const fs::path incoming = domain.cache_dir(2) / "incoming";
+  REQUIRE(HostsDomain::wait_for(
+      [&] {
+        for (const auto &f : files_under(incoming))
+          if (std::error_code ec; fs::file_size(f, ec) > 1'000'000 && !ec)
+            return true;
+        return false;
+      },
+      60s));
+  domain.kill_domaind();
+  // The node gives up on its pieces (their deadline, or the domain gone from DDS) and removes
+  // what it had fetched.
+  CHECK(HostsDomain::wait_for([&] { return files_under(incoming).empty(); }, 40s));
+  CHECK(files_under(domain.cache_dir(2) / "packages").empty());
+  launch.wait();
+}

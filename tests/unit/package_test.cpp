@@ -1,0 +1,86 @@
+// What the domain and a node agree a package is (protocol/package.hpp), and the content hashes
+// and base64 it travels with (content/): a node takes no path or hash from the network on trust.
+#include "content/base64.hpp"
+#include "content/sha256.hpp"
+#include "protocol/package.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <fstream>
+
+#include "temp_dir.hpp"
+
+using namespace rsca;
+using Catch::Matchers::Contains;
+
+namespace {
+
+const std::string kHashA(64, 'a');
+const std::string kHashB(64, 'b');
+
+protocol::Package two_files() {
+  return {"/srv/repository",
+          {{"applications/A/c/C.spd.xml", kHashA, 10, false},
+           {"applications/A/c/run", kHashB, 20, true}}};
+}
+
+} // namespace
+
+TEST_CASE("content: SHA-256 of bytes and of a file is the standard one", "[package]") {
+  // FIPS 180-2's example "abc".
+  CHECK(content::sha256_hex("abc") ==
+        "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+  test::TempDir dir;
+  {
+    std::ofstream out(dir.path() / "f");
+    out << "abc";
+  }
+  CHECK(content::sha256_of_file(dir.path() / "f").value() == content::sha256_hex("abc"));
+  CHECK_FALSE(content::sha256_of_file(dir.path() / "missing").has_value());
+  CHECK(content::is_sha256_hex(kHashA));
+  CHECK_FALSE(content::is_sha256_hex(std::string(64, 'A')));
+  CHECK_FALSE(content::is_sha256_hex("abc"));
+}
+
+TEST_CASE("content: base64 round-trips any bytes and refuses what is not base64", "[package]") {
+  std::string bytes;
+  for (int i = 0; i < 1000; ++i)
+    bytes.push_back(static_cast<char>(i * 7));
+  for (std::size_t n : {0, 1, 2, 3, 4, 999, 1000})
+    CHECK(content::base64_decode(content::base64_encode(bytes.substr(0, n))) == bytes.substr(0, n));
+  CHECK(content::base64_encode("ab") == "YWI=");
+  CHECK_FALSE(content::base64_decode("YWI").has_value());  // not a multiple of 4
+  CHECK_FALSE(content::base64_decode("Y!I=").has_value()); // not the alphabet
+}
+
+TEST_CASE("package: a well-formed package passes, sorted by path", "[package]") {
+  auto package = two_files();
+  std::swap(package.files[0], package.files[1]);
+  CHECK(protocol::package_problem(package).has_value()); // out of order
+  protocol::sort_files(package);
+  CHECK_FALSE(protocol::package_problem(package).has_value());
+}
+
+TEST_CASE("package: a path that could leave the package, a bad hash or a repeated path is refused",
+          "[package]") {
+  for (const std::string path : {"/etc/passwd", "../x", "a/../../x", "a//b", "./a", "a/.", ""}) {
+    auto package = two_files();
+    package.files[0].path = path;
+    protocol::sort_files(package);
+    INFO(path);
+    CHECK(protocol::package_problem(package).has_value());
+  }
+  auto bad_hash = two_files();
+  bad_hash.files[1].sha256 = "not a hash";
+  CHECK_THAT(protocol::package_problem(bad_hash).value(), Contains("SHA-256"));
+  auto twice = two_files();
+  twice.files[1].path = twice.files[0].path;
+  CHECK_THAT(protocol::package_problem(twice).value(), Contains("twice"));
+  auto file_and_folder = two_files();
+  file_and_folder.files[1].path = file_and_folder.files[0].path + "/x";
+  CHECK_THAT(protocol::package_problem(file_and_folder).value(), Contains("a file and a folder"));
+  auto too_big = two_files();
+  too_big.files[1].size = protocol::kMaxPackageBytes;
+  CHECK(protocol::package_problem(too_big).has_value());
+  CHECK(protocol::package_problem({"/r", {}}).has_value());
+}
