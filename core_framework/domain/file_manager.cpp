@@ -22,12 +22,24 @@ using protocol::Status;
 
 namespace {
 
-constexpr int kMaxDependencyDepth = 8;       // as the planner's softpkg dependency check
-constexpr std::size_t kMaxHashesKept = 4096; // files whose hash is remembered, then forgotten
-constexpr std::size_t kLaunchesKept = 64;    // launches whose delivered bytes are remembered
+constexpr int kMaxDependencyDepth = 8;    // as the planner's softpkg dependency check
+constexpr std::size_t kMaxKept = 4096;    // files hashed and served that are remembered
+constexpr std::size_t kLaunchesKept = 64; // launches whose delivered bytes are remembered
 
 CallResult<void> fail(Status status, std::string message) {
   return protocol::call_error(status, std::move(message));
+}
+
+// Drops the least recently used entry of `map` once it holds more than kMaxKept.
+template <typename Map>
+void bound(Map &map) {
+  if (map.size() <= kMaxKept)
+    return;
+  auto oldest = map.begin();
+  for (auto it = map.begin(); it != map.end(); ++it)
+    if (it->second.last_use < oldest->second.last_use)
+      oldest = it;
+  map.erase(oldest);
 }
 
 bool is_executable_file(const fs::path &file) {
@@ -188,10 +200,10 @@ CallResult<protocol::PackageFile> FileManager::describe(const fs::path &file,
     sha256 = std::move(*hashed);
   }
   std::lock_guard lock(mutex_);
-  if (hashes_.size() >= kMaxHashesKept)
-    hashes_.clear();
-  hashes_[file] = {*stamp, sha256};
-  served_[sha256] = file;
+  hashes_[file] = {*stamp, sha256, ++uses_};
+  served_[sha256] = {file, *stamp, uses_};
+  bound(hashes_);
+  bound(served_);
   return protocol::PackageFile{path, sha256, stamp->size, is_executable_file(file)};
 }
 
@@ -211,9 +223,9 @@ FileManager::read(const protocol::file::ReadRequest &request) {
     if (it == served_.end())
       return protocol::call_error(Status::NotFound,
                                   fmt::format("no file {} in a package", request.sha256));
-    file = it->second;
-    if (auto h = hashes_.find(file); h != hashes_.end() && h->second.sha256 == request.sha256)
-      hashed_as = h->second.stamp;
+    it->second.last_use = ++uses_;
+    file = it->second.file;
+    hashed_as = it->second.stamp;
   }
   if (!hashed_as || profile::stamp_of(file) != hashed_as)
     return protocol::call_error(Status::Failed,

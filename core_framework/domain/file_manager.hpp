@@ -54,6 +54,12 @@ private:
   struct Hashed {
     profile::FileStamp stamp;
     std::string sha256;
+    std::uint64_t last_use = 0;
+  };
+  struct Served {
+    std::filesystem::path file;
+    profile::FileStamp stamp; // as it was hashed
+    std::uint64_t last_use = 0;
   };
   CallResult<void> add_softpkg(const profile::ResolvedSoftPkg &softpkg,
                                const profile::ResolvedImplementation &implementation, int depth,
@@ -71,11 +77,13 @@ private:
 
   std::filesystem::path repository_;
   std::vector<std::filesystem::path> exec_path_;
-  mutable std::mutex mutex_;                            // guards what follows
-  std::map<std::filesystem::path, Hashed> hashes_;      // by file
-  std::map<std::string, std::filesystem::path> served_; // by hash: the file put into a package
-  std::map<std::string, std::uint64_t> delivered_;      // by launch
-  std::deque<std::string> launches_;                    // of delivered_, oldest first
+  mutable std::mutex mutex_; // guards what follows
+  // Both bounded: past 4096 entries, the least recently used goes.
+  std::map<std::filesystem::path, Hashed> hashes_; // by file
+  std::map<std::string, Served> served_;           // by hash: the file put into a package
+  std::uint64_t uses_ = 0;
+  std::map<std::string, std::uint64_t> delivered_; // by launch
+  std::deque<std::string> launches_;               // of delivered_, oldest first
 };
 
 } // namespace rsca::domain

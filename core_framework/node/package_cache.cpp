@@ -51,12 +51,32 @@ bool alive(pid_t pid) {
   return pid > 0 && (::kill(pid, 0) == 0 || errno == EPERM);
 }
 
+// A package's folders are read-only (package_fetch.cpp): writable again first, as removing what
+// they hold needs.
 void remove_folder(const fs::path &folder) {
   std::error_code ec;
-  // Its files are read-only, not its folders: remove_all needs only the folders' write bit.
+  if (!fs::exists(folder, ec))
+    return;
+  fs::permissions(folder, fs::perms::owner_all, fs::perm_options::add, ec);
+  for (auto it = fs::recursive_directory_iterator(folder, ec); !ec && it != fs::end(it);
+       it.increment(ec))
+    if (it->is_directory(ec) && !it->is_symlink(ec))
+      fs::permissions(it->path(), fs::perms::owner_all, fs::perm_options::add, ec);
+  ec.clear();
   fs::remove_all(folder, ec);
   if (ec)
     spdlog::warn("package cache: cannot remove {}: {}", folder.string(), ec.message());
+}
+
+// Whether the files the manifest lists are there, with their sizes: a package a node crashed
+// while writing, or that someone changed, is not trusted.
+bool complete(const fs::path &root, const protocol::Package &manifest) {
+  std::error_code ec;
+  for (const auto &f : manifest.files)
+    if (profile::is_runtime_model_path(f.path) ? !fs::exists(root / f.path, ec)
+                                               : fs::file_size(root / f.path, ec) != f.size || ec)
+      return false;
+  return true;
 }
 
 } // namespace
@@ -98,11 +118,12 @@ class CachedPackage final : public PackageLease {
 public:
   CachedPackage(std::shared_ptr<PackageCache::State> state, std::string id)
       : state_(std::move(state)), id_(std::move(id)), root_(state_->root_of(id_)) {}
+  // Only counts: a package kept over the cache's size goes at the next acquire, not here on
+  // the thread that saw its process exit (the GPP's reaper, which must not block).
   ~CachedPackage() override {
     std::lock_guard lock(state_->mutex);
     if (auto it = state_->packages.find(id_); it != state_->packages.end() && it->second.leases > 0)
       --it->second.leases;
-    state_->evict_locked(); // one it kept over the limit may go now
   }
   const fs::path &root() const override { return root_; }
 
@@ -117,8 +138,9 @@ private:
 void PackageCache::State::load() {
   std::error_code ec;
   for (const auto &entry : fs::directory_iterator(incoming_dir(), ec)) {
+    // One of this pid is of an earlier node that had it (a container's node is often pid 1).
     const auto maker = maker_of(entry.path().filename().string());
-    if (!maker || !alive(*maker))
+    if (!maker || !alive(*maker) || *maker == ::getpid())
       remove_folder(entry.path());
   }
   for (const auto &entry : fs::directory_iterator(packages_dir(), ec)) {
@@ -126,8 +148,9 @@ void PackageCache::State::load() {
     std::ifstream in(manifests_dir() / (id + ".json"));
     const auto json = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
     auto manifest = protocol::decode<protocol::Package>(json);
-    if (json.is_discarded() || !manifest || package_id(*manifest) != id) {
-      spdlog::info("package cache: {} has no manifest; removed", id);
+    if (json.is_discarded() || !manifest || package_id(*manifest) != id ||
+        !complete(entry.path(), *manifest)) {
+      spdlog::info("package cache: {} has no manifest or lacks files; removed", id);
       remove_folder(entry.path());
       fs::remove(manifests_dir() / (id + ".json"), ec);
       continue;
@@ -219,8 +242,13 @@ CallResult<void> PackageCache::State::fetch_into_place(const std::string &id,
                                [this](const protocol::PackageFile &f) { return copy_of(f); }};
   auto fetched = detail::lay_out(context, package, folder);
   std::error_code ec;
-  if (fetched)
+  if (fetched) {
     fs::rename(folder, root_of(id), ec);
+    if (ec && fs::exists(root_of(id))) { // left by an eviction that could not remove it all
+      remove_folder(root_of(id));
+      fs::rename(folder, root_of(id), ec);
+    }
+  }
   if (!fetched || ec) {
     remove_folder(folder);
     if (fetched)
@@ -277,14 +305,25 @@ PackageCache::acquire(const protocol::Package &package, const std::string &launc
     it->second.last_use = ++s.uses;
     ++it->second.leases;
     ++s.counts.reused;
+    s.evict_locked(); // what leases ended since kept over the size
     return std::make_shared<CachedPackage>(state_, id);
   }
   s.fetching[id] = true;
+  // Whatever becomes of the fetch, even an exception, the callers waiting for it go on.
+  struct Fetched {
+    State &s;
+    const std::string &id;
+    std::unique_lock<std::mutex> &lock;
+    ~Fetched() {
+      if (!lock.owns_lock())
+        lock.lock();
+      s.fetching.erase(id);
+      s.fetched_cv.notify_all();
+    }
+  } done{s, id, lock};
   lock.unlock();
   auto fetched = s.fetch_into_place(id, package, launch);
   lock.lock();
-  s.fetching.erase(id);
-  s.fetched_cv.notify_all();
   if (!fetched)
     return tl::unexpected(fetched.error());
   s.add_locked(id, package);

@@ -136,7 +136,7 @@ CallResult<std::uint64_t> fetch_file(const FetchContext &context, const protocol
 }
 
 // A copy the cache has, linked when it still is what it was verified as (its size; its content is
-// read-only).
+// read-only) and has the mode this package gives it: a link shares its file's mode.
 bool link_copy(const FetchContext &context, const protocol::PackageFile &file,
                const fs::path &target) {
   if (!context.local_copy)
@@ -146,6 +146,10 @@ bool link_copy(const FetchContext &context, const protocol::PackageFile &file,
     return false;
   std::error_code ec;
   if (fs::file_size(*copy, ec) != file.size || ec)
+    return false;
+  const bool executable =
+      (fs::status(*copy, ec).permissions() & fs::perms::owner_exec) != fs::perms::none;
+  if (ec || executable != file.executable)
     return false;
   fs::create_hard_link(*copy, target, ec);
   return !ec;
@@ -193,6 +197,13 @@ CallResult<std::uint64_t> lay_out(const FetchContext &context, const protocol::P
       if (auto ok = profile::relocate_runtime_model(folder, file.path, package.origin); !ok)
         spdlog::warn("package {}: {}; its component reads its XML instead",
                      folder.filename().string(), ok.error().to_string());
+  // Its folders read-only too: a process runs inside its package, and must not change what
+  // other packages link to.
+  for (auto it = fs::recursive_directory_iterator(folder, ec); !ec && it != fs::end(it);
+       it.increment(ec))
+    if (it->is_directory(ec))
+      fs::permissions(it->path(), fs::perms(0555), fs::perm_options::replace, ec);
+  fs::permissions(folder, fs::perms(0555), fs::perm_options::replace, ec);
   return fetched;
 }
 

@@ -1,6 +1,8 @@
 #include "protocol/package.hpp"
 
 #include <algorithm>
+#include <set>
+#include <string_view>
 
 #include <fmt/format.h>
 
@@ -54,14 +56,16 @@ std::optional<std::string> package_problem(const Package &package) {
       return fmt::format("more than {} bytes", kMaxPackageBytes);
     bytes += f.size;
   }
-  // A file that is also a folder of another ("a" and "a/b") cannot be laid out.
-  for (std::size_t i = 1; i < package.files.size(); ++i) {
-    const auto &before = package.files[i - 1].path;
-    const auto &path = package.files[i].path;
-    if (path.size() > before.size() && path.compare(0, before.size(), before) == 0 &&
-        path[before.size()] == '/')
-      return fmt::format("{} is a file and a folder", before);
-  }
+  // A file that is also a folder of another ("a" and "a/b") cannot be laid out; in sorted order
+  // they need not be neighbours ("a", "a-x", "a/b").
+  std::set<std::string_view> paths;
+  for (const auto &f : package.files)
+    paths.insert(f.path);
+  for (const auto &f : package.files)
+    for (auto slash = f.path.find('/'); slash != std::string::npos;
+         slash = f.path.find('/', slash + 1))
+      if (paths.count(std::string_view(f.path).substr(0, slash)) != 0)
+        return fmt::format("{} is a file and a folder", f.path.substr(0, slash));
   return std::nullopt;
 }
 

@@ -154,6 +154,10 @@ GppDevice::execute(const protocol::node::ExecuteRequest &r,
     if (package)
       packages_[*pid] = std::move(package);
   }
+  // A process that exited before it was recorded above found nothing to report or release: what
+  // on_exit would have done is done now (whoever takes the records first does it, once).
+  if (auto status = launcher_.wait_for_exit(*pid, std::chrono::milliseconds(0)))
+    on_exit(*pid, *status);
   spdlog::info("{}: executed {} as pid {} (log {})", context_.id, request.program.string(), *pid,
                request.log_file.string());
   return protocol::node::ExecuteReply{*pid, request.log_file.string()};

@@ -143,8 +143,11 @@ class Domain:
     (docs/architecture.md). `env` is what other programs of the run must use to join the domain."""
 
     def __init__(self, rsca, nodes, sdrroot=None, env=None, domaind_args=None, cli_args=None,
-                 hosts=None, cli_host=None):
+                 hosts=None, cli_host=None, node_dcds=None):
         self.rsca = rsca
+        # The node daemons as (name, DCD) pairs, the k-th on hosts[k + 1] (with hosts); None:
+        # node1..N of the SDR root's dev/nodes.
+        self.node_dcds = node_dcds
         # With hosts (network namespaces, tools/hosts), the daemons are started by hand, the domain
         # daemon on hosts[0] and node i on hosts[i]; with cli_host, the CLI runs on that host and
         # over DDS (not through a node's socket).
@@ -214,12 +217,14 @@ class Domain:
                                 os.path.join(sdrroot, "dom/domain/DomainManager.dmd.xml"),
                                 "--repository", os.path.join(self.run_dir, "repository"),
                                 *(self.domaind_args or [])], host=self.hosts and self.hosts[0])
-        for i in range(1, self.nodes + 1):
-            self._spawn(f"node{i}", [
-                os.path.join(bin_dir, "rsca-noded"), "--dcd",
-                os.path.join(sdrroot, f"dev/nodes/node{i}/DeviceManager.dcd.xml"), "--log-dir",
+        dcds = self.node_dcds or [
+            (f"node{i}", os.path.join(sdrroot, f"dev/nodes/node{i}/DeviceManager.dcd.xml"))
+            for i in range(1, self.nodes + 1)]
+        for i, (name, dcd) in enumerate(dcds, start=1):
+            self._spawn(name, [
+                os.path.join(bin_dir, "rsca-noded"), "--dcd", dcd, "--log-dir",
                 os.path.join(self.run_dir, "logs"), "--exec-path", bin_dir,
-                "--control-socket", os.path.join(self.run_dir, f"node{i}.sock")],
+                "--control-socket", os.path.join(self.run_dir, f"{name}.sock")],
                 host=self.hosts and self.hosts[i])
         deadline = time.monotonic() + 60
         while time.monotonic() < deadline:

@@ -29,6 +29,11 @@ distance_to_wall). The prediction is sim::stop_tolerance with latency = the sens
 robot should rest no nearer than threshold - tolerance, give or take the noise (sigma 5 mm).
 Delay percentiles are taken as the DriveSystem takes them (sorted[n/2], sorted[n*99/100]).
 
+With --hosts (root; tools/hosts), as the paper ran it, across two network hosts: the robot (its
+node daemon for rsca, the robot process for tcp) on one, the controller (node1 running StopCrash,
+the controller process) on the other, the domain daemon on a third; DDS and TCP over the hosts'
+network interfaces. It prints `ratio rsca/tcp delay p50 = R` (issue 21's target: at most 1.2).
+
 Every process started is stopped at the end, also on failure.
 """
 import argparse
@@ -41,7 +46,7 @@ import subprocess
 import sys
 import time
 
-from local_domain import Domain, Processes
+from local_domain import Domain, NetHosts, Processes, on_host
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
@@ -112,15 +117,30 @@ def read_line(proc, timeout, what):
     return json.loads(line)
 
 
+# With --hosts: the network hosts' namespaces and addresses (tools/hosts: host i is 10.77.0.i),
+# the domain daemon on the first, the controller on the second, the robot on the third.
+DOMAIN_HOST, CONTROLLER_HOST, ROBOT_HOST = 0, 1, 2
+
+
+def host_address(index):
+    return f"10.77.0.{index + 1}"
+
+
 def run_tcp(args, runs, logs):
     exe = os.path.join(args.bin, "rsca-bench-rangestop-tcp")
+    hosts = args.net_hosts
+    address = host_address(CONTROLLER_HOST) if hosts else "127.0.0.1"
     with Processes() as procs:
-        controller = procs.start([exe, "--role", "controller", *common_args(args, runs)],
-                                 os.environ, os.path.join(logs, "tcp-controller.log"))
+        controller = procs.start(
+            on_host(hosts and hosts[CONTROLLER_HOST],
+                    [exe, "--role", "controller", "--address", address, *common_args(args, runs)]),
+            os.environ, os.path.join(logs, "tcp-controller.log"))
         port = read_line(controller, 10, "the TCP controller")["listening"]
-        robot = procs.start([exe, "--role", "robot", "--port", str(port),
-                             *common_args(args, runs)], os.environ,
-                            os.path.join(logs, "tcp-robot.log"))
+        robot = procs.start(
+            on_host(hosts and hosts[ROBOT_HOST],
+                    [exe, "--role", "robot", "--port", str(port), "--address", address,
+                     *common_args(args, runs)]),
+            os.environ, os.path.join(logs, "tcp-robot.log"))
         out, _ = robot.communicate(timeout=60 * runs + 30)
         if robot.returncode != 0:
             raise RuntimeError(f"{exe} --role robot failed ({robot.returncode}), "
@@ -133,11 +153,20 @@ class RobotDomain(Domain):
     """local_domain.Domain with the robot's node as well: `rsca domain up --nodes 1 --node DCD`
     (node1, a GPP, and the robot with its Robot, IRSensor and DriveSystem devices)."""
 
-    def __init__(self, rsca, dcd, sdrroot):
-        super().__init__(rsca, nodes=1, sdrroot=sdrroot, env={"RSCA_SDRROOT": sdrroot})
+    def __init__(self, rsca, dcd, sdrroot, hosts=None):
+        env = {"RSCA_SDRROOT": sdrroot}
+        node_dcds = None
+        if hosts:  # started by hand, each daemon on its host (CONTROLLER_HOST, ROBOT_HOST)
+            env["RSCA_DDS_INTERFACE"] = "eth0"
+            node_dcds = [("node1", os.path.join(sdrroot, "dev/nodes/node1/DeviceManager.dcd.xml")),
+                         ("robot", dcd)]
+        super().__init__(rsca, nodes=2 if hosts else 1, sdrroot=sdrroot, env=env, hosts=hosts,
+                         node_dcds=node_dcds)
         self.dcd = dcd
 
     def __enter__(self):
+        if self.hosts:
+            return super().__enter__()
         try:
             subprocess.run([self.rsca, *self._global(), "domain", "up", "--nodes",
                             str(self.nodes), "--node", self.dcd], env=self.env, check=True,
@@ -181,7 +210,7 @@ def run_rsca(args, runs, logs):
     # The drive toward the threshold at full speed.
     drive_s = max(0.0, (args.wall_distance - args.threshold) / args.speed)
     results = []
-    with RobotDomain(rsca, dcd, args.sdrroot) as domain:
+    with RobotDomain(rsca, dcd, args.sdrroot, hosts=args.net_hosts) as domain:
         try:
             domain.cli("configure", "robot:IRSensor_1", f"period_ms={args.period_ms}")
             domain.cli("install", os.path.join(args.sdrroot,
@@ -251,7 +280,24 @@ def main():
     parser.add_argument("--threshold", type=float, default=0.6)
     parser.add_argument("--period-ms", type=int, default=20)
     parser.add_argument("--wall-distance", type=float, default=2.0, help=argparse.SUPPRESS)
+    parser.add_argument("--hosts", action="store_true",
+                        help="robot and controller on two network hosts (root; tools/hosts)")
     args = parser.parse_args()
+    args.net_hosts = None
+    if args.hosts:
+        why = NetHosts.unavailable()
+        if why:
+            print(f"skipped: {why}")
+            with open(args.out, "w") as f:
+                json.dump({"skipped": why}, f)
+            return 0
+        with NetHosts(3) as net:
+            args.net_hosts = net.hosts
+            return experiment(args, parser)
+    return experiment(args, parser)
+
+
+def experiment(args, parser):
     args.sdrroot = os.path.abspath(args.sdrroot)
     runs = args.runs or (1 if args.quick else 20)
     ways = [w for w in args.ways.split(",") if w]
@@ -266,7 +312,8 @@ def main():
     started = time.time()
     results = {"settings": {"speed": args.speed, "threshold": args.threshold,
                             "period_ms": args.period_ms, "wall_distance": args.wall_distance,
-                            "runs": runs, "seeds": [1, runs]},
+                            "runs": runs, "seeds": [1, runs],
+                            "where": "two network hosts" if args.net_hosts else "one host"},
                "host": {"cpus": os.cpu_count(), "machine": platform.machine(),
                         "loadavg_before": os.getloadavg()},
                "ways": {}}
@@ -305,6 +352,14 @@ def main():
               f"{1000 * p['stop_tolerance_m']:.1f} mm ({1000 * p['braking_distance_m']:.1f} mm "
               f"braking): the robot should rest at or beyond {p['min_rest_distance_m']:.4f} m "
               f"from the wall, give or take the sensor's noise")
+    if "rsca" in results["ways"] and "tcp" in results["ways"]:
+        ratio = (results["ways"]["rsca"]["delay_us"]["p50"] /
+                 results["ways"]["tcp"]["delay_us"]["p50"])
+        results["ratio_rsca_tcp_p50"] = ratio
+        with open(args.out, "w") as f:
+            json.dump(results, f, indent=2)
+        where = "across hosts " if args.net_hosts else ""
+        print(f"\nratio {where}rsca/tcp delay p50 = {ratio:.2f}")
     if "rsca" in results["ways"]:
         print(f"rsca delay over {results['ways']['rsca']['delay_us']['samples']} commands "
               f"(all runs, DriveSystem); drive safety stops: "

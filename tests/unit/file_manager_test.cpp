@@ -9,6 +9,8 @@
 #include <algorithm>
 #include <fstream>
 
+#include <fmt/format.h>
+
 #include "content/base64.hpp"
 #include "content/sha256.hpp"
 #include "profile/runtime_model.hpp"
@@ -136,4 +138,27 @@ TEST_CASE("file manager: a file changed since it was put into a package is not s
   auto next = files.package_of({repo.producer()});
   REQUIRE(next.has_value());
   CHECK(file_named(*next, code->path)->sha256 == content::sha256_hex("a new build"));
+}
+
+TEST_CASE("file manager: past the files it remembers it forgets the least recently used, never "
+          "those of the package it just made",
+          "[package]") {
+  Repository repo;
+  domain::FileManager files(repo.root, {repo.bin});
+  // The code is a folder (as REDHAWK allows): 3000 files, then 3000 others, 6000 hashed in all.
+  auto fill = [&](char which) {
+    fs::remove_all(repo.bin / "rsca-producer");
+    for (int i = 0; i < 3000; ++i)
+      write(repo.bin / "rsca-producer" / fmt::format("f{}{}", which, i),
+            fmt::format("{}{}", which, i));
+  };
+  fill('a');
+  REQUIRE(files.package_of({repo.producer()}).has_value());
+  fill('b');
+  auto second = files.package_of({repo.producer()});
+  REQUIRE(second.has_value());
+  for (const auto &f : second->files) {
+    INFO(f.path);
+    REQUIRE(files.read({f.sha256, 0, 16, {}}).has_value());
+  }
 }

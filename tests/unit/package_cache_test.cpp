@@ -262,3 +262,19 @@ TEST_CASE("package cache: a node that starts again finds its packages, and remov
   REQUIRE(f.cache->acquire(package, "").has_value());
   CHECK(f.domain.bytes_read() == before);
 }
+
+TEST_CASE("package cache: the same bytes executable in one package and not in another keep each "
+          "package's mode",
+          "[package]") {
+  Fixture f;
+  f.open();
+  protocol::Package plain{"/srv/repo", {f.domain.add("apps/A/data.sh", "echo hi", false)}};
+  protocol::Package runnable{"/srv/repo", {f.domain.add("apps/B/run.sh", "echo hi", true)}};
+  auto a = f.cache->acquire(plain, "");
+  auto b = f.cache->acquire(runnable, "");
+  REQUIRE(a.has_value());
+  REQUIRE(b.has_value());
+  auto mode = [](const fs::path &p) { return fs::status(p).permissions() & fs::perms::owner_exec; };
+  CHECK(mode((*a)->root() / "apps/A/data.sh") == fs::perms::none);
+  CHECK(mode((*b)->root() / "apps/B/run.sh") != fs::perms::none);
+}

@@ -79,6 +79,10 @@ TEST_CASE("package: a path that could leave the package, a bad hash or a repeate
   auto file_and_folder = two_files();
   file_and_folder.files[1].path = file_and_folder.files[0].path + "/x";
   CHECK_THAT(protocol::package_problem(file_and_folder).value(), Contains("a file and a folder"));
+  // Not neighbours once sorted: '-' sorts before '/'.
+  protocol::Package apart{
+      "/r", {{"a", kHashA, 1, false}, {"a-x", kHashA, 1, false}, {"a/b", kHashB, 1, false}}};
+  CHECK_THAT(protocol::package_problem(apart).value(), Contains("a file and a folder"));
   auto too_big = two_files();
   too_big.files[1].size = protocol::kMaxPackageBytes;
   CHECK(protocol::package_problem(too_big).has_value());

@@ -1,9 +1,10 @@
 // rsca-bench-rangestop-tcp: the RangeStop experiment over plain TCP between two processes, the
 // second way of tests/bench/rangestop_bench.py. Loopback, TCP_NODELAY, POSIX sockets.
 //
-//   rsca-bench-rangestop-tcp --role controller [--port P]   listens on 127.0.0.1 (0: any port),
-//       prints {"listening": PORT}, serves one robot until it hangs up
-//   rsca-bench-rangestop-tcp --role robot --port P [--runs N ...]   the runs (JSON lines)
+//   rsca-bench-rangestop-tcp --role controller [--port P] [--address A]   listens on A (default
+//       127.0.0.1; port 0: any), prints {"listening": PORT}, serves one robot until it hangs up
+//   rsca-bench-rangestop-tcp --role robot --port P [--address A] [--runs N ...]   the runs (JSON
+//       lines); A: the controller's address (another network host's, for --hosts)
 //
 // The robot steps the world in real time, reads the range every period and sends it with its
 // timestamp and the run's number; the controller answers every reading with a command carrying
@@ -93,11 +94,14 @@ void no_delay(int fd) {
     die(kProgram, last_error("TCP_NODELAY"));
 }
 
-sockaddr_in loopback(std::uint16_t port) {
+// The controller's IPv4 address (loopback unless --address says otherwise).
+in_addr g_address{htonl(INADDR_LOOPBACK)};
+
+sockaddr_in controller_address(std::uint16_t port) {
   sockaddr_in address{};
   address.sin_family = AF_INET;
   address.sin_port = htons(port);
-  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  address.sin_addr = g_address;
   return address;
 }
 
@@ -108,7 +112,7 @@ int controller(const Settings &s, std::uint16_t port) {
     die(kProgram, last_error("socket"));
   const int one = 1;
   ::setsockopt(listener, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
-  auto address = loopback(port);
+  auto address = controller_address(port);
   if (::bind(listener, reinterpret_cast<sockaddr *>(&address), sizeof address) != 0)
     die(kProgram, last_error("bind"));
   if (::listen(listener, 1) != 0)
@@ -150,7 +154,7 @@ int connect_to(std::uint16_t port) {
     const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
     if (fd < 0)
       die(kProgram, last_error("socket"));
-    auto address = loopback(port);
+    auto address = controller_address(port);
     if (::connect(fd, reinterpret_cast<sockaddr *>(&address), sizeof address) == 0) {
       no_delay(fd);
       return fd;
@@ -252,11 +256,17 @@ int main(int argc, char **argv) {
   app.add_option("--role", role, "robot or controller")
       ->required()
       ->check(CLI::IsMember({"robot", "controller"}));
-  app.add_option("--port", port, "the controller's port on 127.0.0.1 (controller: 0 = any)");
+  app.add_option("--port", port, "the controller's port (controller: 0 = any)");
+  std::string address = "127.0.0.1";
+  app.add_option("--address", address, "the controller's IPv4 address")->capture_default_str();
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError &e) {
     return app.exit(e) == 0 ? 0 : 2;
+  }
+  if (::inet_pton(AF_INET, address.c_str(), &g_address) != 1) {
+    std::cerr << kProgram << ": --address " << address << " is not an IPv4 address\n";
+    return 2;
   }
   if (role == "controller")
     return controller(settings, port);
