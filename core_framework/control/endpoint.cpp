@@ -19,6 +19,7 @@
 #include "control/partition_writers.hpp"
 #include "control/worker_pool.hpp"
 #include "protocol/addresses.hpp"
+#include "protocol/codec.hpp"
 
 namespace rsca::control {
 
@@ -172,18 +173,52 @@ CallResult<Json> Endpoint::Impl::run_batch(const RequestContext &context, const 
   return Json{{"results", std::move(results)}};
 }
 
+namespace {
+
+// The reply's bytes (protocol::kPayloadField), taken out of its JSON to travel beside it.
+protocol::Bytes::container_type take_payload(CallResult<Json> &result) {
+  if (!result || !result->is_object())
+    return {};
+  auto it = result->find(protocol::kPayloadField);
+  if (it == result->end() || !it->is_binary())
+    return {};
+  auto bytes = std::move(it->get_binary());
+  result->erase(it);
+  return bytes;
+}
+
+// The reply's JSON text; one that cannot be text (a string that is not UTF-8) is a failure to
+// report, not an exception on a worker thread.
+std::string reply_text(CallResult<Json> &result) {
+  if (result) {
+    try {
+      return result->dump();
+    } catch (const Json::exception &e) {
+      result = call_error(Status::Failed, fmt::format("the reply cannot be sent: {}", e.what()));
+    }
+  }
+  return protocol::error_body(result.error());
+}
+
+} // namespace
+
 void Endpoint::Impl::serve(RequestContext context, Json body) {
   CallResult<Json> result =
       body.is_discarded() ? call_error(Status::BadRequest, "the request body is not valid JSON")
       : context.operation == kBatch ? run_batch(context, body)
                                     : served.dispatch(context, body);
-  const std::string reply_body = result ? result->dump() : protocol::error_body(result.error());
+  auto payload = take_payload(result);
+  const std::string reply_body = reply_text(result);
   const std::string error = result ? std::string() : result.error().message;
   rsca_ctl_Reply reply{};
   reply.id = const_cast<char *>(context.id.c_str());
   reply.status = static_cast<std::int32_t>(result ? Status::Ok : result.error().status);
   reply.error = const_cast<char *>(error.c_str());
   reply.body = const_cast<char *>(reply_body.c_str());
+  reply.payload._buffer = payload.data();
+  reply.payload._length = static_cast<std::uint32_t>(payload.size());
+  reply.payload._maximum = reply.payload._length;
+  reply.payload._release = false;
   auto writer =
       reply_ways->matched_writer(context.sender, Clock::now() + std::chrono::seconds(5), stopping);
   if (!writer) {
@@ -222,6 +257,9 @@ void Endpoint::Impl::take_replies() {
         continue;
       }
       Json body = parse_body(r->body);
+      if (r->payload._length > 0 && body.is_object())
+        body[protocol::kPayloadField] = Json::binary(protocol::Bytes::container_type(
+            r->payload._buffer, r->payload._buffer + r->payload._length));
       complete(str(r->id),
                body.is_discarded()
                    ? CallResult<Json>(call_error(Status::Failed, "the reply is not JSON"))

@@ -130,7 +130,12 @@ LinkWriter::LinkWriter(int fd, std::chrono::milliseconds timeout) : fd_(fd) {
 }
 
 tl::expected<void, std::string> LinkWriter::send(const link::Frame &frame) {
-  const std::string text = link::encode_frame(frame).dump();
+  std::string text;
+  try {
+    text = link::encode_frame(frame).dump();
+  } catch (const nlohmann::json::exception &e) { // a string that is not UTF-8
+    return tl::unexpected(fmt::format("a frame the link cannot carry: {}", e.what()));
+  }
   if (text.size() > link::kMaxLinkFrame)
     return tl::unexpected(fmt::format("a frame of {} bytes is over the link's limit of {}",
                                       text.size(), link::kMaxLinkFrame));

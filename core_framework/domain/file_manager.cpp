@@ -10,7 +10,6 @@
 
 #include <fmt/format.h>
 
-#include "content/base64.hpp"
 #include "content/sha256.hpp"
 #include "process/fd.hpp"
 #include "profile/runtime_model.hpp"
@@ -241,7 +240,7 @@ FileManager::read(const protocol::file::ReadRequest &request) {
     return protocol::call_error(Status::Failed,
                                 fmt::format("{}: {}", file.string(), std::strerror(errno)));
   const auto wanted = std::min<std::uint64_t>(request.length, hashed_as->size - request.offset);
-  std::string bytes(wanted, '\0');
+  protocol::Bytes::container_type bytes(wanted);
   std::size_t got = 0;
   while (got < wanted) {
     const ssize_t n = ::pread(fd.get(), bytes.data() + got, wanted - got,
@@ -254,7 +253,7 @@ FileManager::read(const protocol::file::ReadRequest &request) {
   }
   bytes.resize(got);
   count(request.launch, got);
-  return protocol::file::ReadReply{content::base64_encode(bytes), hashed_as->size};
+  return protocol::file::ReadReply{protocol::Bytes(std::move(bytes)), hashed_as->size};
 }
 
 void FileManager::count(const std::optional<std::string> &launch, std::uint64_t bytes) {

@@ -11,7 +11,6 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
-#include "content/base64.hpp"
 #include "content/sha256.hpp"
 #include "control/operation.hpp"
 #include "process/fd.hpp"
@@ -29,7 +28,7 @@ CallResult<void> failed(Status status, std::string message) {
   return protocol::call_error(status, std::move(message));
 }
 
-CallResult<void> write_all(int fd, const std::string &bytes, const std::string &path) {
+CallResult<void> write_all(int fd, const protocol::Bytes &bytes, const std::string &path) {
   std::size_t done = 0;
   while (done < bytes.size()) {
     const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
@@ -89,16 +88,15 @@ private:
       return failed(Status::Failed,
                     fmt::format("{}: the domain's file has {} bytes, the package says {}",
                                 file_.path, piece->size, file_.size));
-    auto bytes = content::base64_decode(piece->data);
-    if (!bytes)
-      return cut_off(written, "a piece that is not base64");
-    if (bytes->size() != expected)
+    const protocol::Bytes none;
+    const auto &bytes = piece->payload ? *piece->payload : none;
+    if (bytes.size() != expected)
       return cut_off(written,
-                     fmt::format("{} bytes where {} were asked for", bytes->size(), expected));
-    if (auto ok = write_all(fd_, *bytes, file_.path); !ok)
+                     fmt::format("{} bytes where {} were asked for", bytes.size(), expected));
+    if (auto ok = write_all(fd_, bytes, file_.path); !ok)
       return ok;
-    hash_.update(bytes->data(), bytes->size());
-    written += bytes->size();
+    hash_.update(bytes.data(), bytes.size());
+    written += bytes.size();
     return {};
   }
 

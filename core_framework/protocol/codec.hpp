@@ -12,8 +12,12 @@
 // into the struct and refuses, with a message naming the field, a missing required field, a
 // value of the wrong type or out of range, and a field the message does not have: a request from
 // the network is untrusted, and a typo in a field name is a bug to see, not a value to ignore.
-// Field types: bool, integers, double, std::string, Json (free-form), enums with an EnumNames
-// table, nested messages, and std::vector, std::optional and std::map<std::string, T> of them.
+// Field types: bool, integers, double, std::string, Json (free-form), Bytes, enums with an
+// EnumNames table, nested messages, and std::vector, std::optional and std::map<std::string, T>
+// of them.
+//
+// Bytes are a JSON binary value: never text. The one field of a reply named kPayloadField may
+// hold them; the control plane carries it beside the reply's JSON (control.idl, Reply.payload).
 #pragma once
 
 #include <cstdint>
@@ -34,6 +38,10 @@
 namespace rsca::protocol {
 
 using Json = nlohmann::json;
+using Bytes = Json::binary_t;
+
+// The member of a reply whose bytes travel beside its JSON (see above).
+inline constexpr const char *kPayloadField = "payload";
 
 // What was wrong with a message, and where: path "connections[2].port", what "expected a
 // string, found number".
@@ -203,6 +211,8 @@ template <typename T>
 Json encode(const T &value) {
   if constexpr (MessageType<T>) {
     return encode_message(value);
+  } else if constexpr (std::is_same_v<T, Bytes>) {
+    return Json::binary(static_cast<const Bytes::container_type &>(value));
   } else if constexpr (NamedEnum<T>) {
     return std::string(enum_name(value));
   } else if constexpr (detail::IsOptional<T>::value) {
@@ -228,6 +238,11 @@ DecodeResult decode_into(const Json &json, T &out) {
     return decode_message(json, out);
   } else if constexpr (std::is_same_v<T, Json>) {
     out = json;
+    return {};
+  } else if constexpr (std::is_same_v<T, Bytes>) {
+    if (!json.is_binary())
+      return detail::wrong(json, "bytes");
+    out = json.get_binary();
     return {};
   } else if constexpr (std::is_same_v<T, bool>) {
     if (!json.is_boolean())

@@ -12,8 +12,8 @@
 
 namespace rsca::protocol::file {
 
-// At most this much of a file travels in one reply (a DDS sample of about 1.4 times that once
-// encoded); a node asks for several pieces at once.
+// At most this much of a file travels in one reply (one DDS sample, fragmented by Cyclone); a
+// node asks for several pieces at once.
 inline constexpr std::uint64_t kMaxReadBytes = 1ULL << 20U;
 inline constexpr std::size_t kMaxLaunchLength = 256; // of ReadRequest::launch
 
@@ -30,10 +30,13 @@ struct ReadRequest {
 };
 
 struct ReadReply {
-  std::string data;       // base64 of the bytes from offset: `length` of them, fewer at the end
+  // The bytes from offset: `length` of them, fewer at the end. They travel beside the reply's
+  // JSON (codec.hpp, kPayloadField), absent when there are none.
+  std::optional<Bytes> payload;
   std::uint64_t size = 0; // the whole file's
   static constexpr auto fields() {
-    return std::tuple{required("data", &ReadReply::data), required("size", &ReadReply::size)};
+    return std::tuple{optional(kPayloadField, &ReadReply::payload),
+                      required("size", &ReadReply::size)};
   }
 };
 

@@ -16,6 +16,7 @@
 #include <fmt/format.h>
 
 #include "control/endpoint.hpp"
+#include "protocol/codec.hpp"
 #include "test_domain.hpp"
 #include "writers_into.hpp"
 
@@ -94,6 +95,36 @@ TEST_CASE("a call reaches the addressed endpoint and its reply comes back", "[co
   CHECK(reply->at("sum") == 42);
   CHECK(reply->at("from") == "test/client");
   CHECK(other_calls == 0); // partitions keep requests to their addressee
+}
+
+TEST_CASE(
+    "a reply's bytes travel beside its JSON, whole, and a reply that cannot be text fails the "
+    "call, not the endpoint",
+    "[control]") {
+  auto pp = test::participant();
+  auto server = open(pp, "test/server");
+  protocol::Bytes::container_type bytes(3 * 1024 * 1024 + 7);
+  for (std::size_t i = 0; i < bytes.size(); ++i)
+    bytes[i] = static_cast<std::uint8_t>(i * 131 + (i >> 9));
+  server->on("read",
+             [&](const Json &, const control::RequestContext &) -> control::CallResult<Json> {
+               return Json{{"size", bytes.size()}, {protocol::kPayloadField, Json::binary(bytes)}};
+             });
+  server->on("nested",
+             [&](const Json &, const control::RequestContext &) -> control::CallResult<Json> {
+               return Json{{"name", std::string("\xff\xfe not UTF-8")}};
+             });
+  auto client = open(pp, "test/client");
+  auto reply = client->call_sync("test/server", "read", Json::object(), 10s);
+  REQUIRE(reply.has_value());
+  CHECK(reply->at("size") == bytes.size());
+  REQUIRE(reply->at(protocol::kPayloadField).is_binary());
+  const protocol::Bytes::container_type &got = reply->at(protocol::kPayloadField).get_binary();
+  CHECK(got == bytes);
+  auto nested = client->call_sync("test/server", "nested", Json::object(), 5s);
+  REQUIRE_FALSE(nested.has_value());
+  CHECK(nested.error().status == Status::Failed);
+  CHECK(client->call_sync("test/server", "read", Json::object(), 10s).has_value());
 }
 
 TEST_CASE("errors travel back with their status", "[control]") {

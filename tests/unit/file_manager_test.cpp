@@ -11,7 +11,6 @@
 
 #include <fmt/format.h>
 
-#include "content/base64.hpp"
 #include "content/sha256.hpp"
 #include "profile/runtime_model.hpp"
 #include "temp_dir.hpp"
@@ -106,7 +105,8 @@ TEST_CASE("file manager: file.read serves the files of packages by hash, in boun
     auto piece = files.read({code->sha256, offset, protocol::file::kMaxReadBytes, "L1"});
     REQUIRE(piece.has_value());
     CHECK(piece->size == code->size);
-    whole += content::base64_decode(piece->data).value();
+    REQUIRE(piece->payload.has_value());
+    whole.append(piece->payload->begin(), piece->payload->end());
   }
   CHECK(content::sha256_hex(whole) == code->sha256);
   CHECK(files.delivered("L1") == code->size);

@@ -12,7 +12,6 @@
 #include <mutex>
 #include <thread>
 
-#include "content/base64.hpp"
 #include "content/sha256.hpp"
 #include "protocol/codec.hpp"
 #include "temp_dir.hpp"
@@ -66,7 +65,8 @@ private:
     if (fault_ == Fault::ShortPiece && !piece.empty())
       piece.pop_back();
     bytes_read_ += piece.size();
-    return protocol::encode(protocol::file::ReadReply{content::base64_encode(piece), size});
+    return protocol::encode(protocol::file::ReadReply{
+        protocol::Bytes(protocol::Bytes::container_type(piece.begin(), piece.end())), size});
   }
 
   std::mutex mutex_;

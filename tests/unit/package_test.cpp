@@ -1,6 +1,5 @@
 // What the domain and a node agree a package is (protocol/package.hpp), and the content hashes
-// and base64 it travels with (content/): a node takes no path or hash from the network on trust.
-#include "content/base64.hpp"
+// that name its files (content/): a node takes no path or hash from the network on trust.
 #include "content/sha256.hpp"
 #include "protocol/package.hpp"
 
@@ -40,17 +39,6 @@ TEST_CASE("content: SHA-256 of bytes and of a file is the standard one", "[packa
   CHECK(content::is_sha256_hex(kHashA));
   CHECK_FALSE(content::is_sha256_hex(std::string(64, 'A')));
   CHECK_FALSE(content::is_sha256_hex("abc"));
-}
-
-TEST_CASE("content: base64 round-trips any bytes and refuses what is not base64", "[package]") {
-  std::string bytes;
-  for (int i = 0; i < 1000; ++i)
-    bytes.push_back(static_cast<char>(i * 7));
-  for (std::size_t n : {0, 1, 2, 3, 4, 999, 1000})
-    CHECK(content::base64_decode(content::base64_encode(bytes.substr(0, n))) == bytes.substr(0, n));
-  CHECK(content::base64_encode("ab") == "YWI=");
-  CHECK_FALSE(content::base64_decode("YWI").has_value());  // not a multiple of 4
-  CHECK_FALSE(content::base64_decode("Y!I=").has_value()); // not the alphabet
 }
 
 TEST_CASE("package: a well-formed package passes, sorted by path", "[package]") {
