@@ -6,6 +6,7 @@
 #include <cerrno>
 #include <string_view>
 #include <system_error>
+#include <thread>
 
 #include <fcntl.h>
 #include <poll.h>
@@ -260,6 +261,15 @@ Expected<pid_t> start(const Command &command, Group group, int log_fd) {
   pid_t pid = 0;
   rc = ::posix_spawn(&pid, command.program.c_str(), actions.get(), attributes.get(), argv.data(),
                      envp.data());
+  // ETXTBSY: a file this process has just written (a node's package) is still open for writing
+  // in a child another thread cloned while it was being written, until that child closes its
+  // descriptors on its way to exec: a few milliseconds at most on a loaded host. Seen in CI: two
+  // packages fetched at once, one executed while the other's child was starting.
+  for (int delay_ms = 1; rc == ETXTBSY && delay_ms <= 64; delay_ms *= 2) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(delay_ms));
+    rc = ::posix_spawn(&pid, command.program.c_str(), actions.get(), attributes.get(), argv.data(),
+                       envp.data());
+  }
   if (rc != 0) {
     return spawn_error(
         command, fmt::format("cannot execute {}: {}", command.program.string(), errno_text(rc)));
