@@ -14,7 +14,7 @@ import statistics
 import sys
 import json
 
-from local_domain import Domain, NetHosts, bench_arguments, summary
+from local_domain import Domain, NetHosts, bench_arguments, skipped_without_hosts, summary
 
 SAD = "dom/waveforms/ProducerConsumer/ProducerConsumer.sad.xml"
 
@@ -35,10 +35,7 @@ def launches(domain, runs):
 
 def main():
     args = bench_arguments(__doc__).parse_args()
-    why = NetHosts.unavailable()
-    if why:
-        print(f"skipped: {why}")
-        json.dump({"skipped": why}, open(args.out, "w"))
+    if skipped_without_hosts(args.out):
         return
     runs = 5 if args.quick else 20
     rsca = os.path.join(args.bin, "rsca")

@@ -131,6 +131,17 @@ class NetHosts:
         subprocess.run([self.TOOL, "down", self.name], capture_output=True)
 
 
+def skipped_without_hosts(out_path):
+    """True, having said why and written it as the results, when network hosts cannot be made."""
+    why = NetHosts.unavailable()
+    if not why:
+        return False
+    print(f"skipped: {why}")
+    with open(out_path, "w") as f:
+        json.dump({"skipped": why}, f)
+    return True
+
+
 def on_host(host, args):
     """`args` run on network host `host` (a namespace of NetHosts), or here when None."""
     return ["ip", "netns", "exec", host, *args] if host else list(args)

@@ -46,7 +46,7 @@ import shutil
 import sys
 import tempfile
 
-from local_domain import Domain, NetHosts
+from local_domain import Domain, NetHosts, skipped_without_hosts
 from port_bench_fanout import Schedule, analyse_fanout, fanout_raw, fanout_rsca
 from port_bench_helpers import (FANOUT_LEASE_MS, SDRROOT, SIDES, LatencyIceoryx, LatencyRaw,
                                 LatencyRsca, busy_note, host_state, latency_stats, lease_env, ratio,
@@ -64,11 +64,7 @@ def bench_latency_hosts(args):
     """Round trips between two network hosts (tools/hosts): BenchPing_1 and BenchEcho_1 on node1
     and node2, each node on a host of its own, through the nodes and with direct DDS; the raw
     DDS ping on node1's host and its echo on node2's, the baseline (issue 21)."""
-    why = NetHosts.unavailable()
-    if why:
-        print(f"skipped: {why}")
-        with open(args.out, "w") as f:
-            json.dump({"skipped": why}, f)
+    if skipped_without_hosts(args.out):
         return 0
     sides_hosts = ("rsca", "rsca_direct", "raw")
     orders = [sides_hosts[i:] + sides_hosts[:i] for i in range(len(sides_hosts))]

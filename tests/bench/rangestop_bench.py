@@ -46,7 +46,7 @@ import subprocess
 import sys
 import time
 
-from local_domain import Domain, NetHosts, Processes, on_host
+from local_domain import Domain, NetHosts, Processes, on_host, skipped_without_hosts
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
@@ -285,11 +285,7 @@ def main():
     args = parser.parse_args()
     args.net_hosts = None
     if args.hosts:
-        why = NetHosts.unavailable()
-        if why:
-            print(f"skipped: {why}")
-            with open(args.out, "w") as f:
-                json.dump({"skipped": why}, f)
+        if skipped_without_hosts(args.out):
             return 0
         with NetHosts(3) as net:
             args.net_hosts = net.hosts
