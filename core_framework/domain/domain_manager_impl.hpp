@@ -126,6 +126,7 @@ struct DomainManager::Impl {
   void node_alive(const control::AnnouncementEvent &event);
   // A node withdrawn (it stopped) or lost (its lease ran out: dead, or cut off).
   void node_gone(const std::string &address, bool withdrawn);
+  void end_earlier_run(const std::string &address, const protocol::node::NodeAnnouncement &now);
   void mark_unreachable(const std::string &node, const std::string &why);
   void node_back(const std::string &node, std::uint64_t epoch);
   std::uint64_t node_epoch(const std::string &node);

@@ -57,6 +57,7 @@ void DomainManager::Impl::node_alive(const control::AnnouncementEvent &event) {
   }
   const std::string node = announced->node;
   const auto devices = announced->devices.size();
+  end_earlier_run(event.address, *announced);
   const auto lost = nodes.take_lost(node);
   const bool restarted = lost && !same_run(lost->announcement, *announced);
   if (restarted)
@@ -80,6 +81,22 @@ void DomainManager::Impl::node_alive(const control::AnnouncementEvent &event) {
   events->publish("node.added", {{"node", node}, {"devices", ids}, {"back", lost.has_value()}});
   if (lost)
     node_returns->post([this, node, epoch = node_epoch(node)] { node_back(node, epoch); });
+}
+
+// A node that restarted within its lease announces its new run while its last one is still known
+// alive: no loss was seen. The last run's processes died with it (each checks that its node is
+// still its parent), so that run is taken as stopped before the new one registers.
+void DomainManager::Impl::end_earlier_run(const std::string &address,
+                                          const protocol::node::NodeAnnouncement &now) {
+  for (const auto &known : nodes.snapshot()) {
+    if (known.address != address || same_run(known.announcement, now))
+      continue;
+    spdlog::warn("node {} restarted (pid {} on {}, was {} on {}) before its last run was seen "
+                 "gone",
+                 now.node, now.pid, now.host, known.announcement.pid, known.announcement.host);
+    node_gone(address, /*withdrawn=*/true);
+    return;
+  }
 }
 
 void DomainManager::Impl::node_gone(const std::string &address, bool withdrawn) {

@@ -52,9 +52,10 @@ public:
   explicit TestDomain(int nodes = 2, int registration_timeout_ms = kRegistrationTimeoutMs)
       : TestDomain(shipped_nodes(nodes), registration_timeout_ms) {}
 
-  // One node daemon per DCD.
+  // One node daemon per DCD; `more_env` adds to every daemon's environment (RSCA_DDS_LEASE_MS).
   explicit TestDomain(const std::vector<fs::path> &dcds,
-                      int registration_timeout_ms = kRegistrationTimeoutMs)
+                      int registration_timeout_ms = kRegistrationTimeoutMs,
+                      const ChildProcess::Environment &more_env = {})
       : run_(fs::temp_directory_path() /
              fmt::format("rsca-it-{}-{}", getpid(), std::random_device{}())) {
     fs::create_directories(run_ / "logs");
@@ -62,6 +63,7 @@ public:
     env_ = {{"RSCA_DDS_DOMAIN", std::to_string(rsca::test::isolated_domain_id())},
             {"RSCA_DDS_TAG", rsca::test::isolated_tag()},
             {"RSCA_RUN_DIR", run_.string()}};
+    env_.insert(env_.end(), more_env.begin(), more_env.end());
     start_domaind(registration_timeout_ms);
     for (const auto &dcd : dcds)
       launch_node(dcd);
@@ -284,6 +286,12 @@ public:
     nodes_[index - 1].reset();
   }
 
+  // Kills node `index` and starts it again at once, not waiting for the domain to see it go.
+  void restart_node_at_once(int index, const fs::path &dcd) {
+    kill_node(index);
+    nodes_[index - 1] = start_node_process(dcd, index);
+  }
+
   template <typename Predicate>
   static bool wait_for(Predicate done, std::chrono::milliseconds limit = 10s) {
     return wait_until(done, limit);
@@ -295,12 +303,16 @@ public:
 
 private:
   void launch_node(const fs::path &dcd) {
-    nodes_.push_back(std::make_unique<ChildProcess>(
+    nodes_.push_back(start_node_process(dcd, static_cast<int>(nodes_.size()) + 1));
+  }
+
+  std::unique_ptr<ChildProcess> start_node_process(const fs::path &dcd, int index) {
+    return std::make_unique<ChildProcess>(
         (kBin / "rsca-noded").string(),
         std::vector<std::string>{"--dcd", dcd.string(), "--log-dir", (run_ / "logs").string(),
                                  "--exec-path", kBin.string(), "--control-socket",
-                                 (run_ / fmt::format("node{}.sock", nodes_.size() + 1)).string()},
-        env_));
+                                 (run_ / fmt::format("node{}.sock", index)).string()},
+        env_);
   }
 
 public:

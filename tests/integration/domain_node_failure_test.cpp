@@ -259,3 +259,30 @@ TEST_CASE("a node daemon stopped after or while it ends a process exits cleanly,
   fs::remove(marker);
   fs::remove(marker.string() + ".ready");
 }
+
+TEST_CASE("a node daemon restarted within its lease is taken for a new run: its components are "
+          "exited, its devices fresh, and a release is clean",
+          "[integration][domain][failure]") {
+  // Leases of a minute: the new run announces itself long before the last one could be lost.
+  TestDomain domain(TestDomain::shipped_nodes(2), TestDomain::kRegistrationTimeoutMs,
+                    {{"RSCA_DDS_LEASE_MS", "60000"}});
+  const Json app = domain.create("Healthy");
+  const std::string node = app.at("components")[0].at("node");
+  const int index = node == "node1" ? 1 : 2;
+  int on_node = 0;
+  for (const auto &c : app.at("components"))
+    on_node += c.at("node") == node ? 1 : 0;
+  domain.restart_node_at_once(index, TestDomain::shipped_nodes(2)[index - 1]);
+  REQUIRE(TestDomain::wait_for([&] {
+    auto shown = domain.call("app.show", Json{{"app", "Healthy"}});
+    return shown && shown->at("exited").size() == static_cast<std::size_t>(on_node);
+  }));
+  auto shown = domain.call("app.show", Json{{"app", "Healthy"}});
+  REQUIRE(shown.has_value());
+  CHECK(shown->at("state") == "degraded");
+  for (const auto &c : shown->at("components"))
+    CHECK((c.at("state") == "exited") == (c.at("node") == node));
+  // The release frees what is left; require_clean checks nothing stays reserved anywhere.
+  REQUIRE(domain.call("app.release", Json{{"app", "Healthy"}}).has_value());
+  domain.require_clean(pids_of(app));
+}
