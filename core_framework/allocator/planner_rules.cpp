@@ -14,7 +14,7 @@
 namespace rsca::allocator::detail {
 
 constexpr double kEpsilon = 1e-9;
-constexpr int kMaxDependencyDepth = 32;
+constexpr int kMaxDependencyDepth = profile::kMaxSoftpkgDependencyDepth;
 
 // ---- static checks: whether an implementation can run on a device at all ----------------------
 

@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "common/own_folder.hpp"
 #include "component/in_process.hpp"
 #include "component/process.hpp"
 #include "component/runtime.hpp"
@@ -32,7 +33,7 @@ fs::path resolve_library(const fs::path &library, const fs::path &spd) {
   std::error_code ec;
   if (fs::exists(named, ec))
     return named;
-  const fs::path exe_dir = fs::read_symlink("/proc/self/exe", ec).parent_path();
+  const fs::path exe_dir = own_folder();
   for (const auto &candidate :
        {exe_dir / "../lib" / library.filename(), exe_dir / library.filename()})
     if (fs::exists(candidate, ec))

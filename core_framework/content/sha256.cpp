@@ -21,15 +21,6 @@ struct Sha256::Context {
   std::unique_ptr<EVP_MD_CTX, Free> md{EVP_MD_CTX_new()};
 };
 
-bool is_sha256_hex(std::string_view text) {
-  if (text.size() != kSha256HexLength)
-    return false;
-  for (char c : text)
-    if (!((c >= '0' && c <= '9') || (c >= 'a' && c <= 'f')))
-      return false;
-  return true;
-}
-
 Sha256::Sha256() : context_(std::make_unique<Context>()) {
   // Only allocation fails here; OpenSSL's default provider always has SHA-256.
   if (!context_->md || EVP_DigestInit_ex(context_->md.get(), EVP_sha256(), nullptr) != 1)

@@ -12,11 +12,6 @@
 
 namespace rsca::content {
 
-inline constexpr std::size_t kSha256HexLength = 64;
-
-// Whether `text` has the form of a SHA-256 in lowercase hex.
-bool is_sha256_hex(std::string_view text);
-
 // A hash computed piece by piece; final() ends it.
 class Sha256 {
 public:

@@ -21,7 +21,6 @@ using protocol::Status;
 
 namespace {
 
-constexpr int kMaxDependencyDepth = 8;    // as the planner's softpkg dependency check
 constexpr std::size_t kMaxKept = 4096;    // files hashed and served that are remembered
 constexpr std::size_t kLaunchesKept = 64; // launches whose delivered bytes are remembered
 
@@ -87,7 +86,7 @@ CallResult<void> FileManager::add_softpkg(const profile::ResolvedSoftPkg &softpk
                                           const profile::ResolvedImplementation &implementation,
                                           int depth,
                                           std::map<std::string, protocol::PackageFile> &files) {
-  if (depth > kMaxDependencyDepth)
+  if (depth > profile::kMaxSoftpkgDependencyDepth)
     return fail(Status::BadRequest, "softpkg dependencies nest too deep");
   for (const auto &source : softpkg.sources)
     if (auto ok = add_file(source.path, package_path(source.path), files); !ok)
@@ -208,7 +207,7 @@ CallResult<protocol::PackageFile> FileManager::describe(const fs::path &file,
 
 CallResult<protocol::file::ReadReply>
 FileManager::read(const protocol::file::ReadRequest &request) {
-  if (!content::is_sha256_hex(request.sha256))
+  if (!protocol::is_sha256_hex(request.sha256))
     return protocol::call_error(Status::BadRequest, "sha256: not a SHA-256 in lowercase hex");
   if (request.length > protocol::file::kMaxReadBytes)
     return protocol::call_error(

@@ -21,6 +21,10 @@ namespace rsca::profile {
 
 struct ResolvedSoftPkg;
 
+// How deep softpkg dependencies may nest: the planner matches them, the FileManager delivers them,
+// to the same depth.
+inline constexpr int kMaxSoftpkgDependencyDepth = 32;
+
 struct ResolvedDependency {
   std::shared_ptr<const ResolvedSoftPkg> softpkg;
   std::optional<std::string> implref;

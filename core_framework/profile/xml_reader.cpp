@@ -1,5 +1,7 @@
 #include "profile/xml_reader.hpp"
 
+#include "common/own_folder.hpp"
+
 #include <dlfcn.h>
 #include <malloc.h>
 
@@ -22,9 +24,8 @@ std::vector<fs::path> module_candidates() {
   if (const char *path = std::getenv("RSCA_XML_READER"); path != nullptr && *path != '\0')
     return {fs::path(path)};
   std::vector<fs::path> out;
-  std::error_code ec;
-  if (auto self = fs::read_symlink("/proc/self/exe", ec); !ec)
-    out.push_back(self.parent_path().parent_path() / "lib" / kModuleName);
+  if (auto bin = own_folder(); !bin.empty())
+    out.push_back(bin.parent_path() / "lib" / kModuleName);
   out.push_back(fs::path(RSCA_XML_READER_BUILD_DIR) / kModuleName);
   return out;
 }

@@ -8,15 +8,11 @@
 
 namespace rsca::protocol {
 
-namespace {
-
-bool lower_hex_sha256(const std::string &text) {
+bool is_sha256_hex(std::string_view text) {
   return text.size() == 64 && std::all_of(text.begin(), text.end(), [](char c) {
            return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f');
          });
 }
-
-} // namespace
 
 std::optional<std::string> package_path_problem(const std::string &path) {
   if (path.empty())
@@ -48,7 +44,7 @@ std::optional<std::string> package_problem(const Package &package) {
     const auto &f = package.files[i];
     if (auto why = package_path_problem(f.path))
       return fmt::format("file {}: {}", i, *why);
-    if (!lower_hex_sha256(f.sha256))
+    if (!is_sha256_hex(f.sha256))
       return fmt::format("{}: \"{}\" is not a SHA-256 in lowercase hex", f.path, f.sha256);
     if (i > 0 && !(package.files[i - 1].path < f.path))
       return fmt::format("{}: paths are not sorted, or one is there twice", f.path);

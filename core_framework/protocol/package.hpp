@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "protocol/codec.hpp"
@@ -44,6 +45,9 @@ struct Package {
 inline constexpr std::size_t kMaxPackageFiles = 4096;
 inline constexpr std::uint64_t kMaxPackageBytes = 16ULL << 30U; // 16 GiB
 inline constexpr std::size_t kMaxPackagePath = 1024;
+
+// Whether `text` has the form of a SHA-256 in lowercase hex (the hash is computed in content/).
+bool is_sha256_hex(std::string_view text);
 
 // Why `path` may not name a file in a package (absolute, empty, "..", ".", "//", too long, a NUL);
 // none when it may.

@@ -81,13 +81,29 @@ TEST_CASE("a component's files are delivered to its node once: verified, run fro
   CHECK(cache.at("fetched") == 2);
   CHECK(cache.at("reused") == 2);
 
-  auto again = domain.call("app.show", Json{{"app", "Again"}});
-  REQUIRE(again.has_value());
+  // On node2, whose cache is empty, the launch's progress counts what its node fetched.
+  auto on_node2 =
+      domain.call("app.create",
+                  Json{{"application", "ProducerConsumer"},
+                       {"name", "OnNode2"},
+                       {"launch_id", "delivery-test-node2"},
+                       {"assign", {{"Producer_1", "node2:GPP_1"}, {"Consumer_1", "node2:GPP_1"}}}});
+  INFO((on_node2 ? std::string() : on_node2.error().message));
+  REQUIRE(on_node2.has_value());
+  auto progress = domain.call("app.progress", Json{{"launch_id", "delivery-test-node2"}});
+  REQUIRE(progress.has_value());
+  CHECK(progress->value("delivered_bytes", std::uint64_t{0}) >=
+        fs::file_size(kBin / "rsca-producer") + fs::file_size(kBin / "rsca-consumer"));
+
   auto all = pids;
-  for (long pid : pids_of(*again))
-    all.push_back(pid);
-  REQUIRE(domain.call("app.release", Json{{"app", "ProducerConsumer"}}).has_value());
-  REQUIRE(domain.call("app.release", Json{{"app", "Again"}}).has_value());
+  for (const char *name : {"Again", "OnNode2"}) {
+    auto shown_app = domain.call("app.show", Json{{"app", name}});
+    REQUIRE(shown_app.has_value());
+    for (long pid : pids_of(*shown_app))
+      all.push_back(pid);
+  }
+  for (const char *name : {"ProducerConsumer", "Again", "OnNode2"})
+    REQUIRE(domain.call("app.release", Json{{"app", name}}).has_value());
   domain.require_clean(all);
 }
 

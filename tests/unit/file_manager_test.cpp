@@ -60,6 +60,11 @@ const protocol::PackageFile *file_named(const protocol::Package &p, const std::s
   return it == p.files.end() ? nullptr : &*it;
 }
 
+// The Producer's executable in its package.
+const protocol::PackageFile *code_of(const protocol::Package &p) {
+  return file_named(p, "applications/A/dom/components/Producer/rsca-producer");
+}
+
 } // namespace
 
 TEST_CASE("file manager: a component's package names its profiles, model and code in the "
@@ -98,7 +103,7 @@ TEST_CASE("file manager: file.read serves the files of packages by hash, in boun
   domain::FileManager files(repo.root, {repo.bin});
   auto package = files.package_of({repo.producer()});
   REQUIRE(package.has_value());
-  const auto *code = file_named(*package, "applications/A/dom/components/Producer/rsca-producer");
+  const auto *code = code_of(*package);
   REQUIRE(code != nullptr);
   std::string whole;
   for (std::uint64_t offset = 0; offset < code->size; offset += protocol::file::kMaxReadBytes) {
@@ -128,7 +133,7 @@ TEST_CASE("file manager: a file changed since it was put into a package is not s
   domain::FileManager files(repo.root, {repo.bin});
   auto package = files.package_of({repo.producer()});
   REQUIRE(package.has_value());
-  const auto *code = file_named(*package, "applications/A/dom/components/Producer/rsca-producer");
+  const auto *code = code_of(*package);
   REQUIRE(code != nullptr);
   write(repo.bin / "rsca-producer", "a new build");
   auto piece = files.read({code->sha256, 0, 10, {}});

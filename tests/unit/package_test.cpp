@@ -36,9 +36,9 @@ TEST_CASE("content: SHA-256 of bytes and of a file is the standard one", "[packa
   }
   CHECK(content::sha256_of_file(dir.path() / "f").value() == content::sha256_hex("abc"));
   CHECK_FALSE(content::sha256_of_file(dir.path() / "missing").has_value());
-  CHECK(content::is_sha256_hex(kHashA));
-  CHECK_FALSE(content::is_sha256_hex(std::string(64, 'A')));
-  CHECK_FALSE(content::is_sha256_hex("abc"));
+  CHECK(protocol::is_sha256_hex(kHashA));
+  CHECK_FALSE(protocol::is_sha256_hex(std::string(64, 'A')));
+  CHECK_FALSE(protocol::is_sha256_hex("abc"));
 }
 
 TEST_CASE("package: a well-formed package passes, sorted by path", "[package]") {

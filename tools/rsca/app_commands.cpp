@@ -144,14 +144,27 @@ private:
   struct sigaction previous_ {};
 };
 
-// Prints the launch steps the domain completed since the last call (`shown` of them were).
-void print_progress(const DomainClient &client, const std::string &launch_id, std::size_t &shown) {
+// What of a launch's progress the terminal has shown.
+struct Shown {
+  std::size_t steps = 0;
+  std::uint64_t delivered_bytes = 0; // files the nodes fetched, as last shown
+};
+
+// Prints the launch steps the domain completed since the last call, and the files its nodes
+// fetched while a step (execute) is under way, each megabyte more.
+void print_progress(const DomainClient &client, const std::string &launch_id, Shown &shown) {
   auto progress = client.call<app_ops::Progress>({launch_id}, 2s);
   if (!progress)
     return;
+  const auto delivered = progress->delivered_bytes.value_or(0);
+  if (!progress->done && delivered >= shown.delivered_bytes + 1'000'000) {
+    fmt::print("  ~ {:<10} {:>8.1f} MB of files delivered to the nodes so far\n", "execute",
+               static_cast<double>(delivered) / 1e6);
+    shown.delivered_bytes = delivered;
+  }
   const auto &steps = progress->steps;
-  for (; shown < steps.size(); ++shown) {
-    const auto &s = steps[shown];
+  for (; shown.steps < steps.size(); ++shown.steps) {
+    const auto &s = steps[shown.steps];
     const bool failed = s.detail == "failed";
     fmt::print("  {} {:<10} {:>8.1f} ms  {}\n", failed ? "x" : "+", s.step, s.ms,
                failed ? "" : s.detail);
@@ -183,7 +196,7 @@ control::CallResult<app_ops::CreateReply>
 await_launch(const DomainClient &client, const std::string &launch_id,
              std::future<control::CallResult<Json>> &launch, bool show_progress,
              const GlobalOptions &global) {
-  std::size_t shown = 0;
+  Shown shown;
   bool cancelling = false;
   for (;;) {
     const bool finished = launch.wait_for(50ms) == std::future_status::ready;
