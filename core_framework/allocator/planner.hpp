@@ -62,8 +62,18 @@ struct Affinity {
   double weight = 1; // heavier pairs win over the strategy
 };
 
+// What a host collocation asks of its host as a whole (REDHAWK 2.2's hostcollocation children).
+struct CollocationRequest {
+  std::string id; // as ComponentRequest::collocation names it
+  // A floor on the CPU its components are charged together, in cpu_capacity units (percent of
+  // one core): the members' own demand, topped up to this by the last member placed.
+  double cpu_reservation = 0;
+  std::vector<std::string> uses_devices; // SAD usesdevice ids whose devices must be on its host
+};
+
 struct PlanRequest {
   std::vector<ComponentRequest> components;
+  std::vector<CollocationRequest> collocations;
   std::vector<Affinity> affinities;
   std::vector<profile::UsesDevice> uses_devices; // the SAD's own usesdevice dependencies
   std::vector<profile::LatencyPath> latency_paths;

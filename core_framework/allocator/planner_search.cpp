@@ -43,6 +43,7 @@ public:
     if (auto unplaceable = find_candidates(); !unplaceable.empty())
       return tl::unexpected(std::move(unplaceable));
     order_components();
+    index_collocations();
     index_affinities();
     fair_share_ = fair_share();
     steps_.resize(order_.size());
@@ -108,6 +109,29 @@ private:
     order_.clear();
     for (const auto &[n, group, i] : keyed)
       order_.push_back(i);
+  }
+
+  // Each collocation's size and what it asks of its host as a whole.
+  void index_collocations() {
+    for (const auto &c : request_.components)
+      if (!c.collocation.empty())
+        ++group_size_[c.collocation];
+    for (const auto &g : request_.collocations)
+      group_request_[g.id] = &g;
+  }
+
+  // The CPU a collocation's last member is charged on top of its own demand, so that the group
+  // is charged its reservation at least; 0 for any other member.
+  double reservation_top_up(const ComponentRequest &c, double own_cpu) const {
+    const auto request = group_request_.find(c.collocation);
+    if (c.collocation.empty() || request == group_request_.end())
+      return 0;
+    const auto placed = group_placed_.find(c.collocation);
+    const std::size_t before = placed == group_placed_.end() ? 0 : placed->second.count;
+    if (before + 1 < group_size_.at(c.collocation))
+      return 0;
+    const double charged = (placed == group_placed_.end() ? 0.0 : placed->second.cpu) + own_cpu;
+    return std::max(0.0, request->second->cpu_reservation - charged);
   }
 
   // Each component's partners (affinities both ways), so that ranking costs its degree only.
@@ -205,6 +229,16 @@ private:
                task_of(c.instance, impl, c.timing),
                std::nullopt,
                {}}};
+    auto &cpu = step.placement.demand[kCpuCapacity];
+    if (const double top_up = reservation_top_up(c, cpu); top_up > 0) {
+      cpu += top_up;
+      if (auto why = capacity_shortfall(step.placement.demand, s))
+        return tl::unexpected(
+            fmt::format("hostcollocation {} reserves {:.4g} cores: {}", c.collocation,
+                        group_request_.at(c.collocation)->cpu_reservation / 100, *why));
+    }
+    if (cpu == 0)
+      step.placement.demand.erase(kCpuCapacity);
     if (auto why = capacity_shortfall(step.placement.demand, s))
       return tl::unexpected(*why);
     if (const auto &task = step.placement.task) {
@@ -309,6 +343,7 @@ private:
         const bool opens_group = !c.collocation.empty() && group_node_.count(c.collocation) == 0;
         if (opens_group)
           group_node_[c.collocation] = step->placement.node;
+        count_in_group(c, step->placement, +1);
         node_of_[c.instance] = step->placement.node;
         ++placed_on_[step->placement.device];
         apply(*step, +1);
@@ -318,6 +353,7 @@ private:
         apply(steps_[k], -1);
         node_of_.erase(c.instance);
         --placed_on_[steps_[k].placement.device];
+        count_in_group(c, steps_[k].placement, -1);
         if (opens_group)
           group_node_.erase(c.collocation);
         if (budget_exhausted_)
@@ -333,12 +369,45 @@ private:
     return false;
   }
 
+  void count_in_group(const ComponentRequest &c, const Placement &p, int sign) {
+    if (c.collocation.empty())
+      return;
+    auto &placed = group_placed_[c.collocation];
+    placed.count = static_cast<std::size_t>(static_cast<long>(placed.count) + sign);
+    const auto cpu = p.demand.find(kCpuCapacity);
+    placed.cpu += sign * (cpu == p.demand.end() ? 0.0 : cpu->second);
+  }
+
+  // Where the SAD's usesdevice `id` must be found: the node of a collocation that refers to it
+  // (usesdeviceref), "" for anywhere; nullopt when two such collocations are on different nodes.
+  std::optional<std::string> node_for_uses(const std::string &id) const {
+    std::string node;
+    for (const auto &g : request_.collocations) {
+      if (std::find(g.uses_devices.begin(), g.uses_devices.end(), id) == g.uses_devices.end())
+        continue;
+      const auto it = group_node_.find(g.id);
+      if (it == group_node_.end())
+        continue;
+      if (!node.empty() && node != it->second)
+        return std::nullopt;
+      node = it->second;
+    }
+    return node;
+  }
+
   // Every component is placed: the SAD's own usesdevice and the latency bounds decide.
   bool complete() {
     Reservations pending;
     std::vector<UsedDevice> used_devices;
     for (const auto &uses : request_.uses_devices) {
-      auto used = find_used_device(uses, "", pending);
+      const auto node = node_for_uses(uses.id);
+      if (!node) {
+        leaf_failure_ = fmt::format("usesdevice {}: host collocations that use its device are "
+                                    "on different nodes",
+                                    uses.id);
+        return false;
+      }
+      auto used = find_used_device(uses, *node, pending);
       if (!used) {
         leaf_failure_ = used.error();
         return false;
@@ -448,6 +517,13 @@ private:
   std::map<std::string, std::size_t> placed_on_; // device -> components of this plan on it
   std::size_t fair_share_ = 0;
   std::map<std::string, std::string> group_node_; // hostcollocation -> node
+  std::map<std::string, std::size_t> group_size_; // hostcollocation -> its components
+  std::map<std::string, const CollocationRequest *> group_request_;
+  struct GroupPlaced {
+    std::size_t count = 0;
+    double cpu = 0; // cpu_capacity charged to its members so far
+  };
+  std::map<std::string, GroupPlaced> group_placed_;
   std::vector<UsedDevice> application_devices_;
   std::size_t tries_ = 0;
   bool budget_exhausted_ = false;

@@ -98,6 +98,8 @@ DomainManager::Impl::install(const domain_ops::InstallRequest &request) {
   domain_ops::InstallReply reply{installed->name, {}};
   for (const auto &w : installed->profile->warnings)
     reply.warnings.push_back(to_string(w));
+  for (const auto &w : installed->profile->tolerated)
+    reply.warnings.push_back(to_string(w));
   return reply;
 }
 

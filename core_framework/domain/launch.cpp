@@ -53,6 +53,8 @@ CallResult<void> ApplicationFactory::Launch::check() {
       problems.push_back(to_string(w));
     return control::call_error(Status::BadRequest, fmt::format("{}", fmt::join(problems, "\n")));
   }
+  if (auto missing = missing_files(); !missing.empty())
+    return control::call_error(Status::BadRequest, fmt::format("{}", fmt::join(missing, "\n")));
   if (auto unsupported = unsupported_connections(); !unsupported.empty())
     return control::call_error(Status::BadRequest, fmt::format("{}", fmt::join(unsupported, "\n")));
   if (auto joined = s_.channels->join(channel_members()); !joined)
@@ -68,6 +70,22 @@ CallResult<void> ApplicationFactory::Launch::check() {
   return {};
 }
 
+// A profile may name files that are not there, as REDHAWK allows until they are needed: a
+// component whose package misses one is needed now, and cannot run.
+std::vector<std::string> ApplicationFactory::Launch::missing_files() const {
+  std::vector<std::string> out;
+  for (const auto &placement : request_.profile->sad->placements) {
+    const auto *pkg = request_.profile->softpkg_of(placement);
+    if (pkg == nullptr)
+      continue;
+    for (const auto &ci : placement.instantiations)
+      for (const auto &missing : pkg->unavailable)
+        out.push_back(
+            fmt::format("component {} cannot be launched: {}", ci.id, to_string(missing)));
+  }
+  return out;
+}
+
 std::vector<std::string> ApplicationFactory::Launch::unsupported_connections() const {
   using Kind = profile::EndpointTarget::Kind;
   std::vector<std::string> out;
@@ -80,6 +98,15 @@ std::vector<std::string> ApplicationFactory::Launch::unsupported_connections() c
         out.push_back(fmt::format("connection {}: only event channels can be found by findby; "
                                   "\"{}\" is not one",
                                   id, end->findby.name));
+      if (end->kind == Kind::DeviceUsedByApplication)
+        out.push_back(fmt::format("connection {}: a port of the device the application uses "
+                                  "(deviceusedbyapplication {}) cannot be connected yet",
+                                  id, end->usesrefid));
+      if (end->kind == Kind::ComponentInstantiation &&
+          sad.find_instantiation(end->refid) == nullptr)
+        out.push_back(fmt::format("connection {}: \"{}\" is no component of the application (a "
+                                  "DeviceManager, to REDHAWK): rsca cannot connect to it",
+                                  id, end->refid));
     }
     const auto is_device = [](const profile::EndpointTarget &t) {
       return t.kind == Kind::DeviceThatLoadedThisComponent ||
@@ -193,7 +220,7 @@ CallResult<void> ApplicationFactory::Launch::execute() {
   std::vector<protocol::node::ExecuteRequest> requests;
   std::vector<std::pair<std::string, std::string>> to; // per request: its node and its `what`
   std::vector<std::vector<std::size_t>> started_by;    // per request, the components it starts
-  std::map<std::string, std::size_t> host_of;          // by device: its host's request
+  std::map<std::string, std::size_t> host_of;          // by host address: its request
   std::map<std::size_t, protocol::HostParams> hosts;   // by request
   for (std::size_t i = 0; i < app_->components.size(); ++i) {
     const auto &c = app_->components[i];
@@ -206,7 +233,7 @@ CallResult<void> ApplicationFactory::Launch::execute() {
       started_by.push_back({i});
       continue;
     }
-    auto [host, fresh] = host_of.try_emplace(c.device, requests.size());
+    auto [host, fresh] = host_of.try_emplace(c.host, requests.size());
     if (fresh) {
       requests.push_back(host_request(c));
       to.emplace_back(*node, fmt::format("the component host on {}", c.device));
@@ -300,7 +327,8 @@ CallResult<void> ApplicationFactory::Launch::configure() {
       Json properties = Json::object();
       for (const auto &ref : ci.properties) {
         const auto *definition = pkg->find_property(profile::refid_of(ref));
-        if (definition == nullptr || is_execparam_only(*definition))
+        if (definition == nullptr || is_execparam_only(*definition) ||
+            profile::is_empty_override(*definition, ref))
           continue;
         auto value = profile::bind_property(*definition, ref);
         if (!value)
@@ -368,15 +396,32 @@ ApplicationFactory::Launch::execute_request(const ComponentInstance &c) const {
           in_package(spd_dir),
           protocol::to_args(exec_params(c)),
           std::nullopt,
-          std::nullopt};
+          std::nullopt,
+          affinity_of(c)};
 }
 
 protocol::node::ExecuteRequest
 ApplicationFactory::Launch::host_request(const ComponentInstance &first) const {
-  return {app_->name,   fmt::format("ComponentHost_{}", first.device),
-          first.device, "rsca-component-host",
-          "",           {},
-          std::nullopt, std::nullopt};
+  const auto affinity = affinity_of(first);
+  return {app_->name,
+          affinity ? fmt::format("ComponentHost_{}_{}", first.device, first.id)
+                   : fmt::format("ComponentHost_{}", first.device),
+          first.device,
+          "rsca-component-host",
+          "",
+          {},
+          std::nullopt,
+          std::nullopt,
+          affinity};
+}
+
+std::optional<protocol::node::AffinityDirective>
+ApplicationFactory::Launch::affinity_of(const ComponentInstance &c) const {
+  const auto *ci = instantiation_of(c.id);
+  if (ci == nullptr || !ci->affinity)
+    return std::nullopt;
+  return protocol::node::AffinityDirective{std::string(profile::to_string(ci->affinity->directive)),
+                                           ci->affinity->value};
 }
 
 std::vector<std::pair<std::string, std::string>>
@@ -387,10 +432,18 @@ ApplicationFactory::Launch::execparams(const ComponentInstance &c) const {
   const auto *pkg = request_.profile->softpkg_of(*placement);
   for (const auto &ref : ci->properties) {
     const auto *definition = pkg->find_property(profile::refid_of(ref));
-    if (definition == nullptr || !is_execparam_only(*definition))
+    if (definition == nullptr || !is_execparam_only(*definition) ||
+        profile::is_empty_override(*definition, ref))
       continue;
     if (auto value = profile::bind_property(*definition, ref))
       out.emplace_back(profile::refid_of(ref), profile::format_value(*value));
+  }
+  // REDHAWK's loggingconfig reaches the component as REDHAWK's GPP passes it.
+  if (const auto &logging = ci->logging) {
+    if (logging->debug_level)
+      out.emplace_back("DEBUG_LEVEL", std::to_string(*logging->debug_level));
+    if (!logging->uri.empty())
+      out.emplace_back("LOGGING_CONFIG_URI", logging->uri);
   }
   return out;
 }
@@ -435,8 +488,11 @@ void ApplicationFactory::Launch::build_components() {
     c.device = p.device;
     c.implementation = p.implementation->id;
     c.address = protocol::component_address(s_.domain_name, app_->name, launch_, p.instance);
+    // Hosted components share their device's host; one with an affinity has a host of its own,
+    // whose process the affinity is.
     if (p.implementation->code.type == profile::CodeType::SharedLibrary)
-      c.host = protocol::host_address(s_.domain_name, app_->name, launch_, p.device);
+      c.host = protocol::host_address(s_.domain_name, app_->name, launch_,
+                                      ci->affinity ? p.device + "." + ci->id : p.device);
     c.spd = request_.profile->softpkg_of(*placement)->spd_path.string();
     c.start_order = ci->start_order.value_or(UINT32_MAX);
     c.assembly_controller = sad.assembly_controller == ci->id;

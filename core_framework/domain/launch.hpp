@@ -43,6 +43,7 @@ private:
   CallResult<void> check();
 
   // Connections rsca cannot make yet, each named with why: refused here rather than left out.
+  std::vector<std::string> missing_files() const;
   std::vector<std::string> unsupported_connections() const;
 
   // This application's publishers and subscribers of event channels, by channel name.
@@ -108,6 +109,8 @@ private:
   static bool is_hosted(const ComponentInstance &c) { return !c.host.empty(); }
 
   protocol::node::ExecuteRequest execute_request(const ComponentInstance &c) const;
+  // The instance's affinity (SAD componentinstantiation/affinity), for the node to apply.
+  std::optional<protocol::node::AffinityDirective> affinity_of(const ComponentInstance &c) const;
   // Gives each request the package of the components it starts (started_by, by request); the
   // bytes they hold.
   CallResult<std::uint64_t>

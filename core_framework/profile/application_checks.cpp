@@ -15,16 +15,32 @@ std::string file_name(const std::filesystem::path &p) {
   return p.filename().string();
 }
 
-// Each override must name a property of the package and carry a value that fits it.
+// Each override must carry a value that fits its property; one that names no property of the
+// package is ignored with a warning, as REDHAWK does. A package whose files are missing is not
+// checked: its missing files are reported already.
 void check_property_refs(const ResolvedSoftPkg &pkg, const std::vector<PropertyRef> &refs,
-                         std::string_view owner, Error &errors) {
+                         std::string_view owner, Error &errors,
+                         std::vector<Diagnostic> &tolerated) {
+  if (!pkg.unavailable.empty())
+    return;
   for (const auto &ref : refs) {
     const PropertyDefinition *definition = pkg.find_property(refid_of(ref));
     if (definition == nullptr) {
-      errors.add({location_of(ref), "unknown-property",
-                  fmt::format("{}: property \"{}\" is not defined by {}", owner, refid_of(ref),
-                              pkg.properties ? file_name(pkg.properties->file)
-                                             : file_name(pkg.spd_path) + " (it has no PRF)")});
+      tolerated.push_back(
+          {location_of(ref), "unknown-property",
+           fmt::format("{}: property \"{}\" is not defined by {}: the override is ignored", owner,
+                       refid_of(ref),
+                       pkg.properties ? file_name(pkg.properties->file)
+                                      : file_name(pkg.spd_path) + " (it has no PRF)"),
+           Severity::Warning});
+      continue;
+    }
+    if (is_empty_override(*definition, ref)) {
+      tolerated.push_back({location_of(ref), "empty-value",
+                           fmt::format("{}: property \"{}\" is given an empty value: the override "
+                                       "is ignored, as REDHAWK does",
+                                       owner, refid_of(ref)),
+                           Severity::Warning});
       continue;
     }
     if (auto bound = bind_property(*definition, ref); !bound)
@@ -34,7 +50,9 @@ void check_property_refs(const ResolvedSoftPkg &pkg, const std::vector<PropertyR
 
 class ApplicationChecker {
 public:
-  ApplicationChecker(const ResolvedApplication &app, Error &errors) : app_(app), errors_(errors) {}
+  ApplicationChecker(const ResolvedApplication &app, Error &errors,
+                     std::vector<Diagnostic> &tolerated)
+      : app_(app), errors_(errors), tolerated_(tolerated) {}
 
   // Wiring problems: reported as warnings (see Severity).
   void warn(SourceLocation where, std::string rule, std::string message) {
@@ -46,7 +64,8 @@ public:
       for (const auto &ci : placement.instantiations)
         if (const ResolvedSoftPkg *pkg = app_.softpkg_of(placement))
           check_property_refs(*pkg, ci.properties,
-                              fmt::format("componentinstantiation \"{}\"", ci.id), errors_);
+                              fmt::format("componentinstantiation \"{}\"", ci.id), errors_,
+                              tolerated_);
     for (const auto &c : app_.sad->connections)
       check_connection(c);
     for (const auto &p : app_.sad->external_ports)
@@ -170,7 +189,7 @@ private:
     if (app_.sad->find_instantiation(p.component_ref, &placement) == nullptr)
       return;
     const ResolvedSoftPkg *pkg = app_.softpkg_of(*placement);
-    if (pkg != nullptr && pkg->find_property(p.property_id) == nullptr)
+    if (pkg != nullptr && pkg->unavailable.empty() && pkg->find_property(p.property_id) == nullptr)
       errors_.add({p.where, "unknown-property",
                    fmt::format("external property \"{}\": component \"{}\" has no property \"{}\"",
                                p.external_id, p.component_ref, p.property_id)});
@@ -178,17 +197,19 @@ private:
 
   const ResolvedApplication &app_;
   Error &errors_;
+  std::vector<Diagnostic> &tolerated_;
 };
 
 } // namespace
 
-std::vector<Diagnostic> check_application(const ResolvedApplication &app) {
+std::vector<Diagnostic> check_application(const ResolvedApplication &app,
+                                          std::vector<Diagnostic> &tolerated) {
   Error findings;
-  ApplicationChecker(app, findings).run();
+  ApplicationChecker(app, findings, tolerated).run();
   return findings.diagnostics();
 }
 
-std::vector<Diagnostic> check_node(const ResolvedNode &node) {
+std::vector<Diagnostic> check_node(const ResolvedNode &node, std::vector<Diagnostic> &tolerated) {
   Error errors;
   std::set<std::string> instance_ids;
   for (const auto &device : node.devices)
@@ -205,7 +226,7 @@ std::vector<Diagnostic> check_node(const ResolvedNode &node) {
       continue;
     for (const auto &ci : placement.instantiations) {
       check_property_refs(*device.softpkg, ci.properties, fmt::format("device \"{}\"", ci.id),
-                          errors);
+                          errors, tolerated);
     }
   }
   return errors.diagnostics();

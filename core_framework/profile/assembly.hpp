@@ -34,6 +34,30 @@ struct Timing {
   SourceLocation where;
 };
 
+// REDHAWK's affinity directive (affinity::exec_directive_class and _value): where the node lets
+// the process run. rsca adds "nice".
+struct ProcessorAffinity {
+  enum class Class : std::uint8_t {
+    Cpu,    // value: CPUs, as a list such as "0-3,6"
+    Socket, // value: NUMA nodes, as a list; the process runs on their CPUs
+    Nic,    // value: a network interface; the process runs on the CPUs that serve it
+    Nice,   // value: a nice value, -20 to 19
+  };
+  Class directive = Class::Cpu;
+  std::string value;
+  SourceLocation where;
+};
+std::string_view to_string(ProcessorAffinity::Class directive);
+
+// REDHAWK's loggingconfig: the initial log level of a component or device, and a logging
+// configuration URI (a log4cxx file for REDHAWK's runtimes; rsca's runtime logs with spdlog and
+// passes it on as LOGGING_CONFIG_URI without reading it).
+struct LoggingConfig {
+  std::optional<int> debug_level; // REDHAWK's DEBUG_LEVEL: 0 fatal ... 5 trace
+  std::string uri;
+  SourceLocation where;
+};
+
 struct ComponentInstantiation {
   std::string id;
   std::string usage_name;
@@ -42,6 +66,8 @@ struct ComponentInstantiation {
   std::vector<PropertyRef> device_requires; // SAD devicerequires / DCD deployerrequires
   std::string naming_service_name;          // findcomponent/namingservice, kept for REDHAWK
   std::optional<Timing> timing;
+  std::optional<ProcessorAffinity> affinity;
+  std::optional<LoggingConfig> logging;
   SourceLocation where;
 };
 
@@ -61,6 +87,12 @@ struct HostCollocation {
   std::string id;
   std::string name;
   SourceLocation where;
+  // REDHAWK 2.2: usesdevice ids of the SAD whose devices the collocation goes next to.
+  std::vector<std::string> uses_device_refs;
+  std::vector<SourceLocation> uses_device_ref_where;
+  // REDHAWK 2.2's reservation of kind cpucores: the collocation as a whole is charged at least
+  // that many cores on its host.
+  std::optional<double> cpu_cores;
 };
 
 // How a connection end finds its object.
@@ -77,11 +109,12 @@ struct EndpointTarget {
     ComponentInstantiation,
     DeviceThatLoadedThisComponent,
     DeviceUsedByThisComponent,
+    DeviceUsedByApplication, // SAD only: the device of one of the SAD's own usesdevice
     FindBy,
   };
   Kind kind = Kind::ComponentInstantiation;
   std::string refid;     // the component instantiation (for device refs: the component)
-  std::string usesrefid; // DeviceUsedByThisComponent: the usesdevice id
+  std::string usesrefid; // DeviceUsedBy*: the usesdevice id
   FindBy findby;
   SourceLocation where; // the reference element itself
 };

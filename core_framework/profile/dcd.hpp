@@ -1,6 +1,8 @@
 // DCD: one node — its DeviceManager, the devices it starts and their properties.
 #pragma once
 
+#include "common/diagnostic.hpp"
+
 #include <string>
 #include <vector>
 
@@ -17,7 +19,8 @@ struct DeviceConfiguration {
   std::vector<ComponentFile> component_files;
   std::vector<ComponentPlacement> placements;
   std::vector<Connection> connections;
-  std::string domain_manager; // REDHAWK's naming-service name; rsca finds the domain by DDS
+  std::string domain_manager;       // REDHAWK's naming-service name; rsca finds the domain by DDS
+  std::vector<Diagnostic> warnings; // what reading it tolerated (see detail::ReadContext::warn)
 
   const ComponentFile *find_component_file(std::string_view id) const;
 };

@@ -1,6 +1,8 @@
 // DMD: the domain — its name and its DomainManager package.
 #pragma once
 
+#include "common/diagnostic.hpp"
+
 #include <string>
 
 #include "profile/spd.hpp"
@@ -13,6 +15,7 @@ struct DomainManagerConfiguration {
   std::string name;
   std::string description;
   LocalFile domain_manager_softpkg;
+  std::vector<Diagnostic> warnings; // what reading it tolerated (see detail::ReadContext::warn)
 };
 
 } // namespace rsca::profile

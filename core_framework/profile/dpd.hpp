@@ -1,6 +1,8 @@
 // DPD: the hardware a device package drives.
 #pragma once
 
+#include "common/diagnostic.hpp"
+
 #include <optional>
 #include <string>
 #include <vector>
@@ -30,6 +32,7 @@ struct DevicePkg {
   std::vector<std::string> authors;
   std::string description;
   HardwareDevice hardware;
+  std::vector<Diagnostic> warnings; // what reading it tolerated (see detail::ReadContext::warn)
 };
 
 } // namespace rsca::profile

@@ -211,6 +211,10 @@ std::string_view to_string(Criticality v) {
   constexpr std::string_view names[] = {"low", "medium", "high", "safety"};
   return names[static_cast<std::size_t>(v)];
 }
+std::string_view to_string(ProcessorAffinity::Class v) {
+  constexpr std::string_view names[] = {"cpu", "socket", "nic", "nice"};
+  return names[static_cast<std::size_t>(v)];
+}
 std::string_view to_string(Reliability v) {
   return v == Reliability::Reliable ? "reliable" : "besteffort";
 }

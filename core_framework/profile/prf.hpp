@@ -108,6 +108,7 @@ std::optional<PropertyValue> default_value(const PropertyDefinition &property);
 struct Properties {
   std::string file;
   std::vector<PropertyDefinition> properties;
+  std::vector<Diagnostic> warnings; // what reading it tolerated (see detail::ReadContext::warn)
 
   const PropertyDefinition *find(std::string_view id) const;
 };

@@ -44,6 +44,47 @@ Error with_reference_note(Error error, const SourceLocation &referenced_at, cons
   return error;
 }
 
+// Whether a file could not be used only because it does not exist (what REDHAWK tolerates until
+// the file is needed).
+bool is_missing_file(const Error &error) {
+  const auto &d = error.diagnostics();
+  return d.size() == 1 && d.front().rule == "missing-file";
+}
+
+// The missing-file finding as the warning a package that names the file carries.
+Diagnostic unavailable_warning(const Error &missing) {
+  Diagnostic d = missing.diagnostics().front();
+  d.severity = Severity::Warning;
+  d.message += "; the package is read without it, but a component or device of it cannot run";
+  return d;
+}
+
+void append_unique(std::vector<Diagnostic> &to, const std::vector<Diagnostic> &from) {
+  for (const auto &d : from) {
+    const bool seen = std::any_of(to.begin(), to.end(), [&](const Diagnostic &t) {
+      return t.where.file == d.where.file && t.where.line == d.where.line &&
+             t.where.column == d.where.column && t.rule == d.rule && t.message == d.message;
+    });
+    if (!seen)
+      to.push_back(d);
+  }
+}
+
+// A package whose SPD does not exist: what a SAD or DCD that names it holds in its place. It
+// has no implementation and says why; whoever would run it refuses, naming the missing file.
+std::shared_ptr<const ResolvedSoftPkg> missing_softpkg(const fs::path &spd_path,
+                                                       const Error &missing) {
+  auto pkg = std::make_shared<ResolvedSoftPkg>();
+  pkg->spd_path = spd_path;
+  auto spd = std::make_shared<SoftPkg>();
+  spd->file = spd_path.string();
+  spd->name = spd_path.filename().string();
+  pkg->spd = std::move(spd);
+  pkg->unavailable.push_back(missing.diagnostics().front());
+  pkg->warnings.push_back(unavailable_warning(missing));
+  return pkg;
+}
+
 // Under which tree an SPD's absolute names resolve: the tree it lives in.
 SdrTree tree_of(const SdrRoot &root, const fs::path &file) {
   auto rel = file.lexically_relative(root.path());
@@ -212,28 +253,44 @@ ProfileLoader::softpkg(const fs::path &spd_file, const SourceLocation &reference
   resolved->sources.push_back(source_file(key));
   const SdrTree own_tree = tree_of(*root, key);
   auto file_of = [&](const LocalFile &f) { return root->resolve(f.name, key, own_tree); };
-  if (const auto &pf = (*spd)->property_file) {
-    auto prf = cached_source<Properties>(file_of(*pf), pf->where, resolved->sources);
-    prf ? void(resolved->properties = *prf) : errors.append(prf.error());
-  }
-  if (const auto &d = (*spd)->descriptor) {
-    auto scd = cached_source<SoftwareComponent>(file_of(*d), d->where, resolved->sources);
-    scd ? void(resolved->scd = *scd) : errors.append(scd.error());
-  }
+  append_unique(resolved->warnings, (*spd)->warnings);
+  // A part that is there is kept with its warnings; a missing one makes the package unavailable.
+  auto keep = [&](auto part, auto &into) {
+    if (part) {
+      into = *part;
+      append_unique(resolved->warnings, (*part)->warnings);
+    } else if (is_missing_file(part.error())) {
+      resolved->unavailable.push_back(part.error().diagnostics().front());
+      resolved->warnings.push_back(unavailable_warning(part.error()));
+    } else {
+      errors.append(part.error());
+    }
+  };
+  if (const auto &pf = (*spd)->property_file)
+    keep(cached_source<Properties>(file_of(*pf), pf->where, resolved->sources),
+         resolved->properties);
+  if (const auto &d = (*spd)->descriptor)
+    keep(cached_source<SoftwareComponent>(file_of(*d), d->where, resolved->sources), resolved->scd);
   for (const auto &impl : (*spd)->implementations) {
     ResolvedImplementation ri{&impl, nullptr, {}};
-    if (impl.property_file) {
-      auto prf = cached_source<Properties>(file_of(*impl.property_file), impl.property_file->where,
-                                           resolved->sources);
-      prf ? void(ri.properties = *prf) : errors.append(prf.error());
-    }
+    if (impl.property_file)
+      keep(cached_source<Properties>(file_of(*impl.property_file), impl.property_file->where,
+                                     resolved->sources),
+           ri.properties);
     for (const auto &ref : impl.softpkg_dependencies) {
       // Shared libraries live in dom/deps whichever tree the package is in, as in REDHAWK.
       auto dep = softpkg(root->resolve(ref.file.name, key, SdrTree::Dom), ref.file.where);
       if (!dep) {
-        errors.append(dep.error());
+        if (is_missing_file(dep.error())) {
+          resolved->unavailable.push_back(dep.error().diagnostics().front());
+          resolved->warnings.push_back(unavailable_warning(dep.error()));
+        } else {
+          errors.append(dep.error());
+        }
         continue;
       }
+      append_unique(resolved->warnings, (*dep)->warnings);
+      append_unique(resolved->unavailable, (*dep)->unavailable);
       if (ref.implref && (*dep)->spd->find_implementation(*ref.implref) == nullptr) {
         std::vector<std::string> ids;
         for (const auto &i : (*dep)->spd->implementations)
@@ -264,14 +321,24 @@ Expected<ResolvedApplication> ProfileLoader::load_application(const fs::path &sa
   auto sad = cached<SoftwareAssembly>(sad_file, {});
   if (!sad)
     return tl::unexpected(sad.error());
-  ResolvedApplication app{fs::absolute(sad_file).lexically_normal(), *sad, {}, {}};
+  ResolvedApplication app{fs::absolute(sad_file).lexically_normal(), *sad, {}, {}, {}};
   Error errors;
   for (const auto &cf : (*sad)->component_files) {
-    auto spd = softpkg(root->resolve(cf.file.name, app.sad_path, SdrTree::Dom), cf.file.where);
-    spd ? void(app.component_files.emplace(cf.id, *spd)) : errors.append(spd.error());
+    const fs::path spd_path = root->resolve(cf.file.name, app.sad_path, SdrTree::Dom);
+    auto spd = softpkg(spd_path, cf.file.where);
+    if (spd)
+      app.component_files.emplace(cf.id, *spd);
+    else if (is_missing_file(spd.error()))
+      app.component_files.emplace(cf.id, missing_softpkg(spd_path, spd.error()));
+    else
+      errors.append(spd.error());
   }
+  app.tolerated = (*sad)->warnings;
+  for (const auto &cf : (*sad)->component_files) // in the SAD's order
+    if (auto it = app.component_files.find(cf.id); it != app.component_files.end())
+      append_unique(app.tolerated, it->second->warnings);
   if (errors.empty())
-    app.warnings = split_findings(check_application(app), errors);
+    app.warnings = split_findings(check_application(app, app.tolerated), errors);
   if (!errors.empty())
     return tl::unexpected(errors);
   return app;
@@ -284,28 +351,44 @@ Expected<ResolvedNode> ProfileLoader::load_node(const fs::path &dcd_file) {
   auto dcd = cached<DeviceConfiguration>(dcd_file, {});
   if (!dcd)
     return tl::unexpected(dcd.error());
-  ResolvedNode node{fs::absolute(dcd_file).lexically_normal(), *dcd, {}, {}};
+  ResolvedNode node{fs::absolute(dcd_file).lexically_normal(), *dcd, {}, {}, (*dcd)->warnings};
   Error errors;
+  // rsca-noded is the DeviceManager: its SPD is checked when it is there, and nothing needs it.
   if (const auto &mgr = (*dcd)->device_manager_softpkg; !mgr.name.empty()) {
     auto spd = softpkg(root->resolve(mgr.name, node.dcd_path, SdrTree::Dev), mgr.where);
-    if (!spd)
+    if (!spd && is_missing_file(spd.error())) {
+      Diagnostic d = spd.error().diagnostics().front();
+      d.severity = Severity::Warning;
+      d.message += "; rsca-noded is the DeviceManager and does not need it";
+      node.tolerated.push_back(std::move(d));
+    } else if (!spd)
       errors.append(spd.error());
   }
   for (const auto &placement : (*dcd)->placements) {
     ResolvedDevicePlacement device{&placement, nullptr, nullptr};
     if (const ComponentFile *cf = (*dcd)->find_component_file(placement.componentfile_ref)) {
-      auto spd = softpkg(root->resolve(cf->file.name, node.dcd_path, SdrTree::Dev), cf->file.where);
-      spd ? void(device.softpkg = *spd) : errors.append(spd.error());
+      const fs::path spd_path = root->resolve(cf->file.name, node.dcd_path, SdrTree::Dev);
+      auto spd = softpkg(spd_path, cf->file.where);
+      if (spd)
+        device.softpkg = *spd;
+      else if (is_missing_file(spd.error()))
+        device.softpkg = missing_softpkg(spd_path, spd.error());
+      else
+        errors.append(spd.error());
     }
     if (placement.device_pkg_file) {
       const auto &f = *placement.device_pkg_file;
       auto dpd = cached<DevicePkg>(root->resolve(f.name, node.dcd_path, SdrTree::Dev), f.where);
       dpd ? void(device.device_pkg = *dpd) : errors.append(dpd.error());
+      if (dpd)
+        append_unique(node.tolerated, (*dpd)->warnings);
     }
+    if (device.softpkg)
+      append_unique(node.tolerated, device.softpkg->warnings);
     node.devices.push_back(std::move(device));
   }
   if (errors.empty())
-    node.warnings = split_findings(check_node(node), errors);
+    node.warnings = split_findings(check_node(node, node.tolerated), errors);
   if (!errors.empty())
     return tl::unexpected(errors);
   return node;
@@ -318,9 +401,10 @@ Expected<DomainManagerConfiguration> ProfileLoader::load_domain(const fs::path &
   auto dmd = cached<DomainManagerConfiguration>(dmd_file, {});
   if (!dmd)
     return tl::unexpected(dmd.error());
+  // rsca-domaind is the DomainManager: its SPD is checked when it is there, and nothing needs it.
   const auto &mgr = (*dmd)->domain_manager_softpkg;
   auto spd = softpkg(root->resolve(mgr.name, fs::absolute(dmd_file), SdrTree::Dom), mgr.where);
-  if (!spd)
+  if (!spd && !is_missing_file(spd.error()))
     return tl::unexpected(spd.error());
   return **dmd;
 }
@@ -329,23 +413,33 @@ Expected<ValidatedDescriptor> ProfileLoader::validate(const fs::path &file) {
   auto descriptor = cached_descriptor(file, {});
   if (!descriptor)
     return tl::unexpected(descriptor.error());
-  ValidatedDescriptor result{**descriptor, {}};
+  // Its own warnings first, then those of what it references.
+  ValidatedDescriptor result{**descriptor,
+                             std::visit([](const auto &d) { return d.warnings; }, **descriptor)};
   auto keep = [&](auto loaded, auto warnings_of) -> Expected<ValidatedDescriptor> {
     if (!loaded)
       return tl::unexpected(loaded.error());
-    result.warnings = warnings_of(*loaded);
+    append_unique(result.warnings, warnings_of(*loaded));
     return result;
   };
-  auto none = [](const auto &) { return std::vector<Diagnostic>{}; };
+  auto nothing_more = [](const auto &) { return std::vector<Diagnostic>{}; };
   switch (type_of(**descriptor)) {
   case DescriptorType::SAD:
-    return keep(load_application(file), [](const ResolvedApplication &a) { return a.warnings; });
+    return keep(load_application(file), [](const ResolvedApplication &a) {
+      auto all = a.warnings;
+      append_unique(all, a.tolerated);
+      return all;
+    });
   case DescriptorType::DCD:
-    return keep(load_node(file), [](const ResolvedNode &n) { return n.warnings; });
+    return keep(load_node(file), [](const ResolvedNode &n) {
+      auto all = n.warnings;
+      append_unique(all, n.tolerated);
+      return all;
+    });
   case DescriptorType::SPD:
-    return keep(load_softpkg(file), none);
+    return keep(load_softpkg(file), [](const auto &pkg) { return pkg->warnings; });
   case DescriptorType::DMD:
-    return keep(load_domain(file), none);
+    return keep(load_domain(file), nothing_more);
   case DescriptorType::SCD:
   case DescriptorType::PRF:
   case DescriptorType::DPD:

@@ -44,6 +44,12 @@ struct ResolvedSoftPkg {
   std::vector<ResolvedImplementation> implementations;
   // The files it was read from (its SPD, PRFs and SCD), each stamped before it was read.
   std::vector<SourceFile> sources;
+  // What reading it and its dependencies tolerated, unavailable files included.
+  std::vector<Diagnostic> warnings;
+  // Files it names that do not exist (a PRF, the SCD, a dependency): as in REDHAWK, the package
+  // reads and validates without them, but a component of it cannot be launched, nor a device
+  // of it started. Each is located where the file is named.
+  std::vector<Diagnostic> unavailable;
 
   // The definition of property `id` in the SPD's PRF or any implementation's PRF.
   const PropertyDefinition *find_property(std::string_view id) const;
@@ -54,6 +60,9 @@ struct ResolvedApplication {
   std::shared_ptr<const SoftwareAssembly> sad;
   std::map<std::string, std::shared_ptr<const ResolvedSoftPkg>> component_files; // by id
   std::vector<Diagnostic> warnings; // wiring findings; a launch treats them as errors
+  // What reading its files tolerated (REDHAWK forms read with a warning, files missing that the
+  // launch of some component would need): only `--strict` refuses them.
+  std::vector<Diagnostic> tolerated;
 
   const ResolvedSoftPkg *softpkg_of(const ComponentPlacement &placement) const;
   // Every profile file the application names: its SAD, and each package's SPD, SCD and PRFs,
@@ -72,6 +81,7 @@ struct ResolvedNode {
   std::shared_ptr<const DeviceConfiguration> dcd;
   std::vector<ResolvedDevicePlacement> devices;
   std::vector<Diagnostic> warnings;
+  std::vector<Diagnostic> tolerated; // as ResolvedApplication::tolerated
 };
 
 // A descriptor that passed validation, with the warnings found on the way.

@@ -127,6 +127,16 @@ Bound<PropertyValue> bind(const PropertyDefinition &definition, const PropertyRe
 
 } // namespace
 
+bool is_empty_override(const PropertyDefinition &definition, const PropertyRef &ref) {
+  const auto *simple = std::get_if<SimpleProperty>(&definition);
+  const auto *value = std::get_if<SimpleRef>(&ref);
+  if (simple == nullptr || value == nullptr)
+    return false;
+  const bool textual =
+      simple->type.type == SimpleType::String || simple->type.type == SimpleType::ObjRef;
+  return !textual && value->value.find_first_not_of(" \t\r\n") == std::string::npos;
+}
+
 Expected<PropertyValue> bind_property(const PropertyDefinition &definition,
                                       const PropertyRef &ref) {
   auto value = bind(definition, ref);

@@ -11,4 +11,8 @@ namespace rsca::profile {
 // The typed value of `ref` under `definition`. Errors are located at the ref.
 Expected<PropertyValue> bind_property(const PropertyDefinition &definition, const PropertyRef &ref);
 
+// Whether `ref` sets a simple property that is not a string to the empty text: REDHAWK takes
+// that as no override (the property keeps its value), and so does rsca, with a warning.
+bool is_empty_override(const PropertyDefinition &definition, const PropertyRef &ref);
+
 } // namespace rsca::profile

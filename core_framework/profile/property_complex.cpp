@@ -1,6 +1,8 @@
 // Complex property values (REDHAWK's complex="true"): "a+jb", "a-jb", "a" or "jb" over any
-// numeric base type, each part checked against the base type and held exactly in a double (an
-// integer part a double cannot hold is refused), and printed so that it reads back the same.
+// numeric base type, or boolean and char as REDHAWK's complexBoolean (parts 0 or 1, or true or
+// false) and complexChar (parts -128 to 127), each part checked against the base type and held
+// exactly in a double (an integer part a double cannot hold is refused), and printed so that it
+// reads back the same.
 #include "profile/property_value_impl.hpp"
 
 #include <cmath>
@@ -10,7 +12,7 @@ namespace rsca::profile::detail {
 namespace {
 
 bool can_be_complex(SimpleType type) {
-  return is_numeric(type);
+  return is_numeric(type) || type == SimpleType::Boolean || type == SimpleType::Char;
 }
 
 // Whether a double holds `value` exactly, so that printing the complex value gives it back.
@@ -37,8 +39,22 @@ tl::expected<double, std::string> floating_part(SimpleType type, std::string_vie
   return parse_floating<T>(type, text).map([](T value) { return static_cast<double>(value); });
 }
 
+tl::expected<double, std::string> boolean_part(std::string_view text) {
+  if (text.starts_with('+'))
+    text.remove_prefix(1); // the sign split_complex leaves on an imaginary part
+  if (text == "0" || text == "false")
+    return 0.0;
+  if (text == "1" || text == "true")
+    return 1.0;
+  return tl::unexpected(quoted(text) + " is not a complex boolean part (0, 1, true or false)");
+}
+
 tl::expected<double, std::string> parse_part(SimpleType type, std::string_view text) {
   switch (type) {
+  case SimpleType::Boolean:
+    return boolean_part(text);
+  case SimpleType::Char:
+    return integer_part<std::int8_t>(type, text);
   case SimpleType::Octet:
     return integer_part<std::uint8_t>(type, text);
   case SimpleType::Short:

@@ -72,25 +72,40 @@ CivilDate civil_from_days(std::int64_t days) {
   return date;
 }
 
-constexpr std::string_view kUtcLayout = "dddd:dd:dd::dd:dd:dd";
 constexpr std::string_view kUtcForm = "YYYY:MM:DD::HH:MM:SS[.ffffff] or now";
-
-bool matches_utc_layout(std::string_view text) {
-  if (text.size() < kUtcLayout.size())
-    return false;
-  for (std::size_t i = 0; i < kUtcLayout.size(); ++i) {
-    const bool ok = kUtcLayout[i] == 'd' ? is_digit(text[i]) : text[i] == kUtcLayout[i];
-    if (!ok)
-      return false;
-  }
-  return true;
-}
 
 unsigned read_digits(std::string_view text) {
   unsigned value = 0;
   for (const char c : text)
     value = value * 10 + static_cast<unsigned>(c - '0');
   return value;
+}
+
+// The six numbers of "YYYY:MM:DD::HH:MM:SS" and what follows them (the fraction). The year has
+// four digits; the others one or two, as REDHAWK writes "2017:2:1::12:01:00" too.
+struct UtcFields {
+  std::array<unsigned, 6> numbers{};
+  std::string_view rest;
+};
+
+std::optional<UtcFields> split_utc_fields(std::string_view text) {
+  constexpr std::string_view kSeparators[] = {":", ":", "::", ":", ":", ""};
+  UtcFields fields;
+  for (std::size_t i = 0; i < fields.numbers.size(); ++i) {
+    std::size_t digits = 0;
+    while (digits < text.size() && is_digit(text[digits]))
+      ++digits;
+    const bool width_ok = i == 0 ? digits == 4 : (digits == 1 || digits == 2);
+    if (!width_ok)
+      return std::nullopt;
+    fields.numbers[i] = read_digits(text.substr(0, digits));
+    text.remove_prefix(digits);
+    if (!text.starts_with(kSeparators[i]))
+      return std::nullopt;
+    text.remove_prefix(kSeparators[i].size());
+  }
+  fields.rest = text;
+  return fields;
 }
 
 // ".f" to ".ffffff" as microseconds; empty text is zero.
@@ -123,19 +138,20 @@ tl::expected<UtcTime, std::string> parse_utctime(std::string_view text) {
   const auto invalid = [&](const std::string &why) {
     return tl::unexpected(quoted(text) + " is not a valid utctime " + why);
   };
-  const auto micros =
-      matches_utc_layout(text) ? read_fraction(text.substr(kUtcLayout.size())) : std::nullopt;
+  const auto parts = split_utc_fields(text);
+  const auto micros = parts ? read_fraction(parts->rest) : std::nullopt;
   if (!micros)
     return invalid("(" + std::string(kUtcForm) + ")");
-  const std::int64_t year = read_digits(text.substr(0, 4));
-  const unsigned month = read_digits(text.substr(5, 2));
+  const auto &n = parts->numbers;
+  const std::int64_t year = n[0];
+  const unsigned month = n[1];
   const bool month_ok = month >= 1 && month <= 12;
   const std::array<Field, 5> fields{{
       {"month", month, 1, 12},
-      {"day", read_digits(text.substr(8, 2)), 1, month_ok ? days_in_month(year, month) : 31},
-      {"hour", read_digits(text.substr(12, 2)), 0, 23},
-      {"minute", read_digits(text.substr(15, 2)), 0, 59},
-      {"second", read_digits(text.substr(18, 2)), 0, 59},
+      {"day", n[2], 1, month_ok ? days_in_month(year, month) : 31},
+      {"hour", n[3], 0, 23},
+      {"minute", n[4], 0, 59},
+      {"second", n[5], 0, 59},
   }};
   for (const Field &field : fields) {
     if (field.value < field.low || field.value > field.high)

@@ -1,10 +1,13 @@
 // Readers of the parts SADs and DCDs share, and the checks of their internal references.
+#include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <map>
 
 #include <fmt/ranges.h>
 
 #include "common/content_filter.hpp"
+#include "common/cpu_list.hpp"
 #include "profile/connection_qos.hpp"
 #include "profile/read_context.hpp"
 
@@ -23,6 +26,15 @@ std::optional<Enum> enum_attr(ReadContext &ctx, const XmlElement &e, std::string
   // The schema enumerates these values; reaching here means schema and reader disagree.
   ctx.fail(e, "value", fmt::format("attribute {}: \"{}\" is not a known value", name, *text));
   return std::nullopt;
+}
+
+constexpr std::string_view kDeviceManagerRepId = "IDL:CF/DeviceManager:1.0";
+
+std::string_view trim_text(std::string_view text) {
+  const auto first = text.find_first_not_of(" \t\r\n");
+  if (first == std::string_view::npos)
+    return {};
+  return text.substr(first, text.find_last_not_of(" \t\r\n") - first + 1);
 }
 
 template <typename Int>
@@ -63,7 +75,12 @@ StructRef read_struct_members(ReadContext &ctx, const XmlElement &e, std::string
   return ref;
 }
 
-FindBy read_findby(const XmlElement &e) {
+// The domainfinder types SCA 2.2.2 and REDHAWK define.
+constexpr std::string_view kDomainFinderTypes[] = {"filemanager",   "log",         "eventchannel",
+                                                   "namingservice", "servicename", "servicetype",
+                                                   "domainmanager"};
+
+FindBy read_findby(ReadContext &ctx, const XmlElement &e) {
   FindBy findby;
   if (const XmlElement *ns = e.child("namingservice")) {
     findby.kind = FindBy::Kind::NamingService;
@@ -72,6 +89,12 @@ FindBy read_findby(const XmlElement &e) {
     findby.kind = FindBy::Kind::DomainFinder;
     findby.type = df->attr("type");
     findby.name = df->attr("name");
+    if (std::find(std::begin(kDomainFinderTypes), std::end(kDomainFinderTypes), findby.type) ==
+        std::end(kDomainFinderTypes))
+      ctx.warn(*df, "unknown-value",
+               fmt::format("domainfinder type \"{}\" is none SCA or REDHAWK defines: a connection "
+                           "through it cannot be made",
+                           findby.type));
   } else if (const XmlElement *so = e.child("stringifiedobjectref")) {
     findby.kind = FindBy::Kind::StringifiedObjectRef;
     findby.name = so->trimmed_text();
@@ -97,9 +120,12 @@ EndpointTarget read_target(ReadContext &ctx, const XmlElement &end) {
       target.kind = EndpointTarget::Kind::DeviceUsedByThisComponent;
       target.refid = c.attr("refid");
       target.usesrefid = c.attr("usesrefid");
+    } else if (c.name == "deviceusedbyapplication") {
+      target.kind = EndpointTarget::Kind::DeviceUsedByApplication;
+      target.usesrefid = c.attr("usesrefid");
     } else if (c.name == "findby") {
       target.kind = EndpointTarget::Kind::FindBy;
-      target.findby = read_findby(c);
+      target.findby = read_findby(ctx, c);
     }
   }
   return target;
@@ -140,12 +166,119 @@ Timing read_timing(ReadContext &ctx, const XmlElement &e) {
   return timing;
 }
 
+// REDHAWK reads any text as a start order; one that is no whole number orders nothing.
+std::optional<std::uint32_t> read_start_order(ReadContext &ctx, const XmlElement &e) {
+  const std::string *text = e.attribute("startorder");
+  if (text == nullptr)
+    return std::nullopt;
+  auto order = parse_int<std::uint32_t>(trim_text(*text));
+  if (!order)
+    ctx.warn(e, "value",
+             fmt::format("startorder \"{}\" is not a whole number: the instance has no start "
+                         "order",
+                         *text));
+  return order ? std::optional(*order) : std::nullopt;
+}
+
+constexpr std::pair<std::string_view, ProcessorAffinity::Class> kAffinityClasses[] = {
+    {"cpu", ProcessorAffinity::Class::Cpu},
+    {"socket", ProcessorAffinity::Class::Socket},
+    {"nic", ProcessorAffinity::Class::Nic},
+    {"nice", ProcessorAffinity::Class::Nice}};
+
+// Whether `value` is one the node can apply for `directive`; why not otherwise.
+std::optional<std::string> affinity_value_problem(ProcessorAffinity::Class directive,
+                                                  const std::string &value) {
+  using Class = ProcessorAffinity::Class;
+  if (directive == Class::Cpu || directive == Class::Socket) {
+    auto list = parse_cpu_list(value);
+    return list ? std::nullopt : std::optional(list.error());
+  }
+  if (directive == Class::Nice) {
+    auto nice = parse_int<int>(trim_text(value));
+    if (!nice || *nice < -20 || *nice > 19)
+      return "a nice value is a whole number from -20 to 19";
+    return std::nullopt;
+  }
+  if (trim_text(value).empty() || value.size() > 15) // IFNAMSIZ - 1
+    return "a network interface name has 1 to 15 characters";
+  return std::nullopt;
+}
+
+// REDHAWK's affinity: a directive class and its value, as simplerefs. What rsca cannot apply
+// (a cgroup, REDHAWK's other affinity settings, a value out of form) is read with a warning.
+std::optional<ProcessorAffinity> read_affinity(ReadContext &ctx, const XmlElement &e) {
+  const XmlElement *directive_ref = nullptr;
+  const XmlElement *value_ref = nullptr;
+  for (const auto &c : e.children) {
+    const std::string &refid = c.attr("refid");
+    if (c.name == "simpleref" && refid == "affinity::exec_directive_class")
+      directive_ref = &c;
+    else if (c.name == "simpleref" && refid == "affinity::exec_directive_value")
+      value_ref = &c;
+    else
+      ctx.warn(c, "unknown-value",
+               fmt::format("affinity setting \"{}\" is not one rsca applies: ignored", refid));
+  }
+  if (directive_ref == nullptr || value_ref == nullptr) {
+    ctx.warn(e, "affinity",
+             "affinity needs affinity::exec_directive_class and affinity::exec_directive_value: "
+             "ignored");
+    return std::nullopt;
+  }
+  const std::string &name = directive_ref->attr("value");
+  const auto *known = std::find_if(std::begin(kAffinityClasses), std::end(kAffinityClasses),
+                                   [&](const auto &entry) { return entry.first == name; });
+  if (known == std::end(kAffinityClasses)) {
+    ctx.warn(*directive_ref, "unknown-value",
+             fmt::format("affinity class \"{}\" is not one rsca applies (cpu, socket, nic, "
+                         "nice): ignored",
+                         name));
+    return std::nullopt;
+  }
+  ProcessorAffinity affinity{known->second, value_ref->attr("value"), ctx.at(e)};
+  if (auto problem = affinity_value_problem(affinity.directive, affinity.value)) {
+    ctx.warn(*value_ref, "value",
+             fmt::format("affinity {} \"{}\": {}: ignored", name, affinity.value, *problem));
+    return std::nullopt;
+  }
+  return affinity;
+}
+
+// REDHAWK's level names, in DEBUG_LEVEL's order (0 is fatal).
+constexpr std::string_view kLogLevels[] = {"FATAL", "ERROR", "WARN", "INFO", "DEBUG", "TRACE"};
+
+LoggingConfig read_logging_config(ReadContext &ctx, const XmlElement &e) {
+  LoggingConfig config{std::nullopt, e.trimmed_text(), ctx.at(e)};
+  const std::string *level = e.attribute("level");
+  if (level == nullptr)
+    return config;
+  std::string upper = *level;
+  std::transform(upper.begin(), upper.end(), upper.begin(),
+                 [](unsigned char ch) { return static_cast<char>(std::toupper(ch)); });
+  if (upper == "ALL")
+    upper = "TRACE";
+  for (std::size_t i = 0; i < std::size(kLogLevels); ++i)
+    if (upper == kLogLevels[i])
+      config.debug_level = static_cast<int>(i);
+  if (!config.debug_level && upper != "OFF")
+    ctx.warn(e, "unknown-value",
+             fmt::format("log level \"{}\" is none of FATAL, ERROR, WARN, INFO, DEBUG, TRACE, "
+                         "ALL, OFF: ignored",
+                         *level));
+  return config;
+}
+
 ComponentInstantiation read_instantiation(ReadContext &ctx, const XmlElement &e) {
   ComponentInstantiation ci;
   ci.id = e.attr("id");
   ci.where = ctx.at(e);
-  ci.start_order = ctx.optional_attr(e, "startorder", parse_int<std::uint32_t>);
+  ci.start_order = read_start_order(ctx, e);
   ci.usage_name = e.child_text("usagename");
+  if (const XmlElement *affinity = e.child("affinity"))
+    ci.affinity = read_affinity(ctx, *affinity);
+  if (const XmlElement *logging = e.child("loggingconfig"))
+    ci.logging = read_logging_config(ctx, *logging);
   ci.properties = read_property_refs(ctx, e.child("componentproperties"));
   for (const auto &c : e.children) {
     if (c.name == "findcomponent") {
@@ -153,7 +286,7 @@ ComponentInstantiation read_instantiation(ReadContext &ctx, const XmlElement &e)
         ci.naming_service_name = ns->attr("name");
     } else if (c.name == "devicerequires" || c.name == "deployerrequires") {
       for (const auto &r : c.children) {
-        if (r.name == "requiresproperty")
+        if (r.name == "requires")
           ci.device_requires.emplace_back(SimpleRef{r.attr("id"), r.attr("value"), ctx.at(r)});
         else if (is_property_ref(r.name))
           ci.device_requires.push_back(read_property_ref(ctx, r));
@@ -213,9 +346,12 @@ std::vector<ComponentFile> read_component_files(ReadContext &ctx, const XmlEleme
   std::vector<ComponentFile> files;
   if (holder == nullptr)
     return files;
-  for (const auto &c : holder->children)
-    if (c.name == "componentfile")
-      files.push_back({c.attr("id"), c.attr("type"), read_localfile(ctx, c), ctx.at(c)});
+  for (const auto &c : holder->children) {
+    if (c.name != "componentfile")
+      continue;
+    ctx.expect_type(c, "SPD");
+    files.push_back({c.attr("id"), c.attr("type"), read_localfile(ctx, c), ctx.at(c)});
+  }
   return files;
 }
 
@@ -230,6 +366,7 @@ ComponentPlacement read_component_placement(ReadContext &ctx, const XmlElement &
     } else if (c.name == "compositepartofdevice") {
       placement.composite_part_of_device = c.attr("refid");
     } else if (c.name == "devicepkgfile") {
+      ctx.expect_type(c, "DPD");
       placement.device_pkg_file = read_localfile(ctx, c);
     } else if (c.name == "componentinstantiation") {
       placement.instantiations.push_back(read_instantiation(ctx, c));
@@ -258,7 +395,7 @@ std::vector<Connection> read_connections(ReadContext &ctx, const XmlElement *hol
       } else if (part.name == "findby") {
         c.provides.kind = ProvidesEnd::Kind::FindBy;
         c.provides.target.kind = EndpointTarget::Kind::FindBy;
-        c.provides.target.findby = read_findby(part);
+        c.provides.target.findby = read_findby(ctx, part);
         c.provides.target.where = ctx.at(part);
         c.provides.where = ctx.at(part);
       } else if (part.name == "qos") {
@@ -304,12 +441,25 @@ void check_assembly_references(ReadContext &ctx, const std::vector<ComponentFile
   }
 
   auto check_target = [&](const EndpointTarget &t, const Connection &c) {
-    if (t.kind == EndpointTarget::Kind::FindBy || instance_ids.count(t.refid) != 0)
+    if (t.kind == EndpointTarget::Kind::FindBy ||
+        t.kind == EndpointTarget::Kind::DeviceUsedByApplication || instance_ids.count(t.refid) != 0)
       return;
-    ctx.report({t.where, "dangling-ref",
-                fmt::format("{} refers to componentinstantiation \"{}\", which this file does "
-                            "not define",
-                            connection_label(c), t.refid)});
+    // REDHAWK resolves a DeviceManager's id here when the connection is to its interface.
+    const bool device_manager = &t == &c.provides.target &&
+                                c.provides.kind == ProvidesEnd::Kind::SupportedInterface &&
+                                c.provides.port == kDeviceManagerRepId;
+    Diagnostic d{t.where, "dangling-ref",
+                 fmt::format("{} refers to componentinstantiation \"{}\", which this file does "
+                             "not define",
+                             connection_label(c), t.refid)};
+    if (device_manager) {
+      d.message += fmt::format(" (REDHAWK takes it for a DeviceManager; rsca's nodes do not "
+                               "serve {}, so the connection cannot be made)",
+                               kDeviceManagerRepId);
+      ctx.warn_at(std::move(d));
+      return;
+    }
+    ctx.report(std::move(d));
   };
   std::set<std::string> connection_ids;
   for (const auto &c : connections) {

@@ -21,6 +21,9 @@ namespace rsca::profile::detail {
 class ReadContext {
 public:
   explicit ReadContext(std::string file) : file_(std::move(file)) {}
+  // Reading `document`, whose own warnings (the XML reader's) come first.
+  explicit ReadContext(const XmlDocument &document)
+      : file_(document.file), warnings_(document.warnings) {}
 
   const std::string &file() const { return file_; }
   SourceLocation at(const XmlElement &e) const { return {file_, e.line, e.column}; }
@@ -32,11 +35,36 @@ public:
   bool ok() const { return error_.empty(); }
   Error take_error() { return std::move(error_); }
 
+  // Something REDHAWK reads and rsca reads too, but that deserves a look (an unknown value
+  // ignored, a form REDHAWK tolerates): a warning, an error only under `--strict`.
+  void warn(const XmlElement &e, std::string rule, std::string message) {
+    warnings_.push_back({at(e), std::move(rule), std::move(message), Severity::Warning});
+  }
+  // REDHAWK reads any text in a file-type attribute (componentfile/@type "SPD", propertyfile's
+  // "PRF", ...); rsca too, warning about one that is not the type the file must have.
+  void expect_type(const XmlElement &e, std::string_view expected) {
+    const std::string *type = e.attribute("type");
+    if (type != nullptr && *type != expected)
+      warn(
+          e, "unknown-value",
+          fmt::format("<{}> type \"{}\" is not {}: read as {}", e.name, *type, expected, expected));
+  }
+
+  void warn_at(Diagnostic diagnostic) {
+    diagnostic.severity = Severity::Warning;
+    warnings_.push_back(std::move(diagnostic));
+  }
+  std::vector<Diagnostic> take_warnings() { return std::move(warnings_); }
+
   // Reports a second use of `id` among `kind` (e.g. "componentinstantiation id").
   void require_unique(std::set<std::string> &seen, const std::string &id, const XmlElement &e,
                       std::string_view kind) {
+    require_unique(seen, id, at(e), kind);
+  }
+  void require_unique(std::set<std::string> &seen, const std::string &id,
+                      const SourceLocation &where, std::string_view kind) {
     if (!seen.insert(id).second)
-      fail(e, "duplicate-id", fmt::format("{} \"{}\" is defined more than once", kind, id));
+      report({where, "duplicate-id", fmt::format("{} \"{}\" is defined more than once", kind, id)});
   }
 
   // The value parsed by `parse` from attribute `name`, or nullopt (reported) when it is invalid
@@ -77,12 +105,15 @@ public:
 private:
   std::string file_;
   Error error_;
+  std::vector<Diagnostic> warnings_;
 };
 
+// The descriptor read, with the warnings found reading it; or every error found.
 template <typename R>
 Expected<R> finish(ReadContext &ctx, R &&result) {
   if (!ctx.ok())
     return tl::unexpected(ctx.take_error());
+  result.warnings = ctx.take_warnings();
   return std::forward<R>(result);
 }
 

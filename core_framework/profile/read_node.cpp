@@ -19,6 +19,7 @@ HardwareDevice read_hardware(ReadContext &ctx, const XmlElement &e) {
   hw.model_number = e.child_text("modelnumber");
   for (const auto &c : e.children) {
     if (c.name == "propertyfile") {
+      ctx.expect_type(c, "PRF");
       hw.property_file = detail::read_localfile(ctx, c);
     } else if (c.name == "deviceclass") {
       for (const auto &cls : c.children)
@@ -36,7 +37,7 @@ HardwareDevice read_hardware(ReadContext &ctx, const XmlElement &e) {
 } // namespace
 
 Expected<DeviceConfiguration> read_dcd(const XmlDocument &document) {
-  ReadContext ctx(document.file);
+  ReadContext ctx(document);
   const XmlElement &root = document.root;
   DeviceConfiguration dcd;
   dcd.file = document.file;
@@ -59,7 +60,7 @@ Expected<DeviceConfiguration> read_dcd(const XmlDocument &document) {
 }
 
 Expected<DomainManagerConfiguration> read_dmd(const XmlDocument &document) {
-  ReadContext ctx(document.file);
+  ReadContext ctx(document);
   const XmlElement &root = document.root;
   DomainManagerConfiguration dmd;
   dmd.file = document.file;
@@ -72,7 +73,7 @@ Expected<DomainManagerConfiguration> read_dmd(const XmlDocument &document) {
 }
 
 Expected<DevicePkg> read_dpd(const XmlDocument &document) {
-  ReadContext ctx(document.file);
+  ReadContext ctx(document);
   const XmlElement &root = document.root;
   DevicePkg dpd;
   dpd.file = document.file;

@@ -22,6 +22,11 @@ void read_common(ReadContext &ctx, const XmlElement &e, PropertyCommon &p) {
       continue;
     if (auto kind = property_kind_from_name(c.attr("kindtype")))
       p.kinds.push_back(*kind);
+    else
+      ctx.warn(c, "unknown-value",
+               fmt::format("kindtype \"{}\" is no property kind (allocation, property, configure, "
+                           "test, execparam, factoryparam, event, message): ignored",
+                           c.attr("kindtype")));
   }
 }
 
@@ -194,7 +199,7 @@ StructSequenceProperty read_struct_sequence(ReadContext &ctx, const XmlElement &
 } // namespace
 
 Expected<Properties> read_prf(const XmlDocument &document) {
-  ReadContext ctx(document.file);
+  ReadContext ctx(document);
   Properties prf;
   prf.file = document.file;
   std::set<std::string> ids;

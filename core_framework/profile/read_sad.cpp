@@ -1,4 +1,7 @@
 // SAD reader: the application and the references between its own parts.
+#include <algorithm>
+#include <charconv>
+
 #include "common/names.hpp"
 #include "profile/read_context.hpp"
 #include "profile/sad.hpp"
@@ -8,6 +11,29 @@ namespace {
 
 using detail::ReadContext;
 
+// A reservation of kind cpucores (REDHAWK's one kind) is a number of cores; another kind is
+// read with a warning and ignored, as rsca reserves nothing for it.
+void read_reservation(ReadContext &ctx, const XmlElement &e, HostCollocation &hc) {
+  const std::string &kind = e.attr("kind");
+  if (kind != "cpucores") {
+    ctx.warn(
+        e, "unknown-value",
+        fmt::format("reservation kind \"{}\" is not one rsca reserves (cpucores): ignored", kind));
+    return;
+  }
+  const std::string value = e.attr("value");
+  double cores = 0;
+  const auto [end, ec] = std::from_chars(value.data(), value.data() + value.size(), cores);
+  if (ec != std::errc() || end != value.data() + value.size() || !(cores >= 0)) {
+    ctx.fail(e, "value",
+             fmt::format("reservation value \"{}\" is not a number of cores", e.attr("value")));
+    return;
+  }
+  if (hc.cpu_cores)
+    ctx.warn(e, "duplicate-id", "a second cpucores reservation: the larger one counts");
+  hc.cpu_cores = std::max(hc.cpu_cores.value_or(0.0), cores);
+}
+
 void read_partitioning(ReadContext &ctx, const XmlElement &e, SoftwareAssembly &sad) {
   for (const auto &c : e.children) {
     if (c.name == "componentplacement") {
@@ -16,12 +42,17 @@ void read_partitioning(ReadContext &ctx, const XmlElement &e, SoftwareAssembly &
     }
     if (c.name != "hostcollocation")
       continue;
-    HostCollocation hc{c.attr("id"), c.attr("name"), ctx.at(c)};
+    HostCollocation hc{c.attr("id"), c.attr("name"), ctx.at(c), {}, {}, std::nullopt};
     for (const auto &p : c.children) {
-      if (p.name != "componentplacement")
-        continue;
-      sad.placements.push_back(detail::read_component_placement(ctx, p));
-      sad.placements.back().host_collocation = hc.id.empty() ? hc.name : hc.id;
+      if (p.name == "usesdeviceref") {
+        hc.uses_device_refs.push_back(p.attr("refid"));
+        hc.uses_device_ref_where.push_back(ctx.at(p));
+      } else if (p.name == "reservation") {
+        read_reservation(ctx, p, hc);
+      } else if (p.name == "componentplacement") {
+        sad.placements.push_back(detail::read_component_placement(ctx, p));
+        sad.placements.back().host_collocation = hc.id.empty() ? hc.name : hc.id;
+      }
     }
     sad.host_collocations.push_back(std::move(hc));
   }
@@ -102,10 +133,34 @@ void check_instance_refs(ReadContext &ctx, const SoftwareAssembly &sad) {
               fmt::format("latency path \"{}\"", path.id));
 }
 
+// References to the SAD's own usesdevice: from a host collocation (usesdeviceref) and from a
+// connection end (deviceusedbyapplication).
+void check_uses_device_refs(ReadContext &ctx, const SoftwareAssembly &sad) {
+  std::set<std::string> ids;
+  for (const auto &u : sad.uses_device_dependencies)
+    ctx.require_unique(ids, u.id, u.where, "usesdevice id");
+  auto require = [&](const std::string &usesrefid, const SourceLocation &where,
+                     std::string_view what) {
+    if (ids.count(usesrefid) == 0)
+      ctx.report({where, "dangling-ref",
+                  fmt::format("{} names usesdevice \"{}\", which this SAD's "
+                              "usesdevicedependencies do not define",
+                              what, usesrefid)});
+  };
+  for (const auto &hc : sad.host_collocations)
+    for (std::size_t i = 0; i < hc.uses_device_refs.size(); ++i)
+      require(hc.uses_device_refs[i], hc.uses_device_ref_where[i],
+              fmt::format("hostcollocation \"{}\"", hc.id.empty() ? hc.name : hc.id));
+  for (const auto &c : sad.connections)
+    for (const auto *end : {&c.uses.target, &c.provides.target})
+      if (end->kind == EndpointTarget::Kind::DeviceUsedByApplication)
+        require(end->usesrefid, end->where, "deviceusedbyapplication");
+}
+
 } // namespace
 
 Expected<SoftwareAssembly> read_sad(const XmlDocument &document) {
-  ReadContext ctx(document.file);
+  ReadContext ctx(document);
   const XmlElement &root = document.root;
   SoftwareAssembly sad;
   sad.file = document.file;
@@ -142,6 +197,7 @@ Expected<SoftwareAssembly> read_sad(const XmlDocument &document) {
   }
   detail::check_assembly_references(ctx, sad.component_files, sad.placements, sad.connections);
   check_instance_refs(ctx, sad);
+  check_uses_device_refs(ctx, sad);
   return detail::finish(ctx, std::move(sad));
 }
 

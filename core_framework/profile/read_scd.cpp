@@ -32,7 +32,7 @@ void read_ports(ReadContext &ctx, const XmlElement &ports, SoftwareComponent &sc
 } // namespace
 
 Expected<SoftwareComponent> read_scd(const XmlDocument &document) {
-  ReadContext ctx(document.file);
+  ReadContext ctx(document);
   const XmlElement &root = document.root;
   SoftwareComponent scd;
   scd.file = document.file;
@@ -40,8 +40,10 @@ Expected<SoftwareComponent> read_scd(const XmlDocument &document) {
   if (const XmlElement *repid = root.child("componentrepid"))
     scd.component_repid = repid->attr("repid");
   scd.component_type = root.child_text("componenttype");
-  if (const XmlElement *pf = root.child("propertyfile"))
+  if (const XmlElement *pf = root.child("propertyfile")) {
+    ctx.expect_type(*pf, "PRF");
     scd.property_file = detail::read_localfile(ctx, *pf).name;
+  }
   if (const XmlElement *features = root.child("componentfeatures")) {
     for (const auto &c : features->children)
       if (c.name == "supportsinterface")

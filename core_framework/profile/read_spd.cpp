@@ -82,6 +82,7 @@ Implementation read_implementation(ReadContext &ctx, const XmlElement &e) {
   impl.description = e.child_text("description");
   for (const auto &c : e.children) {
     if (c.name == "propertyfile") {
+      ctx.expect_type(c, "PRF");
       impl.property_file = detail::read_localfile(ctx, c);
     } else if (c.name == "code") {
       impl.code.type = read_code_type(c.attr("type"));
@@ -115,7 +116,7 @@ Implementation read_implementation(ReadContext &ctx, const XmlElement &e) {
 } // namespace
 
 Expected<SoftPkg> read_spd(const XmlDocument &document) {
-  ReadContext ctx(document.file);
+  ReadContext ctx(document);
   const XmlElement &root = document.root;
   SoftPkg spd;
   spd.file = document.file;
@@ -130,6 +131,7 @@ Expected<SoftPkg> read_spd(const XmlDocument &document) {
     if (c.name == "author") {
       spd.authors.push_back(c.child_text("name"));
     } else if (c.name == "propertyfile") {
+      ctx.expect_type(c, "PRF");
       spd.property_file = detail::read_localfile(ctx, c);
     } else if (c.name == "descriptor") {
       spd.descriptor = detail::read_localfile(ctx, c);
@@ -138,8 +140,15 @@ Expected<SoftPkg> read_spd(const XmlDocument &document) {
       ctx.require_unique(impl_ids, spd.implementations.back().id, c, "implementation id");
     } else if (c.name == "usesdevice") {
       spd.uses_devices.push_back(read_uses_device(ctx, c));
+    } else if (c.name == "child") {
+      ctx.warn(c, "not-modelled",
+               fmt::format("child package \"{}\" (REDHAWK 3's child devices) is read but not used",
+                           c.attr("name")));
     }
   }
+  if (spd.implementations.empty())
+    ctx.warn(root, "no-implementation",
+             fmt::format("softpkg \"{}\" has no implementation: nothing of it can run", spd.name));
   return detail::finish(ctx, std::move(spd));
 }
 

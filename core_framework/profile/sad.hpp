@@ -1,6 +1,8 @@
 // SAD: an application — its components, their placement, connections, and RSCA's latency paths.
 #pragma once
 
+#include "common/diagnostic.hpp"
+
 #include <string>
 #include <vector>
 
@@ -49,6 +51,7 @@ struct SoftwareAssembly {
   std::vector<ExternalProperty> external_properties;
   std::vector<UsesDevice> uses_device_dependencies;
   std::vector<LatencyPath> latency_paths;
+  std::vector<Diagnostic> warnings; // what reading it tolerated (see detail::ReadContext::warn)
 
   const ComponentFile *find_component_file(std::string_view id) const;
   // The instantiation with that id and the placement holding it; nullptr when none.

@@ -50,6 +50,7 @@ struct SoftwareComponent {
   std::vector<SupportedInterface> supported_interfaces;
   std::vector<PortDefinition> ports;
   std::vector<InterfaceDefinition> interfaces;
+  std::vector<Diagnostic> warnings; // what reading it tolerated (see detail::ReadContext::warn)
 
   const PortDefinition *find_port(std::string_view name, PortDirection direction) const;
   // True when `repid` names this component's own interface or one it supports or inherits.

@@ -99,6 +99,7 @@ struct SoftPkg {
   std::optional<LocalFile> descriptor; // the SCD
   std::vector<Implementation> implementations;
   std::vector<UsesDevice> uses_devices;
+  std::vector<Diagnostic> warnings; // what reading it tolerated (see detail::ReadContext::warn)
 
   const Implementation *find_implementation(std::string_view id) const;
 };

@@ -37,6 +37,9 @@ struct XmlElement {
 struct XmlDocument {
   std::string file; // as given, for messages
   XmlElement root;
+  // What the schemas refuse but REDHAWK reads, read anyway (e.g. an attribute no schema declares,
+  // which is ignored): `rsca validate` shows these, `--strict` refuses them.
+  std::vector<Diagnostic> warnings;
 };
 
 // The largest profile accepted; a larger file is refused before parsing, since no descriptor

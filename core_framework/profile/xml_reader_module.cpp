@@ -9,6 +9,7 @@
 #include <fstream>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <sstream>
 #include <vector>
 
@@ -151,12 +152,14 @@ public:
   void fatalError(const x::SAXParseException &e) override { add(e, "xml"); }
   void resetErrors() override {
     error_ = Error();
+    warnings_.clear();
     undeclared_.clear();
   }
   // Whether the root element has been seen yet: a problem before it is a problem with the root.
   void set_root_seen(bool seen) { root_seen_ = seen; }
 
   const Error &error() const { return error_; }
+  std::vector<Diagnostic> take_warnings() { return std::move(warnings_); }
   void add(Diagnostic d) {
     if (error_.diagnostics().size() < kMaxDiagnosticsPerFile)
       error_.add(std::move(d));
@@ -165,6 +168,13 @@ public:
 private:
   void add(const x::SAXParseException &e, const char *rule) {
     std::string message = explain(utf8_(e.getMessage()));
+    const SourceLocation where{file_, static_cast<int>(e.getLineNumber()),
+                               static_cast<int>(e.getColumnNumber())};
+    if (auto tolerated = tolerated_by_redhawk(message)) {
+      if (warnings_.size() < kMaxDiagnosticsPerFile)
+        warnings_.push_back({where, "unknown-attribute", std::move(*tolerated), Severity::Warning});
+      return;
+    }
     constexpr std::string_view kUndeclared = "no declaration found for element '";
     if (message.starts_with(kUndeclared)) {
       std::string name = message.substr(kUndeclared.size(), message.find('\'', kUndeclared.size()) -
@@ -178,10 +188,26 @@ private:
     } else if (is_consequence_of_undeclared(message)) {
       return; // the parent's content model fails only because of a child already reported
     }
-    add(Diagnostic{
-        {file_, static_cast<int>(e.getLineNumber()), static_cast<int>(e.getColumnNumber())},
-        rule,
-        std::move(message)});
+    add(Diagnostic{where, rule, std::move(message)});
+  }
+
+  // REDHAWK's parsers skip attributes they do not know, and real profiles carry some (IDE
+  // leftovers, attributes of later REDHAWK versions): such an attribute is read with a warning
+  // and ignored. Nothing else the schemas refuse is tolerated here.
+  static std::optional<std::string> tolerated_by_redhawk(const std::string &message) {
+    constexpr std::string_view kAttribute = "attribute '";
+    constexpr std::string_view kUndeclared = "' is not declared for element '";
+    if (!message.starts_with(kAttribute))
+      return std::nullopt;
+    const auto name_end = message.find(kUndeclared);
+    if (name_end == std::string::npos)
+      return std::nullopt;
+    const std::string name = message.substr(kAttribute.size(), name_end - kAttribute.size());
+    const auto element_at = name_end + kUndeclared.size();
+    const std::string element =
+        message.substr(element_at, message.find('\'', element_at) - element_at);
+    return fmt::format("attribute {} is not one rsca knows on <{}>: ignored, as REDHAWK does", name,
+                       element);
   }
 
   bool is_consequence_of_undeclared(const std::string &message) const {
@@ -195,6 +221,7 @@ private:
 
   std::string file_;
   Error error_;
+  std::vector<Diagnostic> warnings_;
   Utf8 utf8_;
   bool root_seen_ = false;
   std::vector<std::string> undeclared_;
@@ -370,7 +397,7 @@ public:
       builder_.reset({});
       return tl::unexpected(collector.error());
     }
-    return XmlDocument{file, builder_.take_root()};
+    return XmlDocument{file, builder_.take_root(), collector.take_warnings()};
   }
 
 private:

@@ -13,6 +13,18 @@
 
 namespace rsca::protocol::node {
 
+// Where a process may run: the profile's affinity (REDHAWK's exec_directive_class and _value;
+// profile/assembly.hpp), which the node resolves on its own host (gpp/affinity.hpp).
+struct AffinityDirective {
+  static constexpr std::size_t kMaxValue = 256;
+  std::string directive; // cpu, socket, nic or nice
+  std::string value;     // a CPU or NUMA node list, an interface name, a nice value
+  static constexpr auto fields() {
+    using R = AffinityDirective;
+    return std::tuple{required("directive", &R::directive), required("value", &R::value)};
+  }
+};
+
 // Start one process on an executable device: a component, or a component host for several.
 struct ExecuteRequest {
   std::string application;
@@ -28,13 +40,15 @@ struct ExecuteRequest {
   // installed (the component host), found in the node's exec path.
   std::optional<Package> package;
   std::optional<std::string> launch; // the launch it is part of (its progress shows transfers)
+  std::optional<AffinityDirective> affinity;
   static constexpr auto fields() {
     using R = ExecuteRequest;
     return std::tuple{
         required("application", &R::application), required("component", &R::component),
         optional("device", &R::device),           required("entrypoint", &R::entrypoint),
         optional("spd_dir", &R::spd_dir),         required("args", &R::args),
-        optional("package", &R::package),         optional("launch", &R::launch)};
+        optional("package", &R::package),         optional("launch", &R::launch),
+        optional("affinity", &R::affinity)};
   }
 };
 

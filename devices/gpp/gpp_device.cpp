@@ -3,8 +3,10 @@
 #include <unistd.h>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
+#include "affinity.hpp"
 #include "common/exec_environment.hpp"
 #include "control/link_socket.hpp"
 #include "host_info.hpp"
@@ -92,6 +94,16 @@ GppDevice::execute(const protocol::node::ExecuteRequest &r,
                    std::shared_ptr<const node::PackageLease> package) {
   const std::string &application = r.application;
   const std::string &component = r.component;
+  // An affinity this host cannot honour refuses the process before it starts.
+  std::optional<ProcessPlacement> placement;
+  if (r.affinity) {
+    auto resolved = resolve_affinity(*r.affinity);
+    if (!resolved)
+      return control::call_error(Status::BadRequest,
+                                 fmt::format("{}: {}/{}: {}", context_.id, application, component,
+                                             resolved.error().diagnostics().front().message));
+    placement = std::move(*resolved);
+  }
   ExecRequest request;
   if (package) {
     auto program = packaged_executable(r, *package);
@@ -136,6 +148,19 @@ GppDevice::execute(const protocol::node::ExecuteRequest &r,
       context_.host_data->release_page(*page);
     return control::call_error(Status::Failed,
                                fmt::format("{}: {}", context_.id, pid.error().to_string()));
+  }
+  if (placement) {
+    if (auto applied = apply_placement(*pid, *placement); !applied) {
+      (void)launcher_.terminate(*pid, {});
+      if (page)
+        context_.host_data->release_page(*page);
+      return control::call_error(Status::Failed,
+                                 fmt::format("{}: {}", context_.id, applied.error().to_string()));
+    }
+    spdlog::info("{}/{} (pid {}) runs on CPUs {}{}", application, component, *pid,
+                 placement->cpus.empty() ? "any"
+                                         : fmt::format("{}", fmt::join(placement->cpus, ",")),
+                 placement->nice ? fmt::format(", nice {}", *placement->nice) : "");
   }
   if (page)
     context_.host_data->adopt(*pid, *page);

@@ -51,10 +51,11 @@ inline const Diagnostic &find_rule(const Error &error, std::string_view rule) {
 
 // Checks one diagnostic: rule, severity, file, line, column and message fragments.
 inline void check(const Diagnostic &d, std::string_view rule, const std::string &file, int line,
-                  int column, std::initializer_list<std::string_view> fragments) {
+                  int column, std::initializer_list<std::string_view> fragments,
+                  Severity severity = Severity::Error) {
   INFO("diagnostic: " << to_string(d));
   CHECK(d.rule == rule);
-  CHECK(d.severity == Severity::Error);
+  CHECK(d.severity == severity);
   CHECK(d.where.file == file);
   CHECK(d.where.line == line);
   CHECK(d.where.column == column);

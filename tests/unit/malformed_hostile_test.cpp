@@ -169,9 +169,9 @@ TEST_CASE("independent errors in one file are all reported", "[malformed][partia
     auto result = read_descriptor(file);
     const Error &error = error_of(result);
     REQUIRE(error.diagnostics().size() == 3);
-    check(error.diagnostics()[0], "schema", file.string(), 11, 57, {"'colour'"});
-    check(error.diagnostics()[1], "schema", file.string(), 12, 62, {"'first'"});
-    check(error.diagnostics()[2], "schema", file.string(), 13, 32, {"'soon'"});
+    check(error.diagnostics()[0], "schema", file.string(), 12, 26, {"'refid'"});
+    check(error.diagnostics()[1], "schema", file.string(), 14, 54, {"'extreme'"});
+    check(error.diagnostics()[2], "schema", file.string(), 14, 54, {"'soon'"});
   }
 }
 

@@ -68,15 +68,20 @@ TEST_CASE("an SPD implref naming an implementation the dependency lacks", "[malf
   CHECK_THAT(d.message, Contains("(it has: cpp)"));
 }
 
-TEST_CASE("a SAD override of a property the PRF does not define", "[malformed][dangling]") {
+TEST_CASE("a SAD override of a property the PRF does not define is ignored with a warning",
+          "[malformed][dangling][redhawk]") {
+  // REDHAWK warns and ignores such an override; so does rsca (--strict refuses it).
   const fs::path root = fixture("dangling/unknown_property");
   const fs::path sad = root / "dom/waveforms/app/app.sad.xml";
   ProfileLoader loader(root);
   auto result = loader.load_application(sad);
-  const Error &error = error_of(result);
-  REQUIRE(error.diagnostics().size() == 1);
-  check(error.diagnostics().front(), "unknown-property", loader_name(sad), 14, 46,
-        {"componentinstantiation \"comp_1\"", "property \"gain\" is not defined by comp.prf.xml"});
+  REQUIRE(result.has_value());
+  CHECK(result->warnings.empty()); // nothing that stops a launch
+  REQUIRE(result->tolerated.size() == 1);
+  check(result->tolerated.front(), "unknown-property", loader_name(sad), 14, 46,
+        {"componentinstantiation \"comp_1\"", "property \"gain\" is not defined by comp.prf.xml",
+         "the override is ignored"},
+        Severity::Warning);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -95,19 +100,28 @@ TEST_CASE("two PRF properties with one id", "[malformed][duplicate]") {
 // ---------------------------------------------------------------------------------------------
 // Missing files, cycles, wrong descriptor types: problems between files.
 
-TEST_CASE("a SAD naming an SPD that does not exist", "[malformed][missing-file]") {
+// A missing file is an error only where it is needed (REDHAWK reads such a package): the loader
+// reads the package without it, marks it unavailable with where the file is named, and warns.
+
+TEST_CASE("a SAD naming an SPD that does not exist", "[malformed][missing-file][redhawk]") {
   const fs::path root = fixture("missing_file/spd");
   const fs::path sad = root / "dom/waveforms/app/app.sad.xml";
   ProfileLoader loader(root);
   auto result = loader.load_application(sad);
-  const Error &error = error_of(result);
-  REQUIRE(error.diagnostics().size() == 1);
-  check(error.diagnostics().front(), "missing-file", loader_name(sad), 6, 56,
+  REQUIRE(result.has_value());
+  REQUIRE(result->component_files.size() == 1);
+  const auto &pkg = *result->component_files.begin()->second;
+  CHECK(pkg.spd->implementations.empty());
+  REQUIRE(pkg.unavailable.size() == 1);
+  check(pkg.unavailable.front(), "missing-file", loader_name(sad), 6, 56,
         {"the file named here does not exist",
          loader_name(root / "dom/components/comp/comp.spd.xml")});
+  REQUIRE(result->tolerated.size() == 1);
+  check(result->tolerated.front(), "missing-file", loader_name(sad), 6, 56, {"cannot run"},
+        Severity::Warning);
 }
 
-TEST_CASE("an SPD naming a PRF that does not exist", "[malformed][missing-file]") {
+TEST_CASE("an SPD naming a PRF that does not exist", "[malformed][missing-file][redhawk]") {
   const fs::path root = fixture("missing_file/prf");
   const fs::path spd = root / "dom/components/comp/comp.spd.xml";
   const std::string prf = loader_name(root / "dom/components/comp/comp.prf.xml");
@@ -115,20 +129,29 @@ TEST_CASE("an SPD naming a PRF that does not exist", "[malformed][missing-file]"
   SECTION("the package on its own") {
     ProfileLoader loader(root);
     auto result = loader.load_softpkg(spd);
-    const Error &error = error_of(result);
-    REQUIRE(error.diagnostics().size() == 1);
-    check(error.diagnostics().front(), "missing-file", loader_name(spd), 8, 37,
+    REQUIRE(result.has_value());
+    CHECK((*result)->properties == nullptr);
+    REQUIRE((*result)->unavailable.size() == 1);
+    check((*result)->unavailable.front(), "missing-file", loader_name(spd), 8, 37,
           {"the file named here does not exist", prf});
+    REQUIRE((*result)->warnings.size() == 1);
+    CHECK((*result)->warnings.front().severity == Severity::Warning);
   }
-  SECTION("through an application: the SPD's error, then a note where the SAD names it") {
+  SECTION("through an application: read, with the SPD's warning") {
     const fs::path sad = root / "dom/waveforms/app/app.sad.xml";
     ProfileLoader loader(root);
     auto result = loader.load_application(sad);
-    const Error &error = error_of(result);
-    REQUIRE(error.diagnostics().size() == 2);
-    check(error.diagnostics()[0], "missing-file", loader_name(spd), 8, 37, {prf});
-    check(error.diagnostics()[1], "invalid-ref", loader_name(sad), 6, 56,
-          {"is invalid", loader_name(spd)});
+    REQUIRE(result.has_value());
+    REQUIRE(result->tolerated.size() == 1);
+    check(result->tolerated.front(), "missing-file", loader_name(spd), 8, 37, {prf},
+          Severity::Warning);
+  }
+  SECTION("validate reports it as a warning") {
+    ProfileLoader loader(root);
+    auto result = loader.validate(spd);
+    REQUIRE(result.has_value());
+    REQUIRE(result->warnings.size() == 1);
+    CHECK(result->warnings.front().rule == "missing-file");
   }
 }
 

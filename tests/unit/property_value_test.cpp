@@ -299,6 +299,10 @@ TEST_CASE("utctime parsing", "[property_value]") {
   CHECK(parsed<UtcTime>(t, "2001:03:01::00:00:00.123") == utc(983404800, 123000));
   CHECK(parsed<UtcTime>(t, " 2000:01:01::00:00:00 ") == utc(946684800));
   CHECK(parsed<UtcTime>(t, "now") == UtcTime{true, 0, 0});
+  // REDHAWK writes the fields after the year with one digit too.
+  CHECK(parsed<UtcTime>(t, "2017:2:1::12:01:00.123") ==
+        parsed<UtcTime>(t, "2017:02:01::12:01:00.123"));
+  CHECK(parsed<UtcTime>(t, "2000:1:1::0:0:0") == utc(946684800));
 
   CHECK(error_of(t, "2000:13:01::00:00:00") ==
         "\"2000:13:01::00:00:00\" is not a valid utctime (month 13 is out of range 1..12)");
@@ -320,7 +324,9 @@ TEST_CASE("utctime parsing", "[property_value]") {
                           "2000:01:01::00:00:00.1234567",
                           "2000:01:01::00:00:00.12a",
                           "2000:01:01::00:00:00Z",
-                          "2000:1:01::00:00:00",
+                          "200:01:01::00:00:00",
+                          "2000:001:01::00:00:00",
+                          "2000::01::00:00:00",
                           "2000:01:01:00:00:00",
                           "2000:01:01::00:00",
                           "",
@@ -408,9 +414,17 @@ TEST_CASE("complex values", "[property_value]") {
       CHECK(rejects(d, bad));
     }
   }
-  SECTION("non-numeric bases cannot be complex") {
-    CHECK(error_of(complex_of(SimpleType::Boolean), "true") == "boolean cannot be complex");
+  SECTION("REDHAWK's complexBoolean and complexChar") {
+    CHECK(parsed<C>(complex_of(SimpleType::Boolean), "0+j1") == C(0, 1));
+    CHECK(parsed<C>(complex_of(SimpleType::Boolean), "true+jfalse") == C(1, 0));
+    CHECK(rejects(complex_of(SimpleType::Boolean), "2+j0"));
+    CHECK(rejects(complex_of(SimpleType::Boolean), "0-j1"));
+    CHECK(parsed<C>(complex_of(SimpleType::Char), "4+j5") == C(4, 5));
+    CHECK(parsed<C>(complex_of(SimpleType::Char), "-128+j127") == C(-128, 127));
+    CHECK(rejects(complex_of(SimpleType::Char), "128"));
     CHECK(rejects(complex_of(SimpleType::Char), "a"));
+  }
+  SECTION("non-numeric bases cannot be complex") {
     CHECK(rejects(complex_of(SimpleType::String), "1+j2"));
     CHECK(rejects(complex_of(SimpleType::ObjRef), "x"));
     CHECK(rejects(complex_of(SimpleType::UtcTime), "now"));

@@ -136,6 +136,8 @@ std::string describe(const EndpointTarget &target, const std::string &port) {
     return fmt::format("device-that-loaded({}).{}", target.refid, port);
   case EndpointTarget::Kind::DeviceUsedByThisComponent:
     return fmt::format("device-used-by({}, {}).{}", target.refid, target.usesrefid, port);
+  case EndpointTarget::Kind::DeviceUsedByApplication:
+    return fmt::format("device-used-by-application({}).{}", target.usesrefid, port);
   case EndpointTarget::Kind::ComponentInstantiation:
     break;
   }
