@@ -76,44 +76,87 @@ struct DeviceManager::Impl {
   op::StatusReply status() const;
 };
 
-Expected<void> DeviceManager::Impl::start_devices(const DeviceRegistry &registry) {
-  for (const auto &placed : node.devices) {
-    if (!placed.softpkg)
-      continue;
-    const DeviceFactory *factory = registry.find(placed.softpkg->spd->name);
+namespace {
+
+// The DCD's device instances in the order they start: those with a start order by it (REDHAWK
+// 2.2's componentinstantiation/@startorder), then the others in the DCD's order.
+std::vector<
+    std::pair<const profile::ResolvedDevicePlacement *, const profile::ComponentInstantiation *>>
+start_order_of(const profile::ResolvedNode &node) {
+  std::vector<
+      std::pair<const profile::ResolvedDevicePlacement *, const profile::ComponentInstantiation *>>
+      out;
+  for (const auto &placed : node.devices)
+    if (placed.softpkg)
+      for (const auto &ci : placed.placement->instantiations)
+        out.emplace_back(&placed, &ci);
+  std::stable_sort(out.begin(), out.end(), [](const auto &a, const auto &b) {
+    return a.second->start_order.value_or(UINT32_MAX) < b.second->start_order.value_or(UINT32_MAX);
+  });
+  return out;
+}
+
+// REDHAWK's loggingconfig of a device instance sets its log level; rsca's devices run inside the
+// node daemon, whose log they write to: the node logs at least as verbosely as any of them asks.
+void apply_logging_config(const profile::ResolvedNode &node) {
+  for (const auto &placed : node.devices)
     for (const auto &ci : placed.placement->instantiations) {
-      const std::string label = ci.usage_name.empty() ? ci.id : ci.usage_name;
-      const std::string id = fmt::format("{}:{}", dcd->name, label);
-      if (factory == nullptr) {
-        spdlog::warn("device {}: no implementation of {} in this node daemon; skipped", id,
-                     placed.softpkg->spd->name);
+      if (!ci.logging || !ci.logging->debug_level)
         continue;
+      constexpr spdlog::level::level_enum kLevels[] = {
+          spdlog::level::critical, spdlog::level::err,   spdlog::level::warn,
+          spdlog::level::info,     spdlog::level::debug, spdlog::level::trace};
+      const auto level = kLevels[std::clamp(*ci.logging->debug_level, 0, 5)];
+      if (level < spdlog::get_level()) {
+        spdlog::set_level(level);
+        spdlog::info("logging at {}: the DCD's loggingconfig of {} asks for it",
+                     spdlog::level::to_string_view(level), ci.id);
       }
-      DeviceContext context{id,
-                            label,
-                            dcd->name,
-                            options.domain_name,
-                            placed.softpkg,
-                            &ci,
-                            overrides_of(ci, *placed.softpkg),
-                            participant,
-                            options.exec_path,
-                            options.log_dir,
-                            participant->settings(),
-                            [this](const auto &report) { report_exit(report); },
-                            links.get(),
-                            host_data.get()};
-      auto device = (*factory)(context);
-      if (!device)
-        return tl::unexpected(device.error());
-      spdlog::info("device {} ({}) started", id, placed.softpkg->spd->name);
-      Json offers = Json::object();
-      for (const auto &ref : ci.device_requires)
-        if (const auto *simple = std::get_if<profile::SimpleRef>(&ref))
-          offers[simple->refid] = simple->value;
-      devices.push_back({id, label, placed.softpkg->spd->name, std::move(*device),
-                         allocator::allocation_properties_json(*placed.softpkg), offers});
     }
+}
+
+} // namespace
+
+Expected<void> DeviceManager::Impl::start_devices(const DeviceRegistry &registry) {
+  for (const auto &[placed_ptr, ci_ptr] : start_order_of(node)) {
+    const auto &placed = *placed_ptr;
+    const auto &ci = *ci_ptr;
+    const DeviceFactory *factory = registry.find(placed.softpkg->spd->name);
+    const std::string label = ci.usage_name.empty() ? ci.id : ci.usage_name;
+    const std::string id = fmt::format("{}:{}", dcd->name, label);
+    if (!placed.softpkg->unavailable.empty()) {
+      spdlog::warn("device {} not started: {}", id, to_string(placed.softpkg->unavailable.front()));
+      continue;
+    }
+    if (factory == nullptr) {
+      spdlog::warn("device {}: no implementation of {} in this node daemon; skipped", id,
+                   placed.softpkg->spd->name);
+      continue;
+    }
+    DeviceContext context{id,
+                          label,
+                          dcd->name,
+                          options.domain_name,
+                          placed.softpkg,
+                          &ci,
+                          overrides_of(ci, *placed.softpkg),
+                          participant,
+                          options.exec_path,
+                          options.log_dir,
+                          participant->settings(),
+                          [this](const auto &report) { report_exit(report); },
+                          links.get(),
+                          host_data.get()};
+    auto device = (*factory)(context);
+    if (!device)
+      return tl::unexpected(device.error());
+    spdlog::info("device {} ({}) started", id, placed.softpkg->spd->name);
+    Json offers = Json::object();
+    for (const auto &ref : ci.device_requires)
+      if (const auto *simple = std::get_if<profile::SimpleRef>(&ref))
+        offers[simple->refid] = simple->value;
+    devices.push_back({id, label, placed.softpkg->spd->name, std::move(*device),
+                       allocator::allocation_properties_json(*placed.softpkg), offers});
   }
   return {};
 }
@@ -270,6 +313,9 @@ DeviceManager::create(std::shared_ptr<dds::Participant> participant, NodeOptions
     return tl::unexpected(node.error());
   impl->node = std::move(*node);
   impl->dcd = impl->node.dcd;
+  for (const auto &w : impl->node.tolerated)
+    spdlog::warn("{}", to_string(w));
+  apply_logging_config(impl->node);
   control::EndpointOptions endpoint_options;
   endpoint_options.hold_requests = true; // until its devices run and their handlers are there
   auto endpoint = control::Endpoint::open(

@@ -379,9 +379,18 @@ Expected<ResolvedNode> ProfileLoader::load_node(const fs::path &dcd_file) {
     if (placement.device_pkg_file) {
       const auto &f = *placement.device_pkg_file;
       auto dpd = cached<DevicePkg>(root->resolve(f.name, node.dcd_path, SdrTree::Dev), f.where);
-      dpd ? void(device.device_pkg = *dpd) : errors.append(dpd.error());
-      if (dpd)
+      if (dpd) {
+        device.device_pkg = *dpd;
         append_unique(node.tolerated, (*dpd)->warnings);
+      } else if (is_missing_file(dpd.error())) {
+        // Its hardware description: nothing rsca runs needs it.
+        Diagnostic d = dpd.error().diagnostics().front();
+        d.severity = Severity::Warning;
+        d.message += "; the device is described without it";
+        node.tolerated.push_back(std::move(d));
+      } else {
+        errors.append(dpd.error());
+      }
     }
     if (device.softpkg)
       append_unique(node.tolerated, device.softpkg->warnings);

@@ -236,3 +236,88 @@ TEST_CASE("planner: usesdevice places on the used device's node and allocates it
     CHECK(plan.application_devices[1].device == "n1:radio");
   }
 }
+
+// REDHAWK 2.2's hostcollocation children, each worked out by hand.
+// ------------------------------------------------------------------------------------------------
+TEST_CASE("planner: a hostcollocation's cpucores reservation is a floor on its CPU charge",
+          "[planner][redhawk22]") {
+  // Each GPP has 100 % of cpu_capacity (one core).
+  const auto state = domain_state({gpp_device("n1:GPP", "n1"), gpp_device("n2:GPP", "n2")});
+  auto pkg = softpkg("comp", {ImplSpec("cpp").utilization(0.2)});
+  PlanRequest request = request_of({component_request("a", pkg), component_request("b", pkg)});
+  request.components[0].collocation = request.components[1].collocation = "g";
+
+  SECTION("the last member placed is charged up to the reservation") {
+    // Members 20 + 20 = 40 %; reservation 0.7 cores = 70 %: the last one is charged 20 + 30.
+    request.collocations.push_back({"g", 70.0, {}});
+    const Plan plan = require_plan(make_plan(state, request));
+    const double a = placement_of(plan, "a").demand.at(kCpuCapacity);
+    const double b = placement_of(plan, "b").demand.at(kCpuCapacity);
+    CHECK(a + b == Approx(70.0));
+    CHECK(std::min(a, b) == Approx(20.0));
+    DomainState committed = state;
+    commit(committed, plan);
+    CHECK(allocated(committed, device_of(plan, "a"), kCpuCapacity) == Approx(70.0));
+    release(committed, plan);
+    CHECK(allocated(committed, device_of(plan, "a"), kCpuCapacity) == Approx(0.0));
+  }
+  SECTION("members that demand more than the reservation are charged their own demand") {
+    request.collocations.push_back({"g", 30.0, {}}); // 40 % > 30 %
+    const Plan plan = require_plan(make_plan(state, request));
+    CHECK(placement_of(plan, "a").demand.at(kCpuCapacity) == Approx(20.0));
+    CHECK(placement_of(plan, "b").demand.at(kCpuCapacity) == Approx(20.0));
+  }
+  SECTION("a reservation no node can hold is rejected, saying so") {
+    request.collocations.push_back({"g", 150.0, {}}); // 1.5 cores on one-core nodes
+    const auto rejections = require_rejection(make_plan(state, request));
+    CHECK_THAT(to_string(rejections), Catch::Contains("hostcollocation g reserves 1.5 cores"));
+  }
+  SECTION("a reservation that fits only on the emptier node goes there") {
+    DomainState busy = state;
+    busy.at("n1:GPP").load.allocated[kCpuCapacity] = 50.0; // n1 has 50 % left
+    request.collocations.push_back({"g", 80.0, {}});
+    const Plan plan = require_plan(make_plan(busy, request));
+    CHECK(placement_of(plan, "a").node == "n2");
+    CHECK(placement_of(plan, "b").node == "n2");
+  }
+}
+
+TEST_CASE("planner: a hostcollocation's usesdeviceref puts it next to that device",
+          "[planner][redhawk22]") {
+  // The radio is on n2; the application uses it (SAD usesdevice "radio"); the collocation that
+  // refers to it must be on n2 although packing would put it on n1.
+  const Device radio =
+      peripheral("n2:radio", "n2", {{"kind", "kind", "radio", profile::Action::Eq}}, {});
+  const auto state = domain_state({gpp_device("n1:GPP", "n1"), gpp_device("n2:GPP", "n2"), radio});
+  auto pkg = softpkg("comp", {ImplSpec("cpp").utilization(0.1)});
+  PlanRequest request = request_of({component_request("a", pkg), component_request("b", pkg)});
+  request.uses_devices.push_back(uses_device("radio", {ref("kind", "radio")}));
+
+  SECTION("without usesdeviceref packing fills n1") {
+    const Plan plan = require_plan(make_plan(state, request));
+    CHECK(placement_of(plan, "a").node == "n1");
+    REQUIRE(plan.application_devices.size() == 1);
+    CHECK(plan.application_devices[0].device == "n2:radio");
+  }
+  SECTION("with it the collocation goes to the radio's node") {
+    request.components[0].collocation = request.components[1].collocation = "g";
+    request.collocations.push_back({"g", 0.0, {"radio"}});
+    const Plan plan = require_plan(make_plan(state, request));
+    CHECK(placement_of(plan, "a").node == "n2");
+    CHECK(placement_of(plan, "b").node == "n2");
+    CHECK(plan.application_devices[0].device == "n2:radio");
+  }
+  SECTION("two collocations tied to one device on different nodes are rejected") {
+    const auto full = domain_state({gpp_device("n1:GPP", "n1"), gpp_device("n2:GPP", "n2"), radio});
+    auto big = softpkg("big", {ImplSpec("cpp").utilization(0.6)});
+    PlanRequest two = request_of({component_request("a", big), component_request("b", big)});
+    two.uses_devices.push_back(uses_device("radio", {ref("kind", "radio")}));
+    two.components[0].collocation = "g1";
+    two.components[1].collocation = "g2";
+    two.collocations = {{"g1", 0.0, {"radio"}}, {"g2", 0.0, {"radio"}}};
+    // 60 + 60 % cannot share a one-core node; apart they are on two nodes, one of them not
+    // the radio's.
+    const auto rejections = require_rejection(make_plan(full, two));
+    CHECK_THAT(to_string(rejections), Catch::Contains("usesdevice radio"));
+  }
+}

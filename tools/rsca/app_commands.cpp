@@ -47,9 +47,12 @@ std::optional<fs::path> sdrroot_of(const fs::path &file, const GlobalOptions &gl
 }
 
 // The install request for a SAD: the application's files, read here and carried to the domain,
-// so that the CLI may run on another host than the domain daemon.
-Expected<protocol::domain::InstallRequest>
-install_request(const fs::path &sad, const GlobalOptions &global, const std::string &name) {
+// so that the CLI may run on another host than the domain daemon. `warnings`: what reading them
+// found, located in the user's files.
+Expected<protocol::domain::InstallRequest> install_request(const fs::path &sad,
+                                                           const GlobalOptions &global,
+                                                           const std::string &name,
+                                                           std::vector<Diagnostic> &warnings) {
   auto root = sdrroot_of(sad, global);
   if (!root)
     return make_error(
@@ -59,6 +62,8 @@ install_request(const fs::path &sad, const GlobalOptions &global, const std::str
   auto app = loader.load_application(sad);
   if (!app)
     return tl::unexpected(app.error());
+  warnings = app->warnings;
+  warnings.insert(warnings.end(), app->tolerated.begin(), app->tolerated.end());
   protocol::domain::InstallRequest request{
       app->sad_path.lexically_relative(*root).string(), {}, std::nullopt};
   for (const auto &f : app->files())
@@ -77,11 +82,15 @@ int install(const std::string &sad, const std::string &name, const GlobalOptions
       fmt::print(stderr, "rsca install: {}\n", named.error().diagnostics().front().message);
       return kUsage;
     }
-  auto request = install_request(sad, global, name);
+  std::vector<Diagnostic> warnings;
+  auto request = install_request(sad, global, name, warnings);
   if (!request) {
     fmt::print(stderr, "rsca install: {}\n", request.error().to_string());
     return kInvalidProfile;
   }
+  if (!global.json)
+    for (const auto &w : warnings)
+      fmt::print(stderr, "rsca install: {}\n", to_string(w));
   auto client = DomainClient::connect(global);
   if (!client) {
     fmt::print(stderr, "rsca install: {}\n", client.error().to_string());

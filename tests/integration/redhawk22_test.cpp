@@ -1,0 +1,70 @@
+// REDHAWK 2.2's forms in a real domain (issue 23): an instance's affinity and loggingconfig
+// reach its process through the node; a package that misses a file it names is installed (as
+// REDHAWK reads it), and a launch of it fails at its first step naming the file, leaving nothing
+// behind.
+#include <algorithm>
+#include <fstream>
+#include <sstream>
+
+#include <catch2/catch.hpp>
+#include <fmt/format.h>
+
+#include "domain_fixture.hpp"
+
+using namespace rsca::test;
+using namespace std::chrono_literals;
+using rsca::control::Json;
+
+namespace {
+
+std::string read_proc(long pid, const std::string &what) {
+  std::ifstream in(fmt::format("/proc/{}/{}", pid, what));
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// The value of one "Name:\tvalue" line of /proc/<pid>/status.
+std::string status_field(long pid, const std::string &name) {
+  std::istringstream lines(read_proc(pid, "status"));
+  for (std::string line; std::getline(lines, line);)
+    if (line.rfind(name + ":", 0) == 0)
+      return line.substr(line.find_first_not_of(" \t", name.size() + 1));
+  return {};
+}
+
+} // namespace
+
+TEST_CASE("an instance's affinity and loggingconfig reach its process",
+          "[integration][redhawk22]") {
+  TestDomain domain;
+  const Json app = domain.create("Pinned");
+  const auto pids = pids_of(app);
+  REQUIRE(pids.size() == 1);
+  // affinity cpu 0: the node pinned the process (and its threads) to CPU 0.
+  CHECK(status_field(pids.front(), "Cpus_allowed_list") == "0");
+  // loggingconfig level DEBUG: REDHAWK's DEBUG_LEVEL 4 on its command line.
+  std::string cmdline = read_proc(pids.front(), "cmdline");
+  std::replace(cmdline.begin(), cmdline.end(), '\0', ' ');
+  CHECK_THAT(cmdline, Catch::Contains("DEBUG_LEVEL 4"));
+}
+
+TEST_CASE("a package missing its PRF installs with a warning and its launch fails naming the file",
+          "[integration][redhawk22][failure]") {
+  TestDomain domain;
+  auto [rc_install, installed] =
+      domain.cli({"install", "--sdrroot", kTestSdr.string(),
+                  (kTestSdr / "dom/waveforms/MissingPrf/MissingPrf.sad.xml").string()});
+  INFO(installed);
+  REQUIRE(rc_install == 0);
+  CHECK_THAT(installed, Catch::Contains("NoPrf.prf.xml"));
+
+  auto [rc, out] = domain.cli({"launch", "MissingPrf"});
+  INFO(out);
+  CHECK(rc == 1); // the profile cannot be launched as it is (kInvalidProfile)
+  CHECK_THAT(out, Catch::Contains("failed at step 'check'"));
+  CHECK_THAT(out, Catch::Contains("component NoPrf_1 cannot be launched"));
+  CHECK_THAT(out, Catch::Contains("NoPrf.prf.xml"));
+  domain.require_clean({});
+  CHECK(domain.running_pids().empty());
+}
