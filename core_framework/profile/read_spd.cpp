@@ -27,6 +27,20 @@ tl::expected<std::uint64_t, std::string> parse_count(std::string_view text) {
   return value;
 }
 
+// An os or processor the implementation needs; an empty name (which REDHAWK's tools can write)
+// would match no device, and is ignored with a warning.
+void read_os_or_processor(ReadContext &ctx, const XmlElement &e, Implementation &impl) {
+  const std::string &name = e.attr("name");
+  if (name.find_first_not_of(" \t\r\n") == std::string::npos) {
+    ctx.warn(e, "empty-value", fmt::format("<{}> with no name: ignored", e.name));
+    return;
+  }
+  if (e.name == "os")
+    impl.os.push_back({name, e.attr("version")});
+  else
+    impl.processors.push_back(name);
+}
+
 ResourceDemand read_resource_demand(ReadContext &ctx, const XmlElement &e) {
   ResourceDemand d;
   d.where = ctx.at(e);
@@ -98,10 +112,8 @@ Implementation read_implementation(ReadContext &ctx, const XmlElement &e) {
       impl.human_language = c.attr("name");
     } else if (c.name == "runtime") {
       impl.runtime = {c.attr("name"), c.attr("version")};
-    } else if (c.name == "os") {
-      impl.os.push_back({c.attr("name"), c.attr("version")});
-    } else if (c.name == "processor") {
-      impl.processors.push_back(c.attr("name"));
+    } else if (c.name == "os" || c.name == "processor") {
+      read_os_or_processor(ctx, c, impl);
     } else if (c.name == "dependency") {
       read_dependency(ctx, c, impl);
     } else if (c.name == "usesdevice") {

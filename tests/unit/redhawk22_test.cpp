@@ -170,6 +170,18 @@ TEST_CASE("REDHAWK 2.2 DCD forms are read and modelled", "[redhawk22][dcd]") {
   CHECK(node->warnings.empty());
 }
 
+TEST_CASE("an empty entrypoint and an empty processor name are read", "[redhawk22][spd]") {
+  ProfileLoader loader(kRoot);
+  auto pkg = loader.load_softpkg(kRoot / "dom/components/comp/comp.spd.xml");
+  INFO((pkg ? std::string() : pkg.error().to_string()));
+  REQUIRE(pkg.has_value());
+  const auto &impl = (*pkg)->spd->implementations.front();
+  CHECK(impl.code.entrypoint.empty()); // the code's file is what runs
+  CHECK(impl.processors.empty());      // an empty name would match no device
+  CHECK_THAT(warning_at((*pkg)->warnings, "empty-value", 19).message,
+             Contains("<processor> with no name"));
+}
+
 TEST_CASE("REDHAWK 3 child packages and a package without implementation are read",
           "[redhawk22][spd]") {
   ProfileLoader loader(kRoot);
