@@ -6,6 +6,8 @@
 
 #include <fmt/format.h>
 
+#include "profile/property_binding.hpp"
+
 namespace rsca::allocator {
 namespace {
 
@@ -51,10 +53,12 @@ unsigned cpus_of(const Device &device, std::optional<double> cores_property) {
 
 // The DCD's value for a device property (by id or name), as text.
 std::optional<std::string> override_of(const profile::ComponentInstantiation &ci,
-                                       const profile::PropertyCommon &property) {
+                                       const profile::SimpleProperty &property) {
   for (const auto &ref : ci.properties) {
     const auto *simple = std::get_if<profile::SimpleRef>(&ref);
-    if (simple != nullptr && (simple->refid == property.id || simple->refid == property.name))
+    // An empty number is no override, as at the node (profile::is_empty_override).
+    if (simple != nullptr && (simple->refid == property.id || simple->refid == property.name) &&
+        !profile::is_empty_override(property, ref))
       return simple->value;
   }
   return std::nullopt;
@@ -208,7 +212,8 @@ Device device_from_announcement(const std::string &node, const json &entry) {
 std::vector<Device> devices_of_node(const profile::ResolvedNode &node) {
   std::vector<Device> out;
   for (const auto &placed : node.devices) {
-    if (!placed.softpkg || placed.placement == nullptr)
+    // A device whose package misses a file does not start at its node: not in the domain.
+    if (!placed.softpkg || placed.placement == nullptr || !placed.softpkg->unavailable.empty())
       continue;
     for (const auto &ci : placed.placement->instantiations) {
       const std::string label = ci.usage_name.empty() ? ci.id : ci.usage_name;

@@ -167,7 +167,7 @@ PlanRequest plan_request_of(const profile::ResolvedApplication &application,
     if (!hc.cpu_cores && hc.uses_device_refs.empty())
       continue;
     request.collocations.push_back(
-        {hc.id.empty() ? hc.name : hc.id, hc.cpu_cores.value_or(0.0) * 100.0, hc.uses_device_refs});
+        {hc.key, hc.cpu_cores.value_or(0.0) * 100.0, hc.uses_device_refs});
   }
   request.uses_devices = sad.uses_device_dependencies;
   request.latency_paths = sad.latency_paths;

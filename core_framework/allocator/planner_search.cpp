@@ -61,6 +61,11 @@ private:
     for (std::size_t i = 0; i < request_.components.size(); ++i) {
       const auto &c = request_.components[i];
       Rejection rejection{c.instance, {}};
+      if (auto why = unrunnable(*c.softpkg)) {
+        rejection.reasons.push_back(*why);
+        rejections.push_back(std::move(rejection));
+        continue;
+      }
       for (const auto &impl : c.softpkg->implementations)
         for (auto &[id, s] : working_) {
           if (s.device.kind != "gpp" || (c.device && *c.device != id))
@@ -86,6 +91,16 @@ private:
       rejections.push_back(std::move(rejection));
     }
     return rejections;
+  }
+
+  // Why nothing of a package can run anywhere: a file it names is missing, or it has no
+  // implementation.
+  static std::optional<std::string> unrunnable(const profile::ResolvedSoftPkg &pkg) {
+    if (!pkg.unavailable.empty())
+      return fmt::format("its package cannot run: {}", pkg.unavailable.front().message);
+    if (pkg.implementations.empty())
+      return std::string("its package has no implementation");
+    return std::nullopt;
   }
 
   // Fewest candidates first; a collocation group's members next to each other.
@@ -221,6 +236,8 @@ private:
           it != group_node_.end() && it->second != s.device.node)
         return tl::unexpected(
             fmt::format("hostcollocation {} is on node {}", c.collocation, it->second));
+    if (auto why = missing_referenced_device(c, s.device.node))
+      return tl::unexpected(*why);
     Step step{{c.instance,
                candidate.device,
                s.device.node,
@@ -376,6 +393,26 @@ private:
     placed.count = static_cast<std::size_t>(static_cast<long>(placed.count) + sign);
     const auto cpu = p.demand.find(kCpuCapacity);
     placed.cpu += sign * (cpu == p.demand.end() ? 0.0 : cpu->second);
+  }
+
+  // A collocation that refers to the application's usesdevice (usesdeviceref) goes only to a node
+  // that has such a device: checked as each member is tried, so that a wrong node is left at
+  // once rather than after everything else is placed. Capacity is checked when all are.
+  std::optional<std::string> missing_referenced_device(const ComponentRequest &c,
+                                                       const std::string &node) const {
+    const auto request = group_request_.find(c.collocation);
+    if (c.collocation.empty() || request == group_request_.end())
+      return std::nullopt;
+    for (const auto &id : request->second->uses_devices) {
+      const auto uses = std::find_if(request_.uses_devices.begin(), request_.uses_devices.end(),
+                                     [&](const profile::UsesDevice &u) { return u.id == id; });
+      if (uses == request_.uses_devices.end())
+        continue;
+      if (auto found = find_used_device(*uses, node, {}); !found)
+        return fmt::format("hostcollocation {} goes next to usesdevice {}: {}", c.collocation, id,
+                           found.error());
+    }
+    return std::nullopt;
   }
 
   // Where the SAD's usesdevice `id` must be found: the node of a collocation that refers to it

@@ -11,9 +11,9 @@
 
 namespace rsca {
 
-// The highest CPU or node number a list may name: far above any robot computer, and it bounds
-// what a profile (untrusted input) can make a node allocate.
-inline constexpr unsigned kMaxCpuIndex = 4095;
+// The highest CPU or node number a list may name: far above any robot computer, it bounds what
+// a profile (untrusted input) can make a node allocate, and a cpu_set_t holds it (CPU_SETSIZE).
+inline constexpr unsigned kMaxCpuIndex = 1023;
 
 // The numbers of `text` in increasing order without repeats; "" and malformed text are errors.
 tl::expected<std::vector<unsigned>, std::string> parse_cpu_list(std::string_view text);

@@ -47,14 +47,15 @@ CallResult<std::shared_ptr<Application>> ApplicationFactory::Launch::run() {
 }
 
 CallResult<void> ApplicationFactory::Launch::check() {
+  // A missing file first: it explains the wiring findings it causes (ports of a missing SCD).
+  if (auto missing = missing_files(); !missing.empty())
+    return control::call_error(Status::BadRequest, fmt::format("{}", fmt::join(missing, "\n")));
   if (!request_.profile->warnings.empty()) {
     std::vector<std::string> problems;
     for (const auto &w : request_.profile->warnings)
       problems.push_back(to_string(w));
     return control::call_error(Status::BadRequest, fmt::format("{}", fmt::join(problems, "\n")));
   }
-  if (auto missing = missing_files(); !missing.empty())
-    return control::call_error(Status::BadRequest, fmt::format("{}", fmt::join(missing, "\n")));
   if (auto unsupported = unsupported_connections(); !unsupported.empty())
     return control::call_error(Status::BadRequest, fmt::format("{}", fmt::join(unsupported, "\n")));
   if (auto joined = s_.channels->join(channel_members()); !joined)

@@ -21,7 +21,7 @@ std::string file_name(const std::filesystem::path &p) {
 void check_property_refs(const ResolvedSoftPkg &pkg, const std::vector<PropertyRef> &refs,
                          std::string_view owner, Error &errors,
                          std::vector<Diagnostic> &tolerated) {
-  if (!pkg.unavailable.empty())
+  if (!pkg.unavailable.empty() && pkg.properties == nullptr)
     return;
   for (const auto &ref : refs) {
     const PropertyDefinition *definition = pkg.find_property(refid_of(ref));
@@ -84,6 +84,8 @@ private:
     const ResolvedSoftPkg *pkg = app_.softpkg_of(*placement);
     if (pkg == nullptr)
       return nullptr;
+    if (!pkg->scd && !pkg->unavailable.empty())
+      return nullptr; // its missing files are reported, and refuse its launch
     if (!pkg->scd)
       warn(where, "missing-scd",
            fmt::format("{}: component \"{}\" ({}) has no SCD, so its ports are unknown", what,

@@ -86,6 +86,9 @@ struct ComponentPlacement {
 struct HostCollocation {
   std::string id;
   std::string name;
+  // What its placements name it by (ComponentPlacement::host_collocation), unique in its SAD: its
+  // id, or for one without (REDHAWK allows it) its name and its place among the collocations.
+  std::string key;
   SourceLocation where;
   // REDHAWK 2.2: usesdevice ids of the SAD whose devices the collocation goes next to.
   std::vector<std::string> uses_device_refs;

@@ -107,6 +107,8 @@ const PropertyDefinition *ResolvedSoftPkg::find_property(std::string_view id) co
 namespace {
 
 void collect_files(const ResolvedSoftPkg &pkg, std::set<std::filesystem::path> &files) {
+  if (pkg.sources.empty()) // an SPD that is not there: nothing of it to carry
+    return;
   if (!files.insert(pkg.spd_path).second)
     return;
   if (pkg.properties)

@@ -127,14 +127,18 @@ Bound<PropertyValue> bind(const PropertyDefinition &definition, const PropertyRe
 
 } // namespace
 
-bool is_empty_override(const PropertyDefinition &definition, const PropertyRef &ref) {
-  const auto *simple = std::get_if<SimpleProperty>(&definition);
+bool is_empty_override(const SimpleProperty &definition, const PropertyRef &ref) {
   const auto *value = std::get_if<SimpleRef>(&ref);
-  if (simple == nullptr || value == nullptr)
+  if (value == nullptr)
     return false;
   const bool textual =
-      simple->type.type == SimpleType::String || simple->type.type == SimpleType::ObjRef;
+      definition.type.type == SimpleType::String || definition.type.type == SimpleType::ObjRef;
   return !textual && value->value.find_first_not_of(" \t\r\n") == std::string::npos;
+}
+
+bool is_empty_override(const PropertyDefinition &definition, const PropertyRef &ref) {
+  const auto *simple = std::get_if<SimpleProperty>(&definition);
+  return simple != nullptr && is_empty_override(*simple, ref);
 }
 
 Expected<PropertyValue> bind_property(const PropertyDefinition &definition,

@@ -14,5 +14,6 @@ Expected<PropertyValue> bind_property(const PropertyDefinition &definition, cons
 // Whether `ref` sets a simple property that is not a string to the empty text: REDHAWK takes
 // that as no override (the property keeps its value), and so does rsca, with a warning.
 bool is_empty_override(const PropertyDefinition &definition, const PropertyRef &ref);
+bool is_empty_override(const SimpleProperty &definition, const PropertyRef &ref);
 
 } // namespace rsca::profile

@@ -236,7 +236,8 @@ std::optional<ProcessorAffinity> read_affinity(ReadContext &ctx, const XmlElemen
                          name));
     return std::nullopt;
   }
-  ProcessorAffinity affinity{known->second, value_ref->attr("value"), ctx.at(e)};
+  ProcessorAffinity affinity{known->second, std::string(trim_text(value_ref->attr("value"))),
+                             ctx.at(e)};
   if (auto problem = affinity_value_problem(affinity.directive, affinity.value)) {
     ctx.warn(*value_ref, "value",
              fmt::format("affinity {} \"{}\": {}: ignored", name, affinity.value, *problem));

@@ -1,6 +1,7 @@
 // SAD reader: the application and the references between its own parts.
 #include <algorithm>
 #include <charconv>
+#include <cmath>
 
 #include "common/names.hpp"
 #include "profile/read_context.hpp"
@@ -10,6 +11,9 @@ namespace rsca::profile {
 namespace {
 
 using detail::ReadContext;
+
+// More cores than any robot computer has: a larger reservation is a mistake.
+constexpr double kMaxReservedCores = 4096;
 
 // A reservation of kind cpucores (REDHAWK's one kind) is a number of cores; another kind is
 // read with a warning and ignored, as rsca reserves nothing for it.
@@ -21,20 +25,26 @@ void read_reservation(ReadContext &ctx, const XmlElement &e, HostCollocation &hc
         fmt::format("reservation kind \"{}\" is not one rsca reserves (cpucores): ignored", kind));
     return;
   }
-  const std::string value = e.attr("value");
+  std::string_view value = e.attr("value");
+  const auto first = value.find_first_not_of(" \t\r\n");
+  value = first == std::string_view::npos
+              ? std::string_view{}
+              : value.substr(first, value.find_last_not_of(" \t\r\n") - first + 1);
   double cores = 0;
   const auto [end, ec] = std::from_chars(value.data(), value.data() + value.size(), cores);
-  if (ec != std::errc() || end != value.data() + value.size() || !(cores >= 0)) {
+  if (ec != std::errc() || end != value.data() + value.size() || !std::isfinite(cores) ||
+      cores < 0 || cores > kMaxReservedCores) {
     ctx.fail(e, "value",
              fmt::format("reservation value \"{}\" is not a number of cores", e.attr("value")));
     return;
   }
   if (hc.cpu_cores)
-    ctx.warn(e, "duplicate-id", "a second cpucores reservation: the larger one counts");
+    ctx.warn(e, "reservation", "a second cpucores reservation: the larger one counts");
   hc.cpu_cores = std::max(hc.cpu_cores.value_or(0.0), cores);
 }
 
 void read_partitioning(ReadContext &ctx, const XmlElement &e, SoftwareAssembly &sad) {
+  std::set<std::string> collocation_ids;
   for (const auto &c : e.children) {
     if (c.name == "componentplacement") {
       sad.placements.push_back(detail::read_component_placement(ctx, c));
@@ -42,7 +52,16 @@ void read_partitioning(ReadContext &ctx, const XmlElement &e, SoftwareAssembly &
     }
     if (c.name != "hostcollocation")
       continue;
-    HostCollocation hc{c.attr("id"), c.attr("name"), ctx.at(c), {}, {}, std::nullopt};
+    HostCollocation hc{c.attr("id"), c.attr("name"), {}, ctx.at(c), {}, {}, std::nullopt};
+    if (!hc.id.empty()) {
+      hc.key = hc.id;
+      ctx.require_unique(collocation_ids, hc.id, c, "hostcollocation id");
+    } else {
+      // No id: its name, or its place when the name is empty or taken.
+      hc.key = hc.name;
+      if (hc.key.empty() || !collocation_ids.insert(hc.key).second)
+        hc.key = fmt::format("{}#{}", hc.name, sad.host_collocations.size() + 1);
+    }
     for (const auto &p : c.children) {
       if (p.name == "usesdeviceref") {
         hc.uses_device_refs.push_back(p.attr("refid"));
@@ -51,7 +70,7 @@ void read_partitioning(ReadContext &ctx, const XmlElement &e, SoftwareAssembly &
         read_reservation(ctx, p, hc);
       } else if (p.name == "componentplacement") {
         sad.placements.push_back(detail::read_component_placement(ctx, p));
-        sad.placements.back().host_collocation = hc.id.empty() ? hc.name : hc.id;
+        sad.placements.back().host_collocation = hc.key;
       }
     }
     sad.host_collocations.push_back(std::move(hc));

@@ -2,6 +2,8 @@
 
 #include <cctype>
 #include <fstream>
+#include <optional>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -10,34 +12,19 @@
 namespace rsca::profile {
 namespace {
 
-// Blanks the DOCTYPE declaration, if the prolog has one, keeping line breaks so every position
+// DOCTYPE declarations are blanked before Xerces sees them, keeping line breaks so every position
 // Xerces reports stays where it was. rsca never uses DTDs, and Xerces 3.2 leaks the DTD grammar it
-// builds for a DOCTYPE when parsing with a cached schema grammar (once per file), so the
-// declaration is removed before Xerces sees it. A text whose prolog this does not understand (an
-// unterminated DOCTYPE, a non-ASCII-compatible encoding) is left as it is for Xerces to judge.
-void blank_doctype(std::string &text) {
-  std::size_t i = text.rfind("\xEF\xBB\xBF", 0) == 0 ? 3 : 0;
-  auto skip_past = [&](std::string_view end) {
-    auto at = text.find(end, i);
-    i = at == std::string::npos ? text.size() : at + end.size();
-  };
-  while (i < text.size()) {
-    if (std::isspace(static_cast<unsigned char>(text[i]))) {
-      ++i;
-    } else if (text.compare(i, 2, "<?") == 0) {
-      skip_past("?>");
-    } else if (text.compare(i, 4, "<!--") == 0) {
-      skip_past("-->");
-    } else {
-      break;
-    }
-  }
-  if (text.compare(i, 9, "<!DOCTYPE") != 0)
-    return;
+// builds for a DOCTYPE when parsing with a cached schema grammar (once per file). A text whose
+// prolog this does not understand (an unterminated DOCTYPE, a non-ASCII-compatible encoding) is
+// left as it is for Xerces to judge.
+
+// Blanks the declaration starting at `i` (up to its closing '>' outside quotes and its internal
+// subset) and returns where it ended.
+std::size_t blank_declaration(std::string &text, std::size_t i) {
   char quote = 0;
   int depth = 0;
   for (std::size_t j = i; j < text.size(); ++j) {
-    char c = text[j];
+    const char c = text[j];
     if (quote != 0) {
       quote = c == quote ? 0 : quote;
     } else if (c == '"' || c == '\'') {
@@ -50,9 +37,51 @@ void blank_doctype(std::string &text) {
       for (std::size_t k = i; k <= j; ++k)
         if (text[k] != '\n' && text[k] != '\r')
           text[k] = ' ';
-      return;
+      return j + 1;
     }
   }
+  return text.size();
+}
+
+// Blanks the DOCTYPE declaration in the prolog (keeping line breaks, so positions stay), and
+// returns where a second one starts, if any: XML allows one, and Xerces leaks the declaration of
+// one it sees, so none reaches it.
+std::optional<std::size_t> blank_doctype(std::string &text) {
+  std::size_t i = text.rfind("\xEF\xBB\xBF", 0) == 0 ? 3 : 0;
+  auto skip_past = [&](std::string_view end) {
+    auto at = text.find(end, i);
+    i = at == std::string::npos ? text.size() : at + end.size();
+  };
+  bool blanked = false;
+  while (i < text.size()) {
+    if (std::isspace(static_cast<unsigned char>(text[i]))) {
+      ++i;
+    } else if (text.compare(i, 2, "<?") == 0) {
+      skip_past("?>");
+    } else if (text.compare(i, 4, "<!--") == 0) {
+      skip_past("-->");
+    } else if (text.compare(i, 9, "<!DOCTYPE") == 0) {
+      if (blanked)
+        return i;
+      i = blank_declaration(text, i);
+      blanked = true;
+    } else {
+      break;
+    }
+  }
+  return std::nullopt;
+}
+
+// The 1-based line and column of byte `at`.
+std::pair<int, int> position_of(std::string_view text, std::size_t at) {
+  int line = 1;
+  std::size_t line_start = 0;
+  for (std::size_t k = 0; k < at && k < text.size(); ++k)
+    if (text[k] == '\n') {
+      ++line;
+      line_start = k + 1;
+    }
+  return {line, static_cast<int>(at - line_start) + 1};
 }
 
 std::string_view trim_xml_space(std::string_view s) {
@@ -99,7 +128,11 @@ Expected<XmlDocument> read_xml_profile_text(std::string_view text, std::string f
   if (!reader)
     return tl::unexpected(reader.error());
   std::string without_doctype(text);
-  blank_doctype(without_doctype);
+  if (auto second = blank_doctype(without_doctype)) {
+    const auto [line, column] = position_of(text, *second);
+    return make_error({file_name, line, column}, "xml",
+                      "a second DOCTYPE declaration: a document has at most one");
+  }
   return (*reader)->read(without_doctype, file_name);
 }
 

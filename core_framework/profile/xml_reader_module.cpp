@@ -64,6 +64,11 @@ constexpr PatternMeaning kPatternMeanings[] = {
 
 // Xerces states some rules as the regular expression behind them; say what they mean instead.
 std::string explain(std::string message) {
+  // common.Blank: the content of an element that holds only attributes.
+  constexpr std::string_view kBlank = "' which is not equal to length facet value '0'";
+  if (message.starts_with("value '") && message.find(kBlank) != std::string::npos)
+    return fmt::format("this element holds only attributes: text \"{}\" is not allowed in it",
+                       message.substr(7, message.find('\'', 7) - 7));
   constexpr std::string_view kFacet = "does not match regular expression facet '";
   const auto at = message.find(kFacet);
   if (at == std::string::npos)
@@ -75,6 +80,11 @@ std::string explain(std::string message) {
       return message.substr(0, at) + "is not " + std::string(meaning.expected);
   return message;
 }
+
+// The elements of rsca's extensions (docs/profiles.md, "RSCA extensions"), which REDHAWK does not
+// have: their attributes are checked strictly.
+constexpr std::string_view kRscaElements[] = {
+    "timing", "qos", "filter", "latencyconstraints", "latencypath", "resourcedemand"};
 
 constexpr std::string_view kProfileRoots =
     "softwareassembly (SAD), softpkg (SPD), softwarecomponent (SCD), properties (PRF), "
@@ -206,6 +216,11 @@ private:
     const auto element_at = name_end + kUndeclared.size();
     const std::string element =
         message.substr(element_at, message.find('\'', element_at) - element_at);
+    // rsca's own elements are no REDHAWK's: a misspelt attribute there is a mistake to refuse
+    // (a <qos leese="..."> would otherwise silently keep the default lease).
+    if (std::find(std::begin(kRscaElements), std::end(kRscaElements), element) !=
+        std::end(kRscaElements))
+      return std::nullopt;
     return fmt::format("attribute {} is not one rsca knows on <{}>: ignored, as REDHAWK does", name,
                        element);
   }

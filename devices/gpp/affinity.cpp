@@ -39,6 +39,16 @@ Expected<std::vector<unsigned>> online_cpus(const std::string &sys) {
   return *online;
 }
 
+// Every CPU of `cpus` must be one this node may use.
+Expected<std::vector<unsigned>> within(std::vector<unsigned> cpus,
+                                       const std::vector<unsigned> &usable) {
+  for (unsigned cpu : cpus)
+    if (!std::binary_search(usable.begin(), usable.end(), cpu))
+      return affinity_error(fmt::format("cpu {} is not one this node may use (it may use {})", cpu,
+                                        fmt::join(usable, ",")));
+  return cpus;
+}
+
 Expected<std::vector<unsigned>> cpus_of_list(const std::string &value, const std::string &sys) {
   auto wanted = parse_cpu_list(value);
   if (!wanted)
@@ -106,8 +116,20 @@ Expected<int> nice_of(const std::string &value) {
 
 } // namespace
 
+std::vector<unsigned> usable_cpus() {
+  std::vector<unsigned> out;
+  cpu_set_t set;
+  if (sched_getaffinity(0, sizeof(set), &set) != 0)
+    return out;
+  for (unsigned cpu = 0; cpu < CPU_SETSIZE; ++cpu)
+    if (CPU_ISSET(cpu, &set))
+      out.push_back(cpu);
+  return out;
+}
+
 Expected<ProcessPlacement> resolve_affinity(const protocol::node::AffinityDirective &directive,
-                                            const std::string &sys) {
+                                            const std::string &sys,
+                                            const std::vector<unsigned> &usable) {
   if (directive.value.size() > protocol::node::AffinityDirective::kMaxValue)
     return affinity_error("the affinity value is too long");
   ProcessPlacement placement;
@@ -128,30 +150,40 @@ Expected<ProcessPlacement> resolve_affinity(const protocol::node::AffinityDirect
                                       directive.directive));
   if (!cpus)
     return tl::unexpected(cpus.error());
-  placement.cpus = std::move(*cpus);
+  auto allowed = within(std::move(*cpus), usable);
+  if (!allowed)
+    return tl::unexpected(allowed.error());
+  placement.cpus = std::move(*allowed);
   return placement;
 }
 
-Expected<void> apply_placement(pid_t pid, const ProcessPlacement &placement) {
+ScopedThreadCpus::ScopedThreadCpus(const std::vector<unsigned> &cpus) {
+  if (cpus.empty() || sched_getaffinity(0, sizeof(saved_), &saved_) != 0)
+    return;
   cpu_set_t set;
   CPU_ZERO(&set);
-  for (unsigned cpu : placement.cpus)
-    if (cpu < CPU_SETSIZE)
-      CPU_SET(cpu, &set);
-  // Every thread it has now (Linux keeps the mask and the nice value per thread); threads it
-  // starts later inherit them from the thread that starts them.
+  for (unsigned cpu : cpus)
+    CPU_SET(cpu, &set); // below CPU_SETSIZE: kMaxCpuIndex bounds every list
+  pinned_ = sched_setaffinity(0, sizeof(set), &set) == 0;
+}
+
+ScopedThreadCpus::~ScopedThreadCpus() {
+  if (pinned_)
+    sched_setaffinity(0, sizeof(saved_), &saved_);
+}
+
+Expected<void> apply_nice(pid_t pid, const ProcessPlacement &placement) {
+  if (!placement.nice)
+    return {};
   std::error_code ec;
   for (const auto &task : fs::directory_iterator(fmt::format("/proc/{}/task", pid), ec)) {
     const pid_t tid = std::stoi(task.path().filename().string());
-    if (!placement.cpus.empty() && sched_setaffinity(tid, sizeof(set), &set) != 0 && errno != ESRCH)
-      return affinity_error(fmt::format("cannot pin thread {} of {} to CPUs {}: {}", tid, pid,
-                                        fmt::join(placement.cpus, ","), std::strerror(errno)));
-    if (placement.nice && setpriority(PRIO_PROCESS, static_cast<id_t>(tid), *placement.nice) != 0 &&
-        errno != ESRCH)
+    if (setpriority(PRIO_PROCESS, static_cast<id_t>(tid), *placement.nice) != 0 && errno != ESRCH)
       return affinity_error(
           fmt::format("cannot set nice {} of {}: {}", *placement.nice, pid, std::strerror(errno)));
   }
-  if (ec)
+  // No /proc/<pid>/task: the process is gone already; its exit is reported as any exit.
+  if (ec && ec != std::errc::no_such_file_or_directory)
     return affinity_error(fmt::format("process {}: {}", pid, ec.message()));
   return {};
 }

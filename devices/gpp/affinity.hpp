@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include <sched.h>
 #include <sys/types.h>
 
 #include "common/diagnostic.hpp"
@@ -21,11 +22,35 @@ struct ProcessPlacement {
   std::optional<int> nice;
 };
 
-// Reads the host's CPUs, NUMA nodes and interfaces under `sys` (/sys; tests give another root).
-Expected<ProcessPlacement> resolve_affinity(const protocol::node::AffinityDirective &directive,
-                                            const std::string &sys = "/sys");
+// The CPUs this process may run on (its own affinity mask): all a process it starts can have.
+std::vector<unsigned> usable_cpus();
 
-// Pins every thread of `pid` to the placement's CPUs and sets its nice value.
-Expected<void> apply_placement(pid_t pid, const ProcessPlacement &placement);
+// Reads the host's CPUs, NUMA nodes and interfaces under `sys` (/sys; tests give another root);
+// every CPU must be online and among `usable` (those this node may use, e.g. in its cpuset).
+Expected<ProcessPlacement> resolve_affinity(const protocol::node::AffinityDirective &directive,
+                                            const std::string &sys = "/sys",
+                                            const std::vector<unsigned> &usable = usable_cpus());
+
+// While it lives, the calling thread runs on `cpus` (none: unchanged), so that a process it
+// starts has them from its first instruction (a child inherits its parent thread's mask); then
+// the thread's own mask is back.
+class ScopedThreadCpus {
+public:
+  explicit ScopedThreadCpus(const std::vector<unsigned> &cpus);
+  ~ScopedThreadCpus();
+  ScopedThreadCpus(const ScopedThreadCpus &) = delete;
+  ScopedThreadCpus &operator=(const ScopedThreadCpus &) = delete;
+  // Whether the mask is set (false: the kernel refused it, errno says why).
+  bool pinned() const { return pinned_; }
+
+private:
+  cpu_set_t saved_{};
+  bool pinned_ = false;
+};
+
+// Sets the placement's nice value on every thread of `pid` (nice cannot go back down without
+// privilege, so it is set on the child, not around its start). A process already gone is no
+// error: its exit is reported as any exit.
+Expected<void> apply_nice(pid_t pid, const ProcessPlacement &placement);
 
 } // namespace rsca::gpp

@@ -4,6 +4,9 @@
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
+
+#include <cerrno>
+#include <cstring>
 #include <spdlog/spdlog.h>
 
 #include "affinity.hpp"
@@ -142,7 +145,20 @@ GppDevice::execute(const protocol::node::ExecuteRequest &r,
       request.env.emplace_back(shm::kArenaVariable, reserved->second);
     }
   }
+  // The process starts on its CPUs (it inherits this thread's mask while it is set).
+  std::optional<ScopedThreadCpus> pinned;
+  if (placement && !placement->cpus.empty()) {
+    pinned.emplace(placement->cpus);
+    if (!pinned->pinned()) {
+      if (page)
+        context_.host_data->release_page(*page);
+      return control::call_error(
+          Status::Failed, fmt::format("{}: cannot run on CPUs {}: {}", context_.id,
+                                      fmt::join(placement->cpus, ","), std::strerror(errno)));
+    }
+  }
   auto pid = launcher_.execute(request);
+  pinned.reset();
   if (!pid) {
     if (page)
       context_.host_data->release_page(*page);
@@ -150,7 +166,7 @@ GppDevice::execute(const protocol::node::ExecuteRequest &r,
                                fmt::format("{}: {}", context_.id, pid.error().to_string()));
   }
   if (placement) {
-    if (auto applied = apply_placement(*pid, *placement); !applied) {
+    if (auto applied = apply_nice(*pid, *placement); !applied) {
       (void)launcher_.terminate(*pid, {});
       if (page)
         context_.host_data->release_page(*page);

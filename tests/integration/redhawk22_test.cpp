@@ -49,22 +49,36 @@ TEST_CASE("an instance's affinity and loggingconfig reach its process",
   CHECK_THAT(cmdline, Catch::Contains("DEBUG_LEVEL 4"));
 }
 
-TEST_CASE("a package missing its PRF installs with a warning and its launch fails naming the file",
-          "[integration][redhawk22][failure]") {
+// A SAD whose component misses a file (its PRF, or its SPD altogether) installs with a warning,
+// as REDHAWK reads it; a launch fails at its first step naming the component and the file.
+static void check_missing(const std::string &application, const std::string &component,
+                          const std::string &file) {
   TestDomain domain;
   auto [rc_install, installed] =
       domain.cli({"install", "--sdrroot", kTestSdr.string(),
-                  (kTestSdr / "dom/waveforms/MissingPrf/MissingPrf.sad.xml").string()});
+                  (kTestSdr / fmt::format("dom/waveforms/{0}/{0}.sad.xml", application)).string()});
   INFO(installed);
   REQUIRE(rc_install == 0);
-  CHECK_THAT(installed, Catch::Contains("NoPrf.prf.xml"));
+  CHECK_THAT(installed, Catch::Contains("warning: missing-file"));
+  CHECK_THAT(installed, Catch::Contains(file));
 
-  auto [rc, out] = domain.cli({"launch", "MissingPrf"});
+  auto [rc, out] = domain.cli({"launch", application});
   INFO(out);
   CHECK(rc == 1); // the profile cannot be launched as it is (kInvalidProfile)
   CHECK_THAT(out, Catch::Contains("failed at step 'check'"));
-  CHECK_THAT(out, Catch::Contains("component NoPrf_1 cannot be launched"));
-  CHECK_THAT(out, Catch::Contains("NoPrf.prf.xml"));
+  CHECK_THAT(out, Catch::Contains(fmt::format("component {} cannot be launched", component)));
+  CHECK_THAT(out, Catch::Contains(file));
   domain.require_clean({});
   CHECK(domain.running_pids().empty());
+}
+
+TEST_CASE("a package missing its PRF installs with a warning and its launch fails naming the file",
+          "[integration][redhawk22][failure]") {
+  check_missing("MissingPrf", "NoPrf_1", "NoPrf.prf.xml");
+}
+
+TEST_CASE("a SAD naming an SPD that is not there installs with a warning and its launch fails "
+          "naming the file",
+          "[integration][redhawk22][failure]") {
+  check_missing("MissingSpd", "Gone_1", "Gone.spd.xml");
 }

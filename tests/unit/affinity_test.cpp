@@ -60,54 +60,75 @@ TEST_CASE("CPU lists", "[affinity]") {
 
 TEST_CASE("affinity directives resolve against the host", "[affinity]") {
   FakeSys sys;
-  auto resolve = [&](std::string directive, std::string value) {
+  const std::vector<unsigned> all{0, 1, 2, 3, 4, 5, 6, 7};
+  auto resolve = [&](std::string directive, std::string value,
+                     const std::vector<unsigned> &usable) {
     return gpp::resolve_affinity(AffinityDirective{std::move(directive), std::move(value)},
-                                 sys.root());
+                                 sys.root(), usable);
   };
-  CHECK(resolve("cpu", "1,6")->cpus == std::vector<unsigned>{1, 6});
-  CHECK(resolve("socket", "1")->cpus == std::vector<unsigned>{4, 5, 6, 7});
-  CHECK(resolve("socket", "0-1")->cpus.size() == 8);
-  CHECK(resolve("nic", "eth1")->cpus == std::vector<unsigned>{4, 5, 6, 7});
-  auto nice = resolve("nice", "10");
+  auto resolve_any = [&](std::string directive, std::string value) {
+    return resolve(std::move(directive), std::move(value), all);
+  };
+  CHECK(resolve_any("cpu", "1,6")->cpus == std::vector<unsigned>{1, 6});
+  CHECK(resolve_any("socket", "1")->cpus == std::vector<unsigned>{4, 5, 6, 7});
+  CHECK(resolve_any("socket", "0-1")->cpus.size() == 8);
+  CHECK(resolve_any("nic", "eth1")->cpus == std::vector<unsigned>{4, 5, 6, 7});
+  auto nice = resolve_any("nice", "10");
   REQUIRE(nice.has_value());
   CHECK(nice->cpus.empty());
   CHECK(nice->nice == 10);
 
-  CHECK_THAT(message(resolve("cpu", "9").error()), Catch::Contains("cpu 9 is not online"));
-  CHECK_THAT(message(resolve("socket", "2").error()), Catch::Contains("NUMA node 2 is not"));
-  CHECK_THAT(message(resolve("nic", "veth0").error()), Catch::Contains("no device"));
-  CHECK_THAT(message(resolve("nic", "wlan9").error()), Catch::Contains("not on this host"));
+  CHECK_THAT(message(resolve_any("cpu", "9").error()), Catch::Contains("cpu 9 is not online"));
+  CHECK_THAT(message(resolve_any("socket", "2").error()), Catch::Contains("NUMA node 2 is not"));
+  CHECK_THAT(message(resolve_any("nic", "veth0").error()), Catch::Contains("no device"));
+  CHECK_THAT(message(resolve_any("nic", "wlan9").error()), Catch::Contains("not on this host"));
   // A name that would reach another /sys path is refused before any path is made of it.
-  CHECK_THAT(message(resolve("nic", "../../x").error()),
+  CHECK_THAT(message(resolve_any("nic", "../../x").error()),
              Catch::Contains("not a network interface name"));
-  CHECK(!resolve("nice", "20").has_value());
-  CHECK(!resolve("nice", "x").has_value());
-  CHECK(!resolve("cgroup", "rt").has_value());
-  CHECK(!resolve("cpu", std::string(300, '1')).has_value());
+  CHECK(!resolve_any("nice", "20").has_value());
+  CHECK(!resolve_any("nice", "x").has_value());
+  CHECK(!resolve_any("cgroup", "rt").has_value());
+  CHECK(!resolve_any("cpu", std::string(300, '1')).has_value());
+  // Online is not enough: the node (in a cpuset, say) may use only some CPUs.
+  CHECK_THAT(message(resolve("socket", "1", {0, 1, 2, 3, 4}).error()),
+             Catch::Contains("cpu 5 is not one this node may use"));
+  CHECK(resolve("cpu", "4", {0, 1, 2, 3, 4}).has_value());
 }
 
-TEST_CASE("an affinity applied to a process pins it and sets its nice value", "[affinity]") {
-  cpu_set_t own;
-  REQUIRE(sched_getaffinity(0, sizeof(own), &own) == 0);
-  unsigned first = 0;
-  while (!CPU_ISSET(first, &own))
-    ++first;
-  const pid_t child = fork();
-  REQUIRE(child >= 0);
-  if (child == 0) {
-    pause(); // until killed
-    _exit(0);
+TEST_CASE("a process started while its parent thread is pinned starts on those CPUs",
+          "[affinity]") {
+  const auto usable = gpp::usable_cpus();
+  REQUIRE_FALSE(usable.empty());
+  const unsigned last = usable.back();
+  pid_t child = -1;
+  {
+    gpp::ScopedThreadCpus pinned({last});
+    REQUIRE(pinned.pinned());
+    child = fork();
+    REQUIRE(child >= 0);
+    if (child == 0) {
+      pause(); // until killed
+      _exit(0);
+    }
   }
-  const auto applied = gpp::apply_placement(child, gpp::ProcessPlacement{{first}, 5});
-  cpu_set_t set;
-  REQUIRE(sched_getaffinity(child, sizeof(set), &set) == 0);
+  cpu_set_t child_set;
+  const bool read = sched_getaffinity(child, sizeof(child_set), &child_set) == 0;
+  // The nice value goes on the child: one above this process's, which needs no privilege.
   errno = 0;
-  const int nice = getpriority(PRIO_PROCESS, static_cast<id_t>(child));
+  const int own_nice = getpriority(PRIO_PROCESS, 0);
+  const auto niced = gpp::apply_nice(child, gpp::ProcessPlacement{{}, std::min(own_nice + 1, 19)});
+  errno = 0;
+  const int child_nice = getpriority(PRIO_PROCESS, static_cast<id_t>(child));
   kill(child, SIGKILL);
   waitpid(child, nullptr, 0);
-  INFO((applied ? std::string() : applied.error().to_string()));
-  REQUIRE(applied.has_value());
-  CHECK(CPU_COUNT(&set) == 1);
-  CHECK(CPU_ISSET(first, &set));
-  CHECK(nice == 5);
+  REQUIRE(read);
+  CHECK(CPU_COUNT(&child_set) == 1);
+  CHECK(CPU_ISSET(last, &child_set));
+  // This thread has its own mask back.
+  CHECK(gpp::usable_cpus() == usable);
+  INFO((niced ? std::string() : niced.error().to_string()));
+  REQUIRE(niced.has_value());
+  CHECK(child_nice == std::min(own_nice + 1, 19));
+  // A process already gone is no error.
+  CHECK(gpp::apply_nice(child, gpp::ProcessPlacement{{}, 5}).has_value());
 }

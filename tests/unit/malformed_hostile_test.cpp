@@ -175,6 +175,17 @@ TEST_CASE("independent errors in one file are all reported", "[malformed][partia
   }
 }
 
+TEST_CASE("a second DOCTYPE is refused where it stands, before Xerces reads it",
+          "[malformed][entities]") {
+  // XML allows one; Xerces leaks the declaration of one it reads (found by tools/fuzz).
+  TempDir dir;
+  const fs::path file = dir.path() / "twice.prf.xml";
+  write_file(file, "<!DOCTYPE a>\n<!-- between -->\n  <!DOCTYPE s SYSTEM \"x\">\n<properties/>\n");
+  auto result = read_descriptor(file);
+  check(error_of(result).diagnostics().front(), "xml", file.string(), 3, 3,
+        {"a second DOCTYPE declaration"});
+}
+
 TEST_CASE("a UTF-16 file is refused before any DTD in it is read", "[malformed][entities]") {
   TempDir dir;
   const fs::path file = dir.path() / "utf16.sad.xml";

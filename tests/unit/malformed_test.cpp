@@ -113,6 +113,32 @@ TEST_CASE("elements out of order are reported with the expected order", "[malfor
   CHECK_THAT(d.message, Contains("componentfiles,partitioning,assemblycontroller"));
 }
 
+TEST_CASE("an unknown attribute on an rsca extension element is refused", "[malformed][schema]") {
+  // REDHAWK has no <timing>: a misspelt attribute there is a mistake, not a REDHAWK form.
+  TempDir dir;
+  const fs::path file = dir.path() / "timing.sad.xml";
+  write_file(file, "<softwareassembly id=\"x\" name=\"x\">\n"
+                   "<componentfiles><componentfile id=\"c\" type=\"SPD\">"
+                   "<localfile name=\"/c.spd.xml\"/></componentfile></componentfiles>\n"
+                   "<partitioning><componentplacement><componentfileref refid=\"c\"/>\n"
+                   "<componentinstantiation id=\"i\"><timing perod=\"1ms\"/>"
+                   "</componentinstantiation></componentplacement></partitioning>\n"
+                   "<assemblycontroller><componentinstantiationref refid=\"i\"/>"
+                   "</assemblycontroller></softwareassembly>\n");
+  single_file_error(file, "schema", 4, 53,
+                    {"attribute 'perod' is not declared for element 'timing'"});
+}
+
+TEST_CASE("text in an element that holds only attributes is refused, saying so",
+          "[malformed][schema]") {
+  TempDir dir;
+  const fs::path file = dir.path() / "text.prf.xml";
+  write_file(file, "<properties>\n<simple id=\"a\" type=\"long\">\n"
+                   "<kind kindtype=\"property\">oops</kind>\n</simple>\n</properties>\n");
+  single_file_error(file, "schema", 3, 38,
+                    {"this element holds only attributes: text \"oops\" is not allowed in it"});
+}
+
 TEST_CASE("a root element that is no profile is refused", "[malformed][schema]") {
   single_file_error(fixture("schema/wrong_root.sad.xml"), "schema", 3, 7,
                     {"<html> is not the root of a domain profile", "softwareassembly (SAD)"});

@@ -279,6 +279,10 @@ TEST_CASE("planner: a hostcollocation's cpucores reservation is a floor on its C
     const Plan plan = require_plan(make_plan(busy, request));
     CHECK(placement_of(plan, "a").node == "n2");
     CHECK(placement_of(plan, "b").node == "n2");
+    // Charged 80 % together although n1 was tried first (and left: 50 % free).
+    CHECK(placement_of(plan, "a").demand.at(kCpuCapacity) +
+              placement_of(plan, "b").demand.at(kCpuCapacity) ==
+          Approx(80.0));
   }
 }
 
@@ -308,7 +312,6 @@ TEST_CASE("planner: a hostcollocation's usesdeviceref puts it next to that devic
     CHECK(plan.application_devices[0].device == "n2:radio");
   }
   SECTION("two collocations tied to one device on different nodes are rejected") {
-    const auto full = domain_state({gpp_device("n1:GPP", "n1"), gpp_device("n2:GPP", "n2"), radio});
     auto big = softpkg("big", {ImplSpec("cpp").utilization(0.6)});
     PlanRequest two = request_of({component_request("a", big), component_request("b", big)});
     two.uses_devices.push_back(uses_device("radio", {ref("kind", "radio")}));
@@ -317,7 +320,33 @@ TEST_CASE("planner: a hostcollocation's usesdeviceref puts it next to that devic
     two.collocations = {{"g1", 0.0, {"radio"}}, {"g2", 0.0, {"radio"}}};
     // 60 + 60 % cannot share a one-core node; apart they are on two nodes, one of them not
     // the radio's.
-    const auto rejections = require_rejection(make_plan(full, two));
+    const auto rejections = require_rejection(make_plan(state, two));
     CHECK_THAT(to_string(rejections), Catch::Contains("usesdevice radio"));
+  }
+  SECTION("a node without the device is left at once, not after the rest is placed") {
+    // Six nodes, the radio on n6, the collocation first in order (fewest candidates), and ten
+    // more components of two implementations each: searching every placement of those under
+    // a collocation on the wrong node would take far more than this budget.
+    std::vector<Device> devices;
+    for (int n = 1; n <= 6; ++n)
+      devices.push_back(gpp_device(fmt::format("n{}:GPP", n), fmt::format("n{}", n)));
+    devices.push_back(
+        peripheral("n6:radio", "n6", {{"kind", "kind", "radio", profile::Action::Eq}}, {}));
+    const auto six = domain_state(devices);
+    auto light =
+        softpkg("light", {ImplSpec("a").utilization(0.05), ImplSpec("b").utilization(0.05)});
+    std::vector<ComponentRequest> components{component_request("a", pkg),
+                                             component_request("b", pkg)};
+    for (int k = 0; k < 10; ++k)
+      components.push_back(component_request(fmt::format("x{}", k), light));
+    PlanRequest wide = request_of(components);
+    wide.uses_devices.push_back(uses_device("radio", {ref("kind", "radio")}));
+    wide.components[0].collocation = wide.components[1].collocation = "g";
+    wide.collocations.push_back({"g", 0.0, {"radio"}});
+    PlanOptions small = with(Strategy::Pack);
+    small.budget = 100;
+    const Plan plan = require_plan(make_plan(six, wide, small));
+    CHECK(placement_of(plan, "a").node == "n6");
+    CHECK(placement_of(plan, "b").node == "n6");
   }
 }
