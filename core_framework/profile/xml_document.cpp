@@ -43,23 +43,41 @@ std::size_t blank_declaration(std::string &text, std::size_t i) {
   return text.size();
 }
 
+// Where the XML declaration starting at `i` ends: its values are quoted, and Xerces reads them so
+// (a "?>" inside quotes does not end it), so this reads it the same way.
+std::size_t end_of_xml_declaration(const std::string &text, std::size_t i) {
+  char quote = 0;
+  for (std::size_t j = i + 5; j < text.size(); ++j) {
+    const char c = text[j];
+    if (quote != 0)
+      quote = c == quote ? 0 : quote;
+    else if (c == '"' || c == '\'')
+      quote = c;
+    else if (c == '?' && j + 1 < text.size() && text[j + 1] == '>')
+      return j + 2;
+  }
+  return text.size();
+}
+
 // Blanks the DOCTYPE declaration in the prolog (keeping line breaks, so positions stay), and
 // returns where a second one starts, if any: XML allows one, and Xerces leaks the declaration of
 // one it sees, so none reaches it.
 std::optional<std::size_t> blank_doctype(std::string &text) {
   std::size_t i = text.rfind("\xEF\xBB\xBF", 0) == 0 ? 3 : 0;
-  auto skip_past = [&](std::string_view end) {
-    auto at = text.find(end, i);
+  auto skip_past = [&](std::string_view start, std::string_view end) {
+    auto at = text.find(end, i + start.size());
     i = at == std::string::npos ? text.size() : at + end.size();
   };
   bool blanked = false;
   while (i < text.size()) {
     if (std::isspace(static_cast<unsigned char>(text[i]))) {
       ++i;
+    } else if (text.compare(i, 5, "<?xml") == 0) {
+      i = end_of_xml_declaration(text, i);
     } else if (text.compare(i, 2, "<?") == 0) {
-      skip_past("?>");
+      skip_past("<?", "?>");
     } else if (text.compare(i, 4, "<!--") == 0) {
-      skip_past("-->");
+      skip_past("<!--", "-->");
     } else if (text.compare(i, 9, "<!DOCTYPE") == 0) {
       if (blanked)
         return i;
