@@ -186,7 +186,7 @@ TEST_CASE("a second DOCTYPE is refused where it stands, before Xerces reads it",
         {"a second DOCTYPE declaration"});
 }
 
-TEST_CASE("a DOCTYPE after an XML declaration with \"?>\" in a quoted value is blanked too",
+TEST_CASE("a DOCTYPE after an XML declaration with ?> in a quoted value is blanked too",
           "[malformed][entities]") {
   // Xerces reads the declaration's values quoted; the prolog scan must too, or the DOCTYPE that
   // follows reaches Xerces (which leaks its declaration: found by tools/fuzz; the sanitizer
@@ -196,12 +196,11 @@ TEST_CASE("a DOCTYPE after an XML declaration with \"?>\" in a quoted value is b
   write_file(file, "<?xml version=\"1.?><?>\n<0\" encoding=\"UTF-8\"?>\n"
                    "<!DOCTYPE properties PUBLIC \"-//JTRS//DTD SCA V2.2.2 PRF//EN\" \"p.dtd\">\n"
                    "<properties/>\n");
+  // Xerces takes that version text; the DOCTYPE it never sees. Read, nothing leaked.
   auto result = read_descriptor(file);
-  const Diagnostic &d = error_of(result).diagnostics().front();
-  INFO(to_string(d));
-  CHECK(d.rule == "xml");
-  CHECK(d.where.file == file.string());
-  CHECK(d.where.line >= 1);
+  INFO((result ? std::string() : result.error().to_string()));
+  REQUIRE(result.has_value());
+  CHECK(std::holds_alternative<Properties>(*result));
 }
 
 TEST_CASE("a UTF-16 file is refused before any DTD in it is read", "[malformed][entities]") {
