@@ -99,10 +99,6 @@ std::vector<std::string> ApplicationFactory::Launch::unsupported_connections() c
         out.push_back(fmt::format("connection {}: only event channels can be found by findby; "
                                   "\"{}\" is not one",
                                   id, end->findby.name));
-      if (end->kind == Kind::DeviceUsedByApplication)
-        out.push_back(fmt::format("connection {}: a port of the device the application uses "
-                                  "(deviceusedbyapplication {}) cannot be connected yet",
-                                  id, end->usesrefid));
       if (end->kind == Kind::ComponentInstantiation &&
           sad.find_instantiation(end->refid) == nullptr)
         out.push_back(fmt::format("connection {}: \"{}\" is no component of the application (a "
@@ -111,7 +107,7 @@ std::vector<std::string> ApplicationFactory::Launch::unsupported_connections() c
     }
     const auto is_device = [](const profile::EndpointTarget &t) {
       return t.kind == Kind::DeviceThatLoadedThisComponent ||
-             t.kind == Kind::DeviceUsedByThisComponent;
+             t.kind == Kind::DeviceUsedByThisComponent || t.kind == Kind::DeviceUsedByApplication;
     };
     if ((c.publishes_to_channel() && is_device(c.uses.target)) ||
         (c.subscribes_to_channel() && is_device(c.provides.target)))

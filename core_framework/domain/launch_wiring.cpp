@@ -135,6 +135,13 @@ ApplicationFactory::Launch::resolve_end(ConnectionInstance &ci,
 
 tl::expected<std::string, std::string>
 ApplicationFactory::Launch::device_of(const profile::EndpointTarget &target) const {
+  // The SAD's own usesdevice (deviceusedbyapplication): the device the plan gave the application.
+  if (target.kind == profile::EndpointTarget::Kind::DeviceUsedByApplication) {
+    for (const auto &used : app_->plan.application_devices)
+      if (used.uses_id == target.usesrefid)
+        return used.device;
+    return tl::unexpected(fmt::format("the application has no usesdevice {}", target.usesrefid));
+  }
   const auto *placement = placement_of(target.refid);
   if (placement == nullptr)
     return tl::unexpected(fmt::format("no component {} in the application", target.refid));

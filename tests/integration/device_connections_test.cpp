@@ -57,6 +57,25 @@ TEST_CASE("a SAD connection to a port of the device a component uses carries dat
   domain.require_clean(pids_of(*app));
 }
 
+TEST_CASE("a SAD connection to a port of the device the application uses (deviceusedbyapplication) "
+          "carries data",
+          "[integration][connections][devices][redhawk22]") {
+  TestDomain domain({TestDomain::shipped_nodes(1)[0], kMonitorNode});
+  domain.install("WatchByApplication");
+  auto [rc, out] = domain.cli({"launch", "WatchByApplication"});
+  INFO(out);
+  REQUIRE(rc == 0);
+  auto app = domain.call("app.show", Json{{"app", "WatchByApplication"}});
+  REQUIRE(app.has_value());
+  CHECK(app->at("connections")[0].at("uses") == "monitor:HostMonitor_1.status_out");
+  CHECK(TestDomain::wait_for([&] {
+    return query_long(domain, "WatchByApplication", "Watcher_1", "events_received") > 5;
+  }));
+  REQUIRE(domain.call("app.release", Json{{"app", "WatchByApplication"}}).has_value());
+  CHECK(port_connections(domain, kMonitor, "status_out") == 0);
+  domain.require_clean(pids_of(*app));
+}
+
 TEST_CASE("a connection to a device that registers later, or to an application not launched "
           "yet, waits and is completed when it appears, and waits again when that end goes",
           "[integration][connections][devices][pending]") {
