@@ -328,6 +328,8 @@ CallResult<void> ApplicationFactory::Launch::configure() {
             profile::is_empty_override(*definition, ref))
           continue;
         auto value = profile::bind_property(*definition, ref);
+        if (!value && profile::names_unknown_members_only(value.error()))
+          continue; // ignored, as the loader warned
         if (!value)
           return control::call_error(Status::BadRequest,
                                      fmt::format("{}: {}", ci.id, value.error().to_string()));

@@ -43,8 +43,18 @@ void check_property_refs(const ResolvedSoftPkg &pkg, const std::vector<PropertyR
                            Severity::Warning});
       continue;
     }
-    if (auto bound = bind_property(*definition, ref); !bound)
+    auto bound = bind_property(*definition, ref);
+    if (bound)
+      continue;
+    if (!names_unknown_members_only(bound.error())) {
       errors.append(bound.error());
+      continue;
+    }
+    for (auto d : bound.error().diagnostics()) {
+      d.severity = Severity::Warning;
+      d.message = fmt::format("{}: {}: the override is ignored", owner, d.message);
+      tolerated.push_back(std::move(d));
+    }
   }
 }
 

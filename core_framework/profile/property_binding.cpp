@@ -1,5 +1,7 @@
 #include "profile/property_binding.hpp"
 
+#include <algorithm>
+
 #include <fmt/format.h>
 
 namespace rsca::profile {
@@ -134,6 +136,13 @@ bool is_empty_override(const SimpleProperty &definition, const PropertyRef &ref)
   const bool textual =
       definition.type.type == SimpleType::String || definition.type.type == SimpleType::ObjRef;
   return !textual && value->value.find_first_not_of(" \t\r\n") == std::string::npos;
+}
+
+bool names_unknown_members_only(const Error &binding) {
+  const auto &d = binding.diagnostics();
+  return !d.empty() && std::all_of(d.begin(), d.end(), [](const Diagnostic &one) {
+    return one.rule == "unknown-property";
+  });
 }
 
 bool is_empty_override(const PropertyDefinition &definition, const PropertyRef &ref) {

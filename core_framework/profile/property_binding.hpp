@@ -16,4 +16,8 @@ Expected<PropertyValue> bind_property(const PropertyDefinition &definition, cons
 bool is_empty_override(const PropertyDefinition &definition, const PropertyRef &ref);
 bool is_empty_override(const SimpleProperty &definition, const PropertyRef &ref);
 
+// Whether binding failed only because the override names struct members the PRF does not
+// define: REDHAWK warns and ignores such an override, as one of a property the PRF lacks.
+bool names_unknown_members_only(const Error &binding);
+
 } // namespace rsca::profile

@@ -72,7 +72,8 @@ std::optional<std::size_t> blank_doctype(std::string &text) {
   while (i < text.size()) {
     if (std::isspace(static_cast<unsigned char>(text[i]))) {
       ++i;
-    } else if (text.compare(i, 5, "<?xml") == 0) {
+    } else if (text.compare(i, 5, "<?xml") == 0 && i + 5 < text.size() &&
+               std::isspace(static_cast<unsigned char>(text[i + 5]))) {
       i = end_of_xml_declaration(text, i);
     } else if (text.compare(i, 2, "<?") == 0) {
       skip_past("<?", "?>");
@@ -146,10 +147,17 @@ Expected<XmlDocument> read_xml_profile_text(std::string_view text, std::string f
   if (!reader)
     return tl::unexpected(reader.error());
   std::string without_doctype(text);
-  if (auto second = blank_doctype(without_doctype)) {
+  auto second = blank_doctype(without_doctype);
+  // Any DOCTYPE left (a second one, or one after a prolog this scan reads otherwise than Xerces
+  // would) is refused before Xerces sees it: no profile has one there (REDHAWK's have one, at
+  // the start), and Xerces leaks what it reads of one.
+  if (!second)
+    if (const auto left = without_doctype.find("<!DOCTYPE"); left != std::string::npos)
+      second = left;
+  if (second) {
     const auto [line, column] = position_of(text, *second);
     return make_error({file_name, line, column}, "xml",
-                      "a second DOCTYPE declaration: a document has at most one");
+                      "a DOCTYPE declaration here: a profile has at most one, at its start");
   }
   return (*reader)->read(without_doctype, file_name);
 }

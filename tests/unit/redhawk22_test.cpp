@@ -98,7 +98,7 @@ TEST_CASE("REDHAWK 2.2 SAD forms are read and modelled", "[redhawk22][sad]") {
     CHECK(hc.uses_device_refs == std::vector<std::string>{"radio"});
     REQUIRE(hc.cpu_cores.has_value());
     CHECK(*hc.cpu_cores == 1.5);
-    CHECK_THAT(warning_at(w, "unknown-value", 28).message, Contains("reservation kind \"memory\""));
+    CHECK_THAT(warning_at(w, "unknown-value", 31).message, Contains("reservation kind \"memory\""));
   }
   SECTION("affinity and loggingconfig of an instance") {
     const auto *ci = app.sad->find_instantiation("comp_1");
@@ -111,7 +111,7 @@ TEST_CASE("REDHAWK 2.2 SAD forms are read and modelled", "[redhawk22][sad]") {
     CHECK(ci->logging->uri == "file:///etc/comp.log4j");
     // A cgroup is REDHAWK's; rsca reads it and applies nothing.
     CHECK_FALSE(app.sad->find_instantiation("comp_2")->affinity.has_value());
-    CHECK_THAT(warning_at(w, "unknown-value", 34).message, Contains("affinity class \"cgroup\""));
+    CHECK_THAT(warning_at(w, "unknown-value", 37).message, Contains("affinity class \"cgroup\""));
   }
   SECTION("a startorder that is no number, a componentfile type that is not SPD") {
     CHECK_FALSE(app.sad->find_instantiation("comp_1")->start_order.has_value());
@@ -128,10 +128,12 @@ TEST_CASE("REDHAWK 2.2 SAD forms are read and modelled", "[redhawk22][sad]") {
   SECTION("overrides REDHAWK ignores: an empty number, a property the PRF lacks") {
     CHECK_THAT(warning_at(w, "empty-value", 16).message, Contains("property \"gain\""));
     CHECK_THAT(warning_at(w, "unknown-property", 17).message, Contains("\"volume\""));
+    CHECK_THAT(warning_at(w, "unknown-property", 18).message,
+               Contains("struct \"limits\" has no member \"limits::high\""));
     CHECK(app.warnings.empty()); // nothing here stops a launch by itself
   }
   SECTION("a domainfinder type nobody defines") {
-    CHECK_THAT(warning_at(w, "unknown-value", 60).message, Contains("\"service\""));
+    CHECK_THAT(warning_at(w, "unknown-value", 63).message, Contains("\"service\""));
   }
 }
 
@@ -147,7 +149,7 @@ TEST_CASE("a usesdeviceref or deviceusedbyapplication naming no usesdevice is re
   auto read = read_descriptor(copy);
   const Error &error = error_of(read);
   REQUIRE(error.diagnostics().size() == 1);
-  check(error.diagnostics().front(), "dangling-ref", copy.string(), 26, 37,
+  check(error.diagnostics().front(), "dangling-ref", copy.string(), 29, 37,
         {"hostcollocation \"near_radio\" names usesdevice \"radar\""});
 }
 
