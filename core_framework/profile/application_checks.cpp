@@ -1,5 +1,6 @@
 #include "profile/application_checks.hpp"
 
+#include <cstdint>
 #include <set>
 
 #include <fmt/format.h>
@@ -15,11 +16,16 @@ std::string file_name(const std::filesystem::path &p) {
   return p.filename().string();
 }
 
+// What an override whose value does not fit its property is: an error in a SAD (the launch would
+// configure the component with it), ignored with a warning in a DCD (REDHAWK's DeviceManager logs
+// it and starts the device with its default; rsca's node skips it the same way).
+enum class BadValue : std::uint8_t { Refused, Ignored };
+
 // Each override must carry a value that fits its property; one that names no property of the
 // package is ignored with a warning, as REDHAWK does. A package whose files are missing is not
 // checked: its missing files are reported already.
 void check_property_refs(const ResolvedSoftPkg &pkg, const std::vector<PropertyRef> &refs,
-                         std::string_view owner, Error &errors,
+                         std::string_view owner, BadValue bad_value, Error &errors,
                          std::vector<Diagnostic> &tolerated) {
   if (!pkg.unavailable.empty() && pkg.properties == nullptr)
     return;
@@ -46,7 +52,7 @@ void check_property_refs(const ResolvedSoftPkg &pkg, const std::vector<PropertyR
     auto bound = bind_property(*definition, ref);
     if (bound)
       continue;
-    if (!names_unknown_members_only(bound.error())) {
+    if (bad_value == BadValue::Refused && !names_unknown_members_only(bound.error())) {
       errors.append(bound.error());
       continue;
     }
@@ -74,8 +80,8 @@ public:
       for (const auto &ci : placement.instantiations)
         if (const ResolvedSoftPkg *pkg = app_.softpkg_of(placement))
           check_property_refs(*pkg, ci.properties,
-                              fmt::format("componentinstantiation \"{}\"", ci.id), errors_,
-                              tolerated_);
+                              fmt::format("componentinstantiation \"{}\"", ci.id),
+                              BadValue::Refused, errors_, tolerated_);
     for (const auto &c : app_.sad->connections)
       check_connection(c);
     for (const auto &p : app_.sad->external_ports)
@@ -238,7 +244,7 @@ std::vector<Diagnostic> check_node(const ResolvedNode &node, std::vector<Diagnos
       continue;
     for (const auto &ci : placement.instantiations) {
       check_property_refs(*device.softpkg, ci.properties, fmt::format("device \"{}\"", ci.id),
-                          errors, tolerated);
+                          BadValue::Ignored, errors, tolerated);
     }
   }
   return errors.diagnostics();

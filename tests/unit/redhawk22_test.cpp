@@ -164,11 +164,15 @@ TEST_CASE("REDHAWK 2.2 DCD forms are read and modelled", "[redhawk22][dcd]") {
   CHECK(ci.logging->debug_level == 5); // TRACE
   REQUIRE(ci.device_requires.size() == 1);
   // White space inside elements that hold only attributes is no finding at all; the missing
-  // DeviceManager SPD and the connection to the DeviceManager are.
-  CHECK(node->tolerated.size() == 2);
+  // DeviceManager SPD, the connection to the DeviceManager and the bad value are.
+  // A device's value that does not fit its property: REDHAWK's DeviceManager logs it and starts
+  // the device with its default; so do rsca's node and loader.
+  CHECK(node->tolerated.size() == 3);
+  CHECK_THAT(warning_at(node->tolerated, "value", 21).message,
+             Contains("the override is ignored"));
   CHECK_THAT(warning_at(node->tolerated, "missing-file", 5).message,
              Contains("rsca-noded is the DeviceManager"));
-  CHECK_THAT(warning_at(node->tolerated, "dangling-ref", 35).message, Contains("DeviceManager"));
+  CHECK_THAT(warning_at(node->tolerated, "dangling-ref", 38).message, Contains("DeviceManager"));
   CHECK(node->warnings.empty());
 }
 
