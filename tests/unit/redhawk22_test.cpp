@@ -168,8 +168,7 @@ TEST_CASE("REDHAWK 2.2 DCD forms are read and modelled", "[redhawk22][dcd]") {
   // A device's value that does not fit its property: REDHAWK's DeviceManager logs it and starts
   // the device with its default; so do rsca's node and loader.
   CHECK(node->tolerated.size() == 3);
-  CHECK_THAT(warning_at(node->tolerated, "value", 21).message,
-             Contains("the override is ignored"));
+  CHECK_THAT(warning_at(node->tolerated, "value", 21).message, Contains("the override is ignored"));
   CHECK_THAT(warning_at(node->tolerated, "missing-file", 5).message,
              Contains("rsca-noded is the DeviceManager"));
   CHECK_THAT(warning_at(node->tolerated, "dangling-ref", 38).message, Contains("DeviceManager"));
