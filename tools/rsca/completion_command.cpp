@@ -90,7 +90,8 @@ void add_completion_command(CLI::App &app, int &exit_code) {
                                                "source <(rsca completion bash)");
   auto shell = std::make_shared<std::string>();
   cmd->add_option("shell", *shell, "The shell")->required()->check(CLI::IsMember({"bash"}));
-  cmd->callback([&app, &exit_code] {
+  // The callback holds `shell`: the option writes into it when the command line is parsed.
+  cmd->callback([&app, &exit_code, shell] {
     fmt::print("{}", bash_script(app));
     exit_code = kOk;
   });
