@@ -11,7 +11,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
-#include "common/own_folder.hpp"
+#include "common/install_layout.hpp"
 #include "component/in_process.hpp"
 #include "component/process.hpp"
 #include "component/runtime.hpp"
@@ -26,18 +26,16 @@ using detail::ExitEvents;
 
 // Takes LIBRARY out of the group's other parameters.
 // The library as the SPD names it: absolute, or relative to the SPD's folder; one that is not
-// there is looked up by name in the host's own lib folder (where the build puts the example
-// components' libraries) and next to the host.
+// there is looked up by name where rsca keeps component code (common/install_layout.hpp: the
+// example components' libraries, built or installed).
 fs::path resolve_library(const fs::path &library, const fs::path &spd) {
   const fs::path named = library.is_absolute() ? library : spd.parent_path() / library;
   std::error_code ec;
   if (fs::exists(named, ec))
     return named;
-  const fs::path exe_dir = own_folder();
-  for (const auto &candidate :
-       {exe_dir / "../lib" / library.filename(), exe_dir / library.filename()})
-    if (fs::exists(candidate, ec))
-      return candidate;
+  for (const auto &folder : layout::component_folders())
+    if (fs::exists(folder / library.filename(), ec))
+      return folder / library.filename();
   return named;
 }
 

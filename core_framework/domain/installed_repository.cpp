@@ -9,6 +9,7 @@
 #include <spdlog/spdlog.h>
 
 #include "common/names.hpp"
+#include "content/base64.hpp"
 #include "profile/runtime_model.hpp"
 
 namespace rsca::domain {
@@ -71,22 +72,53 @@ std::string unique_name(std::string_view what) {
   return fmt::format("{}-{}-{}", what, ::getpid(), ++counter);
 }
 
+// A file's bytes: its text, or its base64 decoded; at most `budget` of them.
+CallResult<std::string> content_of(const InstallFile &f, std::uint64_t budget) {
+  using protocol::domain::FileEncoding;
+  std::optional<std::string> bytes = f.content;
+  if (f.encoding.value_or(FileEncoding::Text) == FileEncoding::Base64)
+    bytes = content::base64_decode(f.content);
+  if (!bytes)
+    return control::call_error(Status::BadRequest,
+                               fmt::format("file {}: its content is not base64", excerpt(f.path)));
+  if (bytes->size() > budget)
+    return control::call_error(Status::BadRequest,
+                               fmt::format("file {}: an install carries at most {} MiB in all",
+                                           excerpt(f.path),
+                                           protocol::domain::kMaxInstallBytes >> 20U));
+  return std::move(*bytes);
+}
+
+CallResult<void> write_file(const fs::path &file, const std::string &bytes, bool executable) {
+  std::error_code ec;
+  fs::create_directories(file.parent_path(), ec);
+  std::ofstream out(file, std::ios::binary);
+  out << bytes;
+  out.close();
+  if (!ec && out && executable)
+    fs::permissions(file, fs::perms::owner_exec | fs::perms::group_exec | fs::perms::others_exec,
+                    fs::perm_options::add, ec);
+  if (ec || !out)
+    return control::call_error(Status::Failed,
+                               fmt::format("writing {} into the repository: {}", file.string(),
+                                           ec ? ec.message() : std::strerror(errno)));
+  return {};
+}
+
 CallResult<void> write_files(const fs::path &dir, const std::vector<InstallFile> &files) {
+  std::uint64_t budget = protocol::domain::kMaxInstallBytes;
   for (const auto &f : files) {
     auto rel = safe_relative(f.path);
     if (!rel)
       return control::call_error(
           Status::BadRequest,
           fmt::format("file path \"{}\" is not inside an SDR root", excerpt(f.path)));
-    std::error_code ec;
-    fs::create_directories((dir / *rel).parent_path(), ec);
-    std::ofstream out(dir / *rel, std::ios::binary);
-    out << f.content;
-    out.close();
-    if (ec || !out)
-      return control::call_error(Status::Failed,
-                                 fmt::format("writing {} into the repository: {}", excerpt(f.path),
-                                             ec ? ec.message() : std::strerror(errno)));
+    auto bytes = content_of(f, budget);
+    if (!bytes)
+      return tl::unexpected(bytes.error());
+    budget -= bytes->size();
+    if (auto written = write_file(dir / *rel, *bytes, f.executable.value_or(false)); !written)
+      return written;
   }
   return {};
 }

@@ -4,7 +4,7 @@
 #include <spdlog/spdlog.h>
 
 #include "common/daemon_heap.hpp"
-#include "common/own_folder.hpp"
+#include "common/install_layout.hpp"
 #include "common/process_priority.hpp"
 #include "common/termination_signals.hpp"
 #include "dds/participant.hpp"
@@ -38,7 +38,8 @@ int main(int argc, char **argv) {
   std::vector<std::string> exec_path;
   app.add_option("--exec-path", exec_path,
                  "Folders where code an SPD names is looked for when its install did not carry it "
-                 "(default: this program's folder; libraries also in ../lib beside each)");
+                 "(default: this program's folder and where an install puts rsca's components; "
+                 "libraries also in ../lib beside each)");
   std::string strategy = "pack";
   app.add_option("--strategy", strategy,
                  "Placement: pack (fewest devices) or spread (balance load)")
@@ -57,7 +58,7 @@ int main(int argc, char **argv) {
   for (const auto &p : exec_path)
     options.exec_path.emplace_back(p);
   if (options.exec_path.empty())
-    options.exec_path.push_back(rsca::own_folder());
+    options.exec_path = rsca::layout::component_folders();
   if (!dmd.empty()) {
     rsca::profile::ProfileLoader loader;
     auto domain = loader.load_domain(dmd);

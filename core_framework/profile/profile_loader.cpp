@@ -123,7 +123,26 @@ void collect_files(const ResolvedSoftPkg &pkg, std::set<std::filesystem::path> &
   }
 }
 
+void collect_code(const ResolvedSoftPkg &pkg, std::set<std::filesystem::path> &files) {
+  for (const auto &impl : pkg.implementations) {
+    const auto &name = impl.implementation->code.file.name;
+    std::error_code ec;
+    if (const auto code = pkg.spd_path.parent_path() / name;
+        !name.empty() && std::filesystem::is_regular_file(code, ec))
+      files.insert(code.lexically_normal());
+    for (const auto &dep : impl.dependencies)
+      collect_code(*dep.softpkg, files);
+  }
+}
+
 } // namespace
+
+std::set<std::filesystem::path> ResolvedApplication::code_files() const {
+  std::set<std::filesystem::path> files;
+  for (const auto &[id, pkg] : component_files)
+    collect_code(*pkg, files);
+  return files;
+}
 
 std::set<std::filesystem::path> ResolvedApplication::files() const {
   std::set<std::filesystem::path> files{sad_path};

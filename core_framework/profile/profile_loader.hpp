@@ -68,6 +68,10 @@ struct ResolvedApplication {
   // Every profile file the application names: its SAD, and each package's SPD, SCD and PRFs,
   // softpkg dependencies included (what an install carries to the domain).
   std::set<std::filesystem::path> files() const;
+  // The code files its packages name that lie beside their SPDs as regular files (a component
+  // built and installed into an SDR root): an install carries them too. Code elsewhere, or a
+  // folder, is the domain's to find in its exec path.
+  std::set<std::filesystem::path> code_files() const;
 };
 
 struct ResolvedDevicePlacement {

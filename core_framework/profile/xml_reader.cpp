@@ -1,6 +1,6 @@
 #include "profile/xml_reader.hpp"
 
-#include "common/own_folder.hpp"
+#include "common/install_layout.hpp"
 
 #include <dlfcn.h>
 #include <malloc.h>
@@ -18,14 +18,15 @@ namespace fs = std::filesystem;
 
 constexpr const char *kModuleName = "librsca_xml_reader.so";
 
-// Where the module is: $RSCA_XML_READER alone when set; else lib/ beside the running program's
-// bin/ (the build tree and an installed tree alike), then the build tree this library was built in.
+// Where the module is: $RSCA_XML_READER alone when set; else rsca's library folders as seen from
+// the running program (an installed tree or the build tree), then the build tree this library was
+// built in (for programs outside both, such as a component built elsewhere).
 std::vector<fs::path> module_candidates() {
   if (const char *path = std::getenv("RSCA_XML_READER"); path != nullptr && *path != '\0')
     return {fs::path(path)};
   std::vector<fs::path> out;
-  if (auto bin = own_folder(); !bin.empty())
-    out.push_back(bin.parent_path() / "lib" / kModuleName);
+  for (const auto &folder : layout::library_folders())
+    out.push_back(folder / kModuleName);
   out.push_back(fs::path(RSCA_XML_READER_BUILD_DIR) / kModuleName);
   return out;
 }

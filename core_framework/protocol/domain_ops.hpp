@@ -67,13 +67,33 @@ struct Named {
 };
 
 // One file of an application, carried from the CLI (which may run on another host) with its
-// content.
+// content: a profile as text, a component's code (found beside its SPD) in base64.
+enum class FileEncoding : std::uint8_t { Text, Base64 };
+} // namespace rsca::protocol::domain
+
+template <>
+struct rsca::protocol::EnumNames<rsca::protocol::domain::FileEncoding> {
+  using E = domain::FileEncoding;
+  static constexpr std::array names{std::pair{E::Text, "text"}, std::pair{E::Base64, "base64"}};
+};
+
+namespace rsca::protocol::domain {
+
+// What an install may carry in all, decoded: code bigger than this stays in the domain's exec
+// path. A request's frame on a node's control socket holds 16 MiB (kMaxLinkFrame); base64 adds a
+// third.
+inline constexpr std::uint64_t kMaxInstallBytes = 10ULL << 20U;
+
 struct InstallFile {
   std::string path; // relative to the SDR root the profiles came from
   std::string content;
+  std::optional<FileEncoding> encoding; // absent: text
+  std::optional<bool> executable;       // absent: false; the file is made executable
   static constexpr auto fields() {
     return std::tuple{required("path", &InstallFile::path),
-                      required("content", &InstallFile::content)};
+                      required("content", &InstallFile::content),
+                      optional("encoding", &InstallFile::encoding),
+                      optional("executable", &InstallFile::executable)};
   }
 };
 

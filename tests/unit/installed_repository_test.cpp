@@ -8,6 +8,7 @@
 
 #include <catch2/catch.hpp>
 
+#include "content/base64.hpp"
 #include "domain/installed_repository.hpp"
 
 namespace fs = std::filesystem;
@@ -15,6 +16,7 @@ using rsca::control::Status;
 using rsca::domain::DomainStore;
 using rsca::domain::InstalledRepository;
 using rsca::domain::InstallRequest;
+using rsca::protocol::domain::FileEncoding;
 
 namespace {
 
@@ -34,7 +36,7 @@ InstallRequest request_for(const std::string &application) {
   InstallRequest request;
   request.sad = app->sad_path.lexically_relative(kTestSdr).string();
   for (const auto &f : app->files())
-    request.files.push_back({f.lexically_relative(kTestSdr).string(), read(f)});
+    request.files.push_back({f.lexically_relative(kTestSdr).string(), read(f), {}, {}});
   return request;
 }
 
@@ -144,10 +146,30 @@ TEST_CASE("a failed install leaves no staging copy and keeps what was installed 
   }
   SECTION("a file outside the SDR root") {
     auto outside = good;
-    outside.files.push_back({"../../escape.xml", "x"});
+    outside.files.push_back({"../../escape.xml", "x", {}, {}});
     auto installed = box.repository->install(outside);
     REQUIRE_FALSE(installed.has_value());
     CHECK_FALSE(fs::exists(box.root.parent_path() / "escape.xml"));
+  }
+  SECTION("code whose content is not base64") {
+    auto bad = good;
+    bad.files.push_back(
+        {"dom/components/Healthy/healthy", "not base64!", FileEncoding::Base64, true});
+    auto installed = box.repository->install(bad);
+    REQUIRE_FALSE(installed.has_value());
+    CHECK(installed.error().status == Status::BadRequest);
+    CHECK_THAT(installed.error().message, Catch::Contains("not base64"));
+  }
+  SECTION("more bytes than an install carries") {
+    auto big = good;
+    const std::string megabyte(1 << 20, 'x');
+    for (int i = 0; i < 11; ++i)
+      big.files.push_back({"dom/components/big/part" + std::to_string(i),
+                           rsca::content::base64_encode(megabyte), FileEncoding::Base64, false});
+    auto installed = box.repository->install(big);
+    REQUIRE_FALSE(installed.has_value());
+    CHECK(installed.error().status == Status::BadRequest);
+    CHECK_THAT(installed.error().message, Catch::Contains("at most 10 MiB"));
   }
   SECTION("a SAD whose name is 7 MB long") {
     auto huge = good;
@@ -180,4 +202,29 @@ TEST_CASE("a store record that points outside the repository is skipped, never a
   CHECK(box.repository->list().empty());
   CHECK(box.repository->uninstall("victim").error().status == Status::NotFound);
   CHECK(box.victim_intact());
+}
+
+TEST_CASE("code carried in base64 is written as its bytes, executable when it was",
+          "[unit][installed-repository]") {
+  Sandbox box;
+  auto request = request_for("Healthy");
+  std::string binary;
+  for (int i = 0; i < 256; ++i)
+    binary.push_back(static_cast<char>(i));
+  request.files.push_back({"dom/components/Healthy/healthy", rsca::content::base64_encode(binary),
+                           FileEncoding::Base64, true});
+  request.files.push_back({"dom/components/Healthy/libhealthy.so",
+                           rsca::content::base64_encode("lib"), FileEncoding::Base64, false});
+  auto installed = box.repository->install(request);
+  REQUIRE(installed.has_value());
+  auto found = box.repository->find("Healthy");
+  REQUIRE(found.has_value());
+  const fs::path dom = found->sad.parent_path().parent_path().parent_path();
+  CHECK(read(dom / "components/Healthy/healthy") == binary);
+  CHECK(read(dom / "components/Healthy/libhealthy.so") == "lib");
+  const auto exec = [](const fs::path &f) {
+    return (fs::status(f).permissions() & fs::perms::owner_exec) != fs::perms::none;
+  };
+  CHECK(exec(dom / "components/Healthy/healthy"));
+  CHECK_FALSE(exec(dom / "components/Healthy/libhealthy.so"));
 }

@@ -15,6 +15,7 @@
 
 #include "commands.hpp"
 #include "common/names.hpp"
+#include "content/base64.hpp"
 #include "domain_client.hpp"
 #include "exit_codes.hpp"
 #include "profile/profile_loader.hpp"
@@ -46,6 +47,32 @@ std::optional<fs::path> sdrroot_of(const fs::path &file, const GlobalOptions &gl
   return std::nullopt;
 }
 
+// The code beside the application's SPDs (code_files()), in base64, within kMaxInstallBytes for
+// the whole install.
+Expected<void> add_code_files(const profile::ResolvedApplication &app, const fs::path &root,
+                              protocol::domain::InstallRequest &request) {
+  using protocol::domain::kMaxInstallBytes;
+  std::uint64_t bytes = 0;
+  for (const auto &f : request.files)
+    bytes += f.content.size();
+  for (const auto &code : app.code_files()) {
+    std::error_code ec;
+    const auto size = fs::file_size(code, ec);
+    if (ec || size > kMaxInstallBytes - std::min(bytes, kMaxInstallBytes))
+      return make_error({code.string(), 0, 0}, "install-size",
+                        fmt::format("an install carries at most {} MiB in all and this code does "
+                                    "not fit; put it in the domain's --exec-path instead",
+                                    kMaxInstallBytes >> 20U));
+    bytes += size;
+    const auto perms = fs::status(code, ec).permissions();
+    request.files.push_back({code.lexically_relative(root).string(),
+                             content::base64_encode(read_text(code)),
+                             protocol::domain::FileEncoding::Base64,
+                             (perms & fs::perms::owner_exec) != fs::perms::none});
+  }
+  return {};
+}
+
 // The install request for a SAD: the application's files, read here and carried to the domain,
 // so that the CLI may run on another host than the domain daemon. `warnings`: what reading them
 // found, located in the user's files.
@@ -67,7 +94,10 @@ Expected<protocol::domain::InstallRequest> install_request(const fs::path &sad,
   protocol::domain::InstallRequest request{
       app->sad_path.lexically_relative(*root).string(), {}, std::nullopt};
   for (const auto &f : app->files())
-    request.files.push_back({fs::path(f).lexically_relative(*root).string(), read_text(f)});
+    request.files.push_back(
+        {fs::path(f).lexically_relative(*root).string(), read_text(f), std::nullopt, std::nullopt});
+  if (auto carried = add_code_files(*app, *root, request); !carried)
+    return tl::unexpected(carried.error());
   if (!name.empty())
     request.name = name;
   return request;

@@ -25,6 +25,7 @@ void add_ls_command(CLI::App &app, const GlobalOptions &global, int &exit_code);
 void add_domain_command(CLI::App &app, const GlobalOptions &global, int &exit_code);
 void add_plan_command(CLI::App &app, const GlobalOptions &global, int &exit_code);
 void add_events_command(CLI::App &app, const GlobalOptions &global, int &exit_code);
+void add_new_command(CLI::App &app, const GlobalOptions &global, int &exit_code);
 // rsca completion bash: made from `app`'s commands, so register it after them.
 void add_completion_command(CLI::App &app, int &exit_code);
 

@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 
 #include "commands.hpp"
+#include "common/install_layout.hpp"
 #include "common/own_folder.hpp"
 #include "domain_client.hpp"
 #include "exit_codes.hpp"
@@ -32,7 +33,7 @@ fs::path default_sdrroot(const GlobalOptions &global) {
     return fs::absolute(global.sdrroot);
   if (const char *dir = std::getenv("RSCA_SDRROOT"); dir != nullptr && *dir != '\0')
     return dir;
-  return (own_folder() / "../../profiles").lexically_normal();
+  return layout::default_sdrroot();
 }
 
 bool alive(pid_t pid) {
@@ -113,8 +114,7 @@ Expected<pid_t> spawn_node(const fs::path &dcd, const std::string &name, const f
                            const GlobalOptions &global) {
   const fs::path bin = own_folder();
   std::vector<std::string> args{"--dcd",       dcd.string(), "--domain",
-                                global.domain, "--log-dir",  (run / "logs").string(),
-                                "--exec-path", bin.string()};
+                                global.domain, "--log-dir",  (run / "logs").string()};
   // The CLI reaches the domain through the node's socket; a path too long for one leaves the
   // CLI on DDS.
   if (const fs::path socket = run / (name + ".sock"); socket.string().size() < kMaxSocketPath) {

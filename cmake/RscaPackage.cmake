@@ -1,0 +1,31 @@
+# Debian packages (cpack -G DEB, or tools/package): rsca (install component runtime) and rsca-dev
+# (component dev). The runtime package's dependencies are computed by dpkg-shlibdeps from what
+# its programs link, so they are the Debian packages rsca was built against; the dev package
+# depends on the -dev packages its headers include. Configure with -DCMAKE_INSTALL_PREFIX=/usr
+# for Debian's multiarch library folder.
+set(CPACK_GENERATOR DEB)
+set(CPACK_PACKAGE_NAME rsca)
+set(CPACK_PACKAGE_VENDOR "rsca")
+set(CPACK_PACKAGE_CONTACT "rsca developers <rsca-dev@localhost>")
+set(CPACK_PACKAGE_DESCRIPTION_SUMMARY "${PROJECT_DESCRIPTION}")
+set(CPACK_PACKAGING_INSTALL_PREFIX /usr)
+set(CPACK_DEB_COMPONENT_INSTALL ON)
+set(CPACK_COMPONENTS_ALL runtime dev)
+set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
+set(CPACK_DEBIAN_PACKAGE_SECTION misc)
+set(CPACK_DEBIAN_PACKAGE_GENERATE_SHLIBS ON)
+set(CPACK_STRIP_FILES ON) # the build's debug info stays in the build (RelWithDebInfo: 190 MB)
+
+set(CPACK_DEBIAN_RUNTIME_PACKAGE_NAME rsca)
+set(CPACK_DEBIAN_RUNTIME_PACKAGE_SHLIBDEPS ON)
+set(CPACK_DEBIAN_RUNTIME_PACKAGE_RECOMMENDS "graphviz") # rsca show --graph svg
+set(CPACK_COMPONENT_RUNTIME_DESCRIPTION
+    "rsca's domain and node daemons, its CLI, the component host and runtime, the schemas and the default profiles")
+
+set(CPACK_DEBIAN_DEV_PACKAGE_NAME rsca-dev)
+set(CPACK_DEBIAN_DEV_PACKAGE_DEPENDS
+    "rsca (= ${PROJECT_VERSION}), libexpected-dev, libfmt-dev, libspdlog-dev, nlohmann-json3-dev, cyclonedds-dev")
+set(CPACK_COMPONENT_DEV_DESCRIPTION
+    "rsca's component SDK: headers, find_package(rsca) with rsca_add_component, pkg-config")
+
+include(CPack)

@@ -1,0 +1,46 @@
+#include "common/install_layout.hpp"
+
+#include "common/install_dirs.hpp"
+#include "common/own_folder.hpp"
+
+namespace rsca::layout {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+bool is_folder(const fs::path &path) {
+  std::error_code ec;
+  return fs::is_directory(path, ec);
+}
+
+} // namespace
+
+std::vector<fs::path> library_folders() {
+  const fs::path bin = own_folder();
+  if (bin.empty())
+    return {};
+  return {(bin / installed::kLibFromBin).lexically_normal(), (bin / "../lib").lexically_normal()};
+}
+
+std::vector<fs::path> component_folders() {
+  const fs::path bin = own_folder();
+  if (bin.empty())
+    return {};
+  std::vector<fs::path> out{bin, (bin / installed::kLibexecFromBin).lexically_normal()};
+  for (auto &folder : library_folders())
+    out.push_back(std::move(folder));
+  return out;
+}
+
+fs::path default_sdrroot() {
+  const fs::path bin = own_folder();
+  if (bin.empty())
+    return {};
+  for (const fs::path &candidate : {bin / installed::kProfilesFromBin, bin / "../../profiles"})
+    if (is_folder(candidate))
+      return candidate.lexically_normal();
+  return {};
+}
+
+} // namespace rsca::layout

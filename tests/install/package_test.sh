@@ -1,0 +1,73 @@
+#!/usr/bin/env bash
+# The Debian packages (cmake/RscaPackage.cmake) as a robot's computer gets them: cpack makes rsca
+# and rsca-dev from this build; each holds its files and not the other's; every library a program
+# of rsca's links, outside the package, belongs to a package that rsca's Depends names; and the
+# package's programs, unpacked into an empty root, find the rest of rsca from there (the CLI
+# validates the installed profiles with the installed XML reader).
+# Usage: package_test.sh BUILD_DIR
+set -euo pipefail
+build="$1"
+work="$(mktemp -d /tmp/rsca-package-test.XXXXXX)"
+trap 'rm -rf "$work"' EXIT
+fail() { printf 'FAIL: %s\n' "$*" >&2; exit 1; }
+
+(cd "$build" && cpack -G DEB -B "$work" >"$work/cpack.log" 2>&1) || { cat "$work/cpack.log"; fail "cpack"; }
+runtime="$(ls "$work"/rsca_*.deb)"
+dev="$(ls "$work"/rsca-dev_*.deb)"
+
+has() { dpkg-deb -c "$1" | awk '{print $6}' | grep -qx "$2" || fail "$(basename "$1") lacks $2"; }
+lacks() { ! dpkg-deb -c "$1" | awk '{print $6}' | grep -q "$2" || fail "$(basename "$1") holds $2"; }
+for f in ./usr/bin/rsca ./usr/bin/rsca-domaind ./usr/bin/rsca-noded ./usr/bin/rsca-component-host \
+         ./usr/lib/rsca/librsca_xml_reader.so ./usr/libexec/rsca/rsca-producer \
+         ./usr/share/rsca/profiles/dom/domain/DomainManager.dmd.xml ./usr/share/rsca/schemas/sad.xsd; do
+  has "$runtime" "$f"
+done
+lacks "$runtime" "^./usr/include/"
+for f in ./usr/include/rsca/component/export.hpp ./usr/lib/cmake/rsca/rscaConfig.cmake \
+         ./usr/lib/cmake/rsca/RscaAddComponent.cmake ./usr/lib/pkgconfig/rsca.pc; do
+  has "$dev" "$f"
+done
+lacks "$dev" "^./usr/bin/"
+dpkg-deb -f "$dev" Depends | grep -q "^rsca (= " || fail "rsca-dev does not depend on rsca"
+
+# Depends: every library outside the package that an ELF file of it links directly.
+root="$work/root"
+dpkg-deb -x "$runtime" "$root"
+depends="$(dpkg-deb -f "$runtime" Depends | tr ',' '\n' | sed 's/(.*//; s/ //g')"
+owner() { # the package that holds a library file, under either of usrmerge's paths
+  local path="$1" p
+  for p in "$path" "$(realpath "$path")" "${path/#\/usr\/lib/\/lib}" "${path/#\/lib/\/usr\/lib}"; do
+    dpkg -S "$p" 2>/dev/null | head -1 | cut -d: -f1 && return 0
+  done
+  return 1
+}
+# The files of the libraries an ELF file names itself (NEEDED); those libraries' own needs are
+# their packages' to depend on.
+needed_paths() {
+  local needed
+  needed="$(readelf -d "$1" | sed -n 's/.*(NEEDED).*\[\(.*\)\]/\1/p')"
+  LD_LIBRARY_PATH="$root/usr/lib" ldd "$1" | awk '$2 == "=>" && $3 ~ /^\// {print $1, $3}' |
+    while read -r soname path; do
+      grep -qx "$soname" <<<"$needed" && echo "$path"
+    done
+  return 0
+}
+checked=0
+while IFS= read -r -d '' elf; do
+  readelf -h "$elf" >/dev/null 2>&1 || continue
+  checked=$((checked + 1))
+  while read -r lib; do
+    case "$lib" in "$root"/*) continue ;; esac
+    pkg="$(owner "$lib")" || fail "$elf links $lib, which no package holds"
+    names="$pkg $(dpkg -s "$pkg" | sed -n 's/^Provides: //p' | tr ',' ' ' | sed 's/([^)]*)//g')"
+    named=0
+    for n in $names; do grep -qx "$n" <<<"$depends" && named=1; done
+    [ "$named" = 1 ] || fail "$elf links $lib of $pkg, which Depends lacks"
+  done < <(needed_paths "$elf")
+done < <(find "$root" -type f -print0)
+[ "$checked" -ge 10 ] || fail "only $checked ELF files checked"
+
+# Unpacked anywhere, the CLI finds its schemas' reader and its profiles.
+"$root/usr/bin/rsca" validate --strict "$root/usr/share/rsca/profiles" >"$work/validate.log" ||
+  { cat "$work/validate.log"; fail "the packaged CLI does not validate the packaged profiles"; }
+echo "ok: $checked ELF files, Depends: $(echo $depends)"

@@ -1,0 +1,103 @@
+#!/usr/bin/env bash
+# The SDK as a user meets it. rsca is installed into a DESTDIR (as the rsca and rsca-dev packages
+# would put it); the installed `rsca new component` makes a project, which is built against the
+# installed tree with find_package(rsca) (and compiled once more with pkg-config) and installed
+# into an SDR root of its own; the installed daemons come up, and the component runs in both of
+# its forms: a process of its own (rsca::runtime) and a library a component host loads
+# (rsca::component_library). Everything it started is stopped and checked gone.
+# Usage: sdk_test.sh BUILD_DIR [FLAGS]   (FLAGS: the build's sanitizer flags, which a program
+# linking the installed runtime needs as well)
+set -euo pipefail
+build="$1"
+flags="${2:-}"
+work="$(mktemp -d /tmp/rsca-sdk-test.XXXXXX)"
+usr="$work/root/usr"
+rsca="$usr/bin/rsca"
+sdr="$work/sdr"
+export RSCA_DDS_DOMAIN=$((1 + $$ % 101)) RSCA_DDS_TAG="sdk-test-$$-$RANDOM"
+
+cleanup() {
+  "$rsca" domain down --run-dir "$work/run" >/dev/null 2>&1 || true
+  pkill -KILL -f "$work" 2>/dev/null || true
+  rm -rf "$work"
+}
+trap cleanup EXIT
+step() { printf '== %s\n' "$*"; }
+fail() { printf 'FAIL: %s\n' "$*" >&2; exit 1; }
+
+# Waits (at most 30 s) until APP's component has ticked more than twice.
+wait_ticks() {
+  local app="$1" ticks=0
+  for _ in $(seq 300); do
+    ticks="$("$rsca" --json query "$app" 2>/dev/null |
+      python3 -c 'import json,sys; print(json.load(sys.stdin)["properties"]["ticks"])' 2>/dev/null ||
+      echo 0)"
+    [ "$ticks" -gt 2 ] && return 0
+    sleep 0.1
+  done
+  fail "$app did not tick (ticks = $ticks)"
+}
+
+step "install rsca into $work/root"
+DESTDIR="$work/root" cmake --install "$build" --prefix /usr --strip >/dev/null
+
+step "rsca new component Greeter"
+"$rsca" new component Greeter --dir "$work/src"
+if "$rsca" new component Greeter --dir "$work/src" 2>/dev/null; then
+  fail "rsca new component wrote over an existing project"
+fi
+if "$rsca" new component "no good" --dir "$work/src" 2>/dev/null; then
+  fail "rsca new component took a name that is no identifier"
+fi
+
+step "build it against the installed SDK (find_package) and install it into an SDR root"
+cmake -S "$work/src/Greeter" -B "$work/build" -DCMAKE_PREFIX_PATH="$usr" \
+  -DCMAKE_CXX_FLAGS="$flags" -DCMAKE_EXE_LINKER_FLAGS="$flags" >/dev/null
+cmake --build "$work/build" -j2 >/dev/null
+cmake --install "$work/build" --prefix "$sdr" >/dev/null
+[ -x "$sdr/dom/components/Greeter/Greeter" ] || fail "the executable was not installed"
+[ -f "$sdr/dom/components/Greeter/libGreeter.so" ] || fail "the library was not installed"
+
+step "compile it again with pkg-config"
+pc="$(PKG_CONFIG_PATH="$usr/lib/pkgconfig" pkg-config --cflags --libs rsca)"
+# shellcheck disable=SC2086 # pkg-config's output is a list of flags
+g++ $flags "$work/src/Greeter/src/Greeter.cpp" $pc -o "$work/greeter-pkgconfig"
+LD_LIBRARY_PATH="$usr/lib" ldd "$work/greeter-pkgconfig" | grep -qF "librsca_runtime.so.0 => $usr/lib/" ||
+  fail "the program pkg-config built does not link the installed runtime"
+
+# The same component as a library a host loads: its SPD naming lib<name>.so, as the generated
+# SPD's description says.
+spd="$sdr/dom/components/Greeter"
+sed -e 's|<code type="Executable">|<code type="SharedLibrary">|' \
+    -e 's|<localfile name="Greeter"/>|<localfile name="libGreeter.so"/>|' -e '/<entrypoint>/d' \
+    -e 's|name="Greeter" version|name="GreeterLib" version|' "$spd/Greeter.spd.xml" >"$spd/GreeterLib.spd.xml"
+mkdir -p "$sdr/dom/waveforms/GreeterLib"
+sed -e 's|Greeter/Greeter.spd.xml|Greeter/GreeterLib.spd.xml|' \
+    -e 's|name="Greeter" version|name="GreeterLib" version|' \
+    "$sdr/dom/waveforms/Greeter/Greeter.sad.xml" >"$sdr/dom/waveforms/GreeterLib/GreeterLib.sad.xml"
+
+step "validate the SDR root strictly"
+"$rsca" validate --strict "$sdr"
+
+step "the installed daemons come up"
+"$rsca" domain up --nodes 1 --run-dir "$work/run"
+domaind="$(cat "$work/run/domaind.pid")"
+[ "$(readlink "/proc/$domaind/exe")" = "$usr/bin/rsca-domaind" ] || fail "domaind is not the installed one"
+
+step "launch both forms"
+"$rsca" launch "$sdr/dom/waveforms/Greeter/Greeter.sad.xml"
+"$rsca" launch "$sdr/dom/waveforms/GreeterLib/GreeterLib.sad.xml"
+wait_ticks Greeter
+wait_ticks GreeterLib
+"$rsca" --json show GreeterLib | grep -q '"state": "running"' || fail "GreeterLib is not running"
+
+step "release, domain down, nothing left"
+"$rsca" release Greeter
+"$rsca" release GreeterLib
+"$rsca" domain down --run-dir "$work/run"
+for _ in $(seq 100); do
+  pgrep -f "$work" >/dev/null || break
+  sleep 0.1
+done
+if pgrep -af "$work"; then fail "processes left behind"; fi
+echo "ok"

@@ -1,0 +1,168 @@
+// rsca new component NAME: a component's project to build outside rsca's tree against an
+// installed rsca — its source, SPD, PRF and SCD, a SAD that runs it alone, and a CMakeLists that
+// finds rsca with find_package and installs into an SDR root. The files are templates compiled
+// into the CLI (tools/rsca/templates), so the CLI and the SDK it belongs to never disagree.
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <regex>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+#include <tl/expected.hpp>
+
+#include "commands.hpp"
+#include "exit_codes.hpp"
+
+namespace rsca::cli {
+namespace templates {
+std::pair<std::string_view, std::string_view> const *embedded_files(std::size_t &count);
+} // namespace templates
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// A template and where its text goes in the project, NAME standing for the component's name.
+struct ProjectFile {
+  std::string_view template_name;
+  std::string_view path;
+};
+
+constexpr ProjectFile kComponentFiles[] = {
+    {"component.CMakeLists.txt.in", "CMakeLists.txt"}, {"component.cpp.in", "src/NAME.cpp"},
+    {"component.spd.xml.in", "NAME.spd.xml"},          {"component.prf.xml.in", "NAME.prf.xml"},
+    {"component.scd.xml.in", "NAME.scd.xml"},          {"component.sad.xml.in", "NAME.sad.xml"},
+};
+
+std::string_view template_text(std::string_view name) {
+  std::size_t count = 0;
+  const auto *files = templates::embedded_files(count);
+  for (std::size_t i = 0; i < count; ++i)
+    if (files[i].first == name)
+      return files[i].second;
+  return {}; // every name above is embedded (tools/rsca/CMakeLists.txt)
+}
+
+std::string replace_all(std::string text, std::string_view from, std::string_view to) {
+  for (auto at = text.find(from); at != std::string::npos; at = text.find(from, at + to.size()))
+    text.replace(at, from.size(), to);
+  return text;
+}
+
+// A random (version 4) UUID, for the SPD's and the SAD's DCE ids.
+std::string random_uuid() {
+  std::random_device device;
+  std::uniform_int_distribution<unsigned> byte(0, 255);
+  unsigned char b[16];
+  for (auto &x : b)
+    x = static_cast<unsigned char>(byte(device));
+  b[6] = static_cast<unsigned char>((b[6] & 0x0FU) | 0x40U); // version 4
+  b[8] = static_cast<unsigned char>((b[8] & 0x3FU) | 0x80U); // RFC 4122 variant
+  return fmt::format("{:02x}{:02x}{:02x}{:02x}-{:02x}{:02x}-{:02x}{:02x}-{:02x}{:02x}-"
+                     "{:02x}{:02x}{:02x}{:02x}{:02x}{:02x}",
+                     b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7], b[8], b[9], b[10], b[11],
+                     b[12], b[13], b[14], b[15]);
+}
+
+// The name becomes a C++ class, file names and profile names: an identifier, of a sane length.
+bool valid_name(const std::string &name) {
+  static const std::regex identifier("[A-Za-z][A-Za-z0-9_]{0,63}");
+  return std::regex_match(name, identifier);
+}
+
+bool write_file(const fs::path &path, std::string_view text) {
+  std::error_code ec;
+  fs::create_directories(path.parent_path(), ec);
+  std::ofstream out(path, std::ios::binary);
+  out.write(text.data(), static_cast<std::streamsize>(text.size()));
+  return static_cast<bool>(out.flush());
+}
+
+// Writes the project in a hidden folder beside `target` and renames it into place, so that a
+// failure leaves nothing half-written. Returns the project's files, or the reason it failed.
+tl::expected<std::vector<fs::path>, std::string> write_project(const std::string &name,
+                                                               const fs::path &target) {
+  const fs::path staging = target.parent_path() / fmt::format(".{}.rsca-new", name);
+  std::error_code ec;
+  fs::remove_all(staging, ec);
+  const std::string spd_id = random_uuid(), sad_id = random_uuid();
+  std::vector<fs::path> written;
+  for (const auto &file : kComponentFiles) {
+    std::string text(template_text(file.template_name));
+    for (const auto &[from, to] : {std::pair<std::string_view, std::string_view>{"@NAME@", name},
+                                   {"@SPD_ID@", spd_id},
+                                   {"@SAD_ID@", sad_id},
+                                   {"@RSCA_VERSION@", RSCA_VERSION}})
+      text = replace_all(std::move(text), from, to);
+    const fs::path relative = replace_all(std::string(file.path), "NAME", name);
+    if (!write_file(staging / relative, text)) {
+      fs::remove_all(staging, ec);
+      return tl::unexpected(fmt::format("cannot write {}", (staging / relative).string()));
+    }
+    written.push_back(target / relative);
+  }
+  fs::rename(staging, target, ec);
+  if (ec) {
+    fs::remove_all(staging, ec);
+    return tl::unexpected(fmt::format("cannot create {}: {}", target.string(), ec.message()));
+  }
+  return written;
+}
+
+int new_component(const std::string &name, const std::string &dir, const GlobalOptions &global) {
+  if (!valid_name(name)) {
+    fmt::print(stderr,
+               "rsca new component: \"{}\" is not a name: a letter, then letters, digits or _ "
+               "(at most 64)\n",
+               name);
+    return kUsage;
+  }
+  const fs::path target = fs::absolute(fs::path(dir) / name).lexically_normal();
+  std::error_code ec;
+  if (fs::exists(target, ec)) {
+    fmt::print(stderr, "rsca new component: {} already exists; nothing written\n", target.string());
+    return kRejected;
+  }
+  auto files = write_project(name, target);
+  if (!files) {
+    fmt::print(stderr, "rsca new component: {}\n", files.error());
+    return kFailed;
+  }
+  if (global.json) {
+    nlohmann::json out{{"component", name}, {"project", target.string()}, {"files", {}}};
+    for (const auto &f : *files)
+      out["files"].push_back(f.string());
+    fmt::print("{}\n", out.dump(2));
+    return kOk;
+  }
+  fmt::print("created {}\n", target.string());
+  for (const auto &f : *files)
+    fmt::print("  {}\n", f.lexically_relative(target).string());
+  fmt::print("next:\n  cd {0} && cmake -B build && cmake --build build\n"
+             "  cmake --install build --prefix \"$SDRROOT\"\n"
+             "  rsca launch \"$SDRROOT/dom/waveforms/{1}/{1}.sad.xml\"\n",
+             target.string(), name);
+  return kOk;
+}
+
+} // namespace
+
+void add_new_command(CLI::App &app, const GlobalOptions &global, int &exit_code) {
+  auto *cmd = app.add_subcommand("new", "Create a project for a new component, built against an "
+                                        "installed rsca (find_package(rsca))");
+  cmd->require_subcommand(1);
+  auto *component = cmd->add_subcommand(
+      "component", "A component: its source, SPD, PRF, SCD, a SAD that runs it, and a CMakeLists");
+  auto name = std::make_shared<std::string>();
+  auto dir = std::make_shared<std::string>(".");
+  component->add_option("name", *name, "The component's name (a C++ identifier)")->required();
+  component->add_option("--dir", *dir, "Where the project's folder NAME is made")
+      ->capture_default_str();
+  component->callback(
+      [name, dir, &global, &exit_code] { exit_code = new_component(*name, *dir, global); });
+}
+
+} // namespace rsca::cli
