@@ -6,7 +6,7 @@
 #include <spdlog/spdlog.h>
 
 #include "common/daemon_heap.hpp"
-#include "common/own_folder.hpp"
+#include "common/install_layout.hpp"
 #include "common/process_priority.hpp"
 #include "common/termination_signals.hpp"
 #include "dds/participant.hpp"
@@ -14,8 +14,6 @@
 #include "monitor/host_monitor.hpp"
 #include "node/device_manager.hpp"
 #include "robot/robot_devices.hpp"
-
-using rsca::own_folder;
 
 int main(int argc, char **argv) {
   const int nice = rsca::run_above_applications(); // before any thread exists
@@ -32,7 +30,7 @@ int main(int argc, char **argv) {
   app.add_option("--domain", options.domain_name, "The domain's name")->capture_default_str();
   app.add_option("--exec-path", exec_path,
                  "Folders where component executables named without a path are looked for "
-                 "(default: this program's folder)");
+                 "(default: this program's folder and where an install puts rsca's components)");
   app.add_option("--log-dir", log_dir, "Component logs go here")->capture_default_str();
   std::string control_socket;
   app.add_option("--control-socket", control_socket,
@@ -74,7 +72,7 @@ int main(int argc, char **argv) {
   for (const auto &p : exec_path)
     options.exec_path.emplace_back(p);
   if (options.exec_path.empty())
-    options.exec_path.push_back(own_folder());
+    options.exec_path = rsca::layout::component_folders();
   options.log_dir = log_dir;
   options.cache.dir = cache_dir;
   options.cache.max_bytes = cache_mib << 20U;
