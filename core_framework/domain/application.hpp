@@ -64,7 +64,8 @@ struct ConnectionInstance {
   std::string repid;
   std::string topic;
   nlohmann::json qos;
-  std::string filter; // a channel subscriber's content filter
+  std::string filter;  // a channel subscriber's content filter
+  std::string channel; // the event channel a member joins; empty: none
   // A uses port's connection to a component's supported interface: no topic, the provides end
   // is the component itself.
   bool is_interface() const { return topic.empty() && !provides.empty() && provides.port.empty(); }
@@ -98,7 +99,7 @@ std::vector<std::string> unreachable_components(const Application &app);
 // released), else its lifecycle state.
 std::string state_of(const Application &app);
 
-// The application as replies show it.
+// The application as replies show it (its connections without their live state).
 protocol::application::ApplicationView view_of(const Application &app);
 
 } // namespace rsca::domain

@@ -134,6 +134,51 @@ void status_addresses(const Application &app, std::set<std::string> &addresses) 
         addresses.insert(end->address);
 }
 
+// One status call to every address at once, bounded by `timeout`: the statuses of those that
+// answered.
+StatusOf statuses_of(control::Endpoint &endpoint, const std::set<std::string> &addresses,
+                     std::chrono::milliseconds timeout) {
+  std::vector<control::Call> calls;
+  for (const auto &address : addresses)
+    calls.push_back(control::make_call<protocol::component::Status>(address, {}));
+  const auto statuses = endpoint.call_all(calls, timeout);
+  StatusOf status_of;
+  for (std::size_t i = 0; i < calls.size(); ++i)
+    if (auto status = control::reply_of<protocol::component::Status>(statuses[i]))
+      status_of[calls[i].target] = std::move(*status);
+  return status_of;
+}
+
+// An end's component is gone: its process exited, or its node is lost.
+bool owner_gone(const Application &app, const ConnectionEnd &end) {
+  const auto *component = end.component.empty() ? nullptr : app.find_component(end.component);
+  return component != nullptr && (component->state == ComponentState::Exited ||
+                                  component->state == ComponentState::Unreachable);
+}
+
+// A SAD connection's live state from its ends' owners: failed when an owner is gone; pending
+// while an end has not matched its peer (a channel's member alone on its channel); connected
+// when every end has; none when an end did not answer. The component a uses port calls through
+// its supported interface reports nothing of it: only its caller counts.
+std::optional<connection_ops::ConnectionState>
+live_state(const Application &app, const ConnectionInstance &c, const StatusOf &status_of) {
+  using State = connection_ops::ConnectionState;
+  bool matched = true;
+  for (const auto *end : {&c.uses, &c.provides}) {
+    if (end->empty())
+      continue; // the event channel's side
+    if (owner_gone(app, *end))
+      return State::Failed;
+    if (c.is_interface() && end == &c.provides)
+      continue;
+    const Json state = end_state(status_of, end->address, end->port, end_key(c, *end));
+    if (state.is_null())
+      return std::nullopt;
+    matched = matched && (state.contains("calls") || state.value("matched", 0) > 0);
+  }
+  return matched ? State::Connected : State::Pending;
+}
+
 // A runtime connection's request as the domain's store keeps it (with "format": 1).
 CallResult<connection_ops::CreateRequest> kept_request(const std::string &text) {
   Json record = Json::parse(text, nullptr, /*allow_exceptions=*/false);
@@ -334,14 +379,7 @@ DomainManager::Impl::list_connections(const connection_ops::ListRequest &request
   for (const auto &c : runtime)
     if (c.connected())
       addresses.insert({c.uses_end.address, c.provides_end.address});
-  std::vector<control::Call> calls;
-  for (const auto &address : addresses)
-    calls.push_back(control::make_call<protocol::component::Status>(address, {}));
-  const auto statuses = endpoint->call_all(calls, options.call_timeout / 2);
-  StatusOf status_of;
-  for (std::size_t i = 0; i < calls.size(); ++i)
-    if (auto status = control::reply_of<protocol::component::Status>(statuses[i]))
-      status_of[calls[i].target] = std::move(*status);
+  const auto status_of = statuses_of(*endpoint, addresses, options.call_timeout / 2);
   connection_ops::ListReply reply;
   for (const auto &app : apps)
     for (const auto &c : app.connections)
@@ -349,6 +387,17 @@ DomainManager::Impl::list_connections(const connection_ops::ListRequest &request
   for (const auto &c : runtime)
     reply.connections.push_back(listed(c, status_of));
   return reply;
+}
+
+// As connection.list, the domain asks the live owners at once, bounded below the CLI's wait.
+app_ops::ApplicationView DomainManager::Impl::live_view_of(const Application &app) {
+  std::set<std::string> addresses;
+  status_addresses(app, addresses);
+  const auto status_of = statuses_of(*endpoint, addresses, options.call_timeout / 2);
+  auto view = view_of(app);
+  for (std::size_t i = 0; i < app.connections.size(); ++i)
+    view.connections[i].state = live_state(app, app.connections[i], status_of);
+  return view;
 }
 
 CallResult<RuntimeConnection>

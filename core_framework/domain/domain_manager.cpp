@@ -320,7 +320,7 @@ DomainManager::Impl::show_application(const app_ops::AppRequest &request) {
   if (!app)
     return control::call_error(Status::NotFound,
                                fmt::format("no application {} is running", excerpt(request.app)));
-  return view_of(*app);
+  return live_view_of(*app);
 }
 
 // Admission and placement of an installed application on the domain as it is, reserving nothing.

@@ -147,6 +147,8 @@ struct DomainManager::Impl {
   CallResult<domain_ops::Named> destroy_channel(const domain_ops::Named &request);
   CallResult<connection_ops::ListReply>
   list_connections(const connection_ops::ListRequest &request);
+  // The application as app.show shows it: its connections with their live state.
+  app_ops::ApplicationView live_view_of(const Application &app);
   CallResult<connection_ops::CreateReply>
   create_connection(const connection_ops::CreateRequest &request);
   CallResult<connection_ops::ConnectionId>

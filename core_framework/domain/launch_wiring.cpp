@@ -55,9 +55,10 @@ ApplicationFactory::Launch::connection_of(const profile::Connection &c, std::siz
   ConnectionInstance ci;
   ci.id = connection_id(c, index);
   ci.qos = dds::qos_to_json(c.qos.value_or(profile::ConnectionQos{}));
-  ci.topic = c.publishes_to_channel() || c.subscribes_to_channel()
-                 ? s_.channels->topic_of(channel_name(c))
-                 : protocol::connection_topic(s_.domain_name, app_->name, launch_, ci.id);
+  const bool member = c.publishes_to_channel() || c.subscribes_to_channel();
+  ci.channel = member ? channel_name(c) : "";
+  ci.topic = member ? s_.channels->topic_of(ci.channel)
+                    : protocol::connection_topic(s_.domain_name, app_->name, launch_, ci.id);
   ci.filter = c.filter.value_or("");
   ci.repid = repid_of(c);
   auto uses = resolve_end(ci, c.uses.target, c.uses.port, profile::PortDirection::Uses);

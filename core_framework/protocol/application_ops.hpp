@@ -13,6 +13,7 @@
 
 #include "protocol/codec.hpp"
 #include "protocol/component_ops.hpp"
+#include "protocol/connection_ops.hpp"
 
 namespace rsca::protocol {
 namespace application {
@@ -131,6 +132,14 @@ struct SadConnectionView {
   std::string repid;
   std::string topic;         // empty: a uses port calling a component's supported interface
   Json qos = Json::object(); // dds/port_qos.hpp's JSON form
+  // Each end as a typed port (a component's, with the application, or a device's; a supported
+  // interface's port is empty); absent: the event channel's side.
+  std::optional<connection::PortEnd> uses_end;
+  std::optional<connection::PortEnd> provides_end;
+  std::optional<std::string> channel; // the event channel it joins; absent: none
+  std::optional<std::string> filter;  // its provides end's content filter; absent: none
+  // Live, as its ends' owners report it when app.show asks; absent: an end did not answer.
+  std::optional<connection::ConnectionState> state;
   static constexpr auto fields() {
     using R = SadConnectionView;
     return std::tuple{required("id", &R::id),
@@ -138,7 +147,25 @@ struct SadConnectionView {
                       required("provides", &R::provides),
                       required("repid", &R::repid),
                       required("topic", &R::topic),
-                      required("qos", &R::qos)};
+                      required("qos", &R::qos),
+                      optional("uses_end", &R::uses_end),
+                      optional("provides_end", &R::provides_end),
+                      optional("channel", &R::channel),
+                      optional("filter", &R::filter),
+                      optional("state", &R::state)};
+  }
+};
+
+// A port of a component that the application's SAD offers outside it (<externalports>).
+struct ExternalPortView {
+  std::string name;
+  std::string component;
+  std::string port; // the component's port, or the supported interface's repid
+  std::string kind; // "uses", "provides" or "supportedinterface"
+  static constexpr auto fields() {
+    using R = ExternalPortView;
+    return std::tuple{required("name", &R::name), required("component", &R::component),
+                      required("port", &R::port), required("kind", &R::kind)};
   }
 };
 
@@ -151,6 +178,7 @@ struct ApplicationView {
   std::vector<std::string> exited;
   std::vector<ComponentView> components;
   std::vector<SadConnectionView> connections;
+  std::vector<ExternalPortView> external_ports; // absent from a reply: none
   static constexpr auto fields() {
     using R = ApplicationView;
     return std::tuple{required("name", &R::name),
@@ -159,7 +187,8 @@ struct ApplicationView {
                       required("state", &R::state),
                       required("exited", &R::exited),
                       required("components", &R::components),
-                      required("connections", &R::connections)};
+                      required("connections", &R::connections),
+                      optional("external_ports", &R::external_ports)};
   }
 };
 

@@ -17,13 +17,16 @@
 
 namespace rsca::protocol {
 namespace connection {
-enum class ConnectionState : std::uint8_t { Connected, Pending };
+// Pending: an end is not there yet, or is there and has not matched its peer. Failed: an end's
+// owner is gone (its process exited, or its node is lost).
+enum class ConnectionState : std::uint8_t { Connected, Pending, Failed };
 } // namespace connection
 
 template <>
 struct EnumNames<connection::ConnectionState> {
   static constexpr std::array names{std::pair{connection::ConnectionState::Connected, "connected"},
-                                    std::pair{connection::ConnectionState::Pending, "pending"}};
+                                    std::pair{connection::ConnectionState::Pending, "pending"},
+                                    std::pair{connection::ConnectionState::Failed, "failed"}};
 };
 
 } // namespace rsca::protocol

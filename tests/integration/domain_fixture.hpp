@@ -336,6 +336,15 @@ inline std::vector<long> pids_of(const Json &app) {
   return pids;
 }
 
+// The pid of component `id` of an application as app.show or app.create gives it; 0 when it has
+// none.
+inline long pid_of(const Json &app, const std::string &id) {
+  for (const auto &c : app.at("components"))
+    if (c.at("id") == id)
+      return c.at("pid").get<long>();
+  return 0;
+}
+
 inline long received(TestDomain &domain, const std::string &app) {
   auto q = domain.call("app.query",
                        Json{{"app", app}, {"component", "Consumer_1"}, {"ids", {"received"}}});

@@ -137,10 +137,7 @@ TEST_CASE("a component that crashes after launch is reported to the domain",
           "[integration][domain][failure]") {
   TestDomain domain;
   const Json app = domain.create("Healthy");
-  long victim = 0;
-  for (const auto &c : app.at("components"))
-    if (c.at("id") == "Victim_1")
-      victim = c.at("pid").get<long>();
+  const long victim = pid_of(app, "Victim_1");
   REQUIRE(victim > 0);
   ::kill(static_cast<pid_t>(victim), SIGSEGV);
   CHECK(TestDomain::wait_for([&] {

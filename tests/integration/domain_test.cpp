@@ -283,10 +283,7 @@ TEST_CASE("a writer that stops asserting its liveliness is reported as a domain 
   const Json state = listed->at("connections").at(0).at("provides_state");
   CHECK(state.value("same_host", false));
   CHECK(state.value("relayed", false) == (strategy == "spread"));
-  long producer = 0;
-  for (const auto &c : app->at("components"))
-    if (c.at("id") == "Producer_1")
-      producer = c.at("pid").get<long>();
+  const long producer = pid_of(*app, "Producer_1");
   REQUIRE(producer > 0);
   REQUIRE(::kill(static_cast<pid_t>(producer), SIGSTOP) == 0);
   const Json problem = connection_problem(domain, "liveliness lost");

@@ -273,6 +273,50 @@ TEST_CASE("protocol: a launched application's reply round-trips with its launch"
         "missing field \"launch\"");
 }
 
+TEST_CASE("protocol: app.show's connections round-trip with their typed ends, channel and live "
+          "state, and a reply without them still decodes",
+          "[protocol]") {
+  namespace app = protocol::application;
+  using protocol::connection::ConnectionState;
+  using protocol::connection::PortEnd;
+  app::ApplicationView view;
+  view.name = "Events";
+  app::SadConnectionView publish;
+  publish.id = "publish";
+  publish.uses = "Producer_1.events_out";
+  publish.uses_end = PortEnd{"Events", "Producer_1", std::nullopt, "events_out"};
+  publish.channel = "Ticks";
+  publish.state = ConnectionState::Failed;
+  app::SadConnectionView ranges;
+  ranges.id = "ranges";
+  ranges.uses_end = PortEnd{std::nullopt, std::nullopt, "robot:IRSensor_1", "out"};
+  view.connections = {publish, ranges};
+  view.external_ports = {{"tap", "Producer_1", "events_out", "uses"}};
+  const Json encoded = protocol::encode(view);
+  CHECK(encoded.at("connections")[0].at("state") == "failed");
+  CHECK(encoded.at("connections")[0].at("channel") == "Ticks");
+  CHECK_FALSE(encoded.at("connections")[0].contains("provides_end")); // the channel's side
+  CHECK_FALSE(encoded.at("connections")[1].contains("state"));        // an end did not answer
+  const auto back = round_trip(view);
+  REQUIRE(back.connections.size() == 2);
+  CHECK(back.connections[0].uses_end->component == std::optional<std::string>("Producer_1"));
+  CHECK(back.connections[0].state == std::optional<ConnectionState>(ConnectionState::Failed));
+  CHECK(back.connections[1].uses_end->device == std::optional<std::string>("robot:IRSensor_1"));
+  CHECK_FALSE(back.connections[1].channel.has_value());
+  REQUIRE(back.external_ports.size() == 1);
+  CHECK(back.external_ports[0].kind == "uses");
+
+  Json before = encoded; // as a domain before these fields answered
+  before.erase("external_ports");
+  for (auto &c : before.at("connections"))
+    for (const char *key : {"uses_end", "provides_end", "channel", "filter", "state"})
+      c.erase(key);
+  const auto old = protocol::decode<app::ApplicationView>(before);
+  REQUIRE(old.has_value());
+  CHECK(old->external_ports.empty());
+  CHECK_FALSE(old->connections[0].state.has_value());
+}
+
 TEST_CASE("protocol: launch progress, cancel and plan replies keep what is absent absent",
           "[protocol]") {
   namespace app = protocol::application;

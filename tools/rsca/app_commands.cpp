@@ -443,7 +443,8 @@ int show_application(const std::string &name, const GlobalOptions &global) {
         if (!app.connections.empty())
           fmt::print("  connections:\n");
         for (const auto &c : app.connections)
-          fmt::print("    {:<16} {} -> {}  [{}]\n", c.id, c.uses, c.provides, c.topic);
+          fmt::print("    {:<16} {} -> {}  [{}]{}\n", c.id, c.uses, c.provides, c.topic,
+                     c.state ? fmt::format(" {}", protocol::enum_name(*c.state)) : "");
       });
 }
 

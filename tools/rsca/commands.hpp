@@ -42,4 +42,13 @@ assignments_of(const std::vector<std::string> &assignments, const char *command)
 // rsca show APP when the argument is not a profile file.
 int show_application(const std::string &name, const GlobalOptions &global);
 
+// rsca show APP --graph FORMAT [-o OUTPUT].
+struct GraphOptions {
+  std::string format; // "dot" or "svg"; empty: no picture
+  std::string output; // empty: stdout
+};
+// The running application's picture (show_graph.cpp).
+int show_application_graph(const std::string &name, const GraphOptions &options,
+                           const GlobalOptions &global);
+
 } // namespace rsca::cli

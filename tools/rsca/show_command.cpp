@@ -242,9 +242,16 @@ void show_node(Tree &t, const ResolvedNode &node) {
   }
 }
 
-int run(const std::string &path, const GlobalOptions &global) {
-  if (!fs::exists(path))
+int run(const std::string &path, const GraphOptions &graph, const GlobalOptions &global) {
+  const bool profile = fs::exists(path);
+  if (!profile && !graph.format.empty())
+    return show_application_graph(path, graph, global);
+  if (!profile)
     return show_application(path, global); // not a profile: a running application's name
+  if (!graph.format.empty()) {
+    fmt::print(stderr, "rsca show: --graph draws a running application, and {} is a file\n", path);
+    return kUsage;
+  }
   std::optional<fs::path> sdrroot;
   if (!global.sdrroot.empty())
     sdrroot = global.sdrroot;
@@ -298,7 +305,14 @@ void add_show_command(CLI::App &app, const GlobalOptions &global, int &exit_code
   cmd->add_option("what", *path,
                   "Profile file (SAD, SPD, SCD, PRF, DCD, DMD or DPD) or application name")
       ->required();
-  cmd->callback([path, &global, &exit_code] { exit_code = run(*path, global); });
+  auto graph = std::make_shared<GraphOptions>();
+  auto *format = cmd->add_option("--graph", graph->format,
+                                 "A running application's picture: dot (Graphviz's text) or svg "
+                                 "(drawn by Graphviz's dot, of the Debian package graphviz)")
+                     ->check(CLI::IsMember({"dot", "svg"}));
+  cmd->add_option("-o,--output", graph->output, "Write the picture to this file, not stdout")
+      ->needs(format);
+  cmd->callback([path, graph, &global, &exit_code] { exit_code = run(*path, *graph, global); });
 }
 
 } // namespace rsca::cli
