@@ -6,6 +6,7 @@
 #include "planner_fixture.hpp"
 
 #include <catch2/catch.hpp>
+#include <fmt/format.h>
 
 #include <limits>
 #include <map>
