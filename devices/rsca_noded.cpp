@@ -14,6 +14,7 @@
 #include "monitor/host_monitor.hpp"
 #include "node/device_manager.hpp"
 #include "robot/robot_devices.hpp"
+#include "service/systemd.hpp"
 
 int main(int argc, char **argv) {
   const int nice = rsca::run_above_applications(); // before any thread exists
@@ -26,16 +27,22 @@ int main(int argc, char **argv) {
   std::vector<std::string> exec_path;
   std::string log_dir = options.log_dir.string();
   app.add_option("--dcd", dcd, "The node's DCD")->required()->check(CLI::ExistingFile);
-  app.add_option("--sdrroot", sdrroot, "SDR root of the DCD (default: found from its location)");
+  // Of the folders, the last given wins: a service's configuration (RSCA_NODED_ARGS) overrides
+  // its unit's (tools/systemd/rsca-noded@.service.in).
+  app.add_option("--sdrroot", sdrroot, "SDR root of the DCD (default: found from its location)")
+      ->take_last();
   app.add_option("--domain", options.domain_name, "The domain's name")->capture_default_str();
   app.add_option("--exec-path", exec_path,
                  "Folders where component executables named without a path are looked for "
                  "(default: this program's folder and where an install puts rsca's components)");
-  app.add_option("--log-dir", log_dir, "Component logs go here")->capture_default_str();
+  app.add_option("--log-dir", log_dir, "Component logs go here")
+      ->capture_default_str()
+      ->take_last();
   std::string control_socket;
   app.add_option("--control-socket", control_socket,
                  "A Unix socket where local clients (the CLI) reach the domain through this node "
-                 "instead of DDS (default: none)");
+                 "instead of DDS (default: none)")
+      ->take_last();
   std::uint32_t ring_kib = options.rings.data_bytes / 1024;
   app.add_option("--ring-kib", ring_kib,
                  "Data in each same-host ring, in KiB (a power of two, 4 to 262144; a sample takes "
@@ -48,7 +55,8 @@ int main(int argc, char **argv) {
   std::string cache_dir;
   app.add_option("--cache-dir", cache_dir,
                  "Where the packages of the processes this node runs are kept, fetched from the "
-                 "domain (default: <log-dir>/../cache/<node name>)");
+                 "domain (default: <log-dir>/../cache/<node name>)")
+      ->take_last();
   std::uint64_t cache_mib = options.cache.max_bytes >> 20U;
   app.add_option("--cache-mib", cache_mib,
                  "The most the package cache holds, in MiB: packages beyond it are evicted, least "
@@ -57,6 +65,7 @@ int main(int argc, char **argv) {
       ->capture_default_str();
   app.add_option("--log-level", level, "trace, debug, info, warn, error")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
+  rsca::service::log_to_journal_if_connected("rsca-noded"); // before any thread logs
   spdlog::set_level(spdlog::level::from_str(level));
   spdlog::set_pattern("%Y-%m-%dT%H:%M:%S.%e %^%l%$ noded: %v");
   spdlog::info("running at nice {} (components at {})", nice, rsca::application_nice());
@@ -83,17 +92,27 @@ int main(int argc, char **argv) {
   rsca::gpp::register_gpp(registry);
   rsca::monitor::register_host_monitor(registry);
   rsca::robot::register_robot_devices(registry);
-  auto participant = rsca::dds::Participant::create(rsca::dds::DdsSettings::from_environment());
+  const auto dds = rsca::dds::DdsSettings::from_environment();
+  rsca::service::notify_status(fmt::format("joining DDS domain {}", dds.domain_id));
+  auto participant = rsca::dds::Participant::create(dds);
   if (!participant) {
     spdlog::error("{}", participant.error().to_string());
     return 1;
   }
+  rsca::service::notify_status("starting the node of " + dcd + ": its devices, links and cache");
   auto manager = rsca::node::DeviceManager::create(*participant, options, registry);
   if (!manager) {
     spdlog::error("the node cannot start:\n{}", manager.error().to_string());
     return 1;
   }
+  // Its devices run, it serves (DDS and its control socket) and it has announced itself: the
+  // domain may find it and launch on it from now on.
+  const auto &name = (*manager)->node_name();
+  rsca::service::notify_ready(fmt::format("serving node {} of domain {} on DDS domain {}", name,
+                                          options.domain_name, dds.domain_id));
   const int signal = signals.wait();
-  spdlog::info("signal {} received; stopping node {}", signal, (*manager)->node_name());
+  spdlog::info("signal {} received; stopping node {}", signal, name);
+  rsca::service::notify_stopping(
+      fmt::format("stopping node {} and its processes (signal {})", name, signal));
   return 0;
 }

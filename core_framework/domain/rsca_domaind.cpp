@@ -10,6 +10,7 @@
 #include "dds/participant.hpp"
 #include "domain/domain_manager.hpp"
 #include "profile/profile_loader.hpp"
+#include "service/systemd.hpp"
 
 int main(int argc, char **argv) {
   const int nice = rsca::run_above_applications(); // before any thread exists
@@ -25,8 +26,10 @@ int main(int argc, char **argv) {
   int call_ms = 5000;
   app.add_option("--dmd", dmd, "The domain's DMD; its name names the domain")
       ->check(CLI::ExistingFile);
+  // The last given wins: a service's configuration (RSCA_DOMAIND_ARGS) overrides its unit's.
   app.add_option("--repository", repository, "Where installed applications are kept")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->take_last();
   app.add_option("--registration-timeout-ms", registration_ms,
                  "How long a launch waits for one more of its components to register")
       ->capture_default_str();
@@ -46,6 +49,7 @@ int main(int argc, char **argv) {
       ->check(CLI::IsMember({"pack", "spread"}))
       ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
+  rsca::service::log_to_journal_if_connected("rsca-domaind"); // before any thread logs
   spdlog::set_level(spdlog::level::from_str(level));
   spdlog::set_pattern("%Y-%m-%dT%H:%M:%S.%e %^%l%$ domaind: %v");
   spdlog::info("running at nice {}", nice);
@@ -60,6 +64,7 @@ int main(int argc, char **argv) {
   if (options.exec_path.empty())
     options.exec_path = rsca::layout::component_folders();
   if (!dmd.empty()) {
+    rsca::service::notify_status("reading the DMD " + dmd);
     rsca::profile::ProfileLoader loader;
     auto domain = loader.load_domain(dmd);
     if (!domain) {
@@ -68,17 +73,24 @@ int main(int argc, char **argv) {
     }
     options.name = domain->name;
   }
-  auto participant = rsca::dds::Participant::create(rsca::dds::DdsSettings::from_environment());
+  const auto dds = rsca::dds::DdsSettings::from_environment();
+  rsca::service::notify_status(fmt::format("joining DDS domain {}", dds.domain_id));
+  auto participant = rsca::dds::Participant::create(dds);
   if (!participant) {
     spdlog::error("{}", participant.error().to_string());
     return 1;
   }
+  rsca::service::notify_status("opening the domain store in " + repository);
   auto manager = rsca::domain::DomainManager::create(*participant, options);
   if (!manager) {
     spdlog::error("{}", manager.error().to_string());
     return 1;
   }
+  // Its store is open and its endpoint serves: a request sent from now on is answered.
+  rsca::service::notify_ready(fmt::format("serving domain {} on DDS domain {}, store in {}",
+                                          options.name, dds.domain_id, repository));
   const int signal = signals.wait();
   spdlog::info("signal {} received; stopping", signal);
+  rsca::service::notify_stopping(fmt::format("stopping (signal {})", signal));
   return 0;
 }

@@ -7,6 +7,7 @@
 
 #include <chrono>
 #include <csignal>
+#include <filesystem>
 #include <optional>
 #include <string>
 #include <utility>
@@ -25,11 +26,13 @@ class ChildProcess {
 public:
   using Environment = std::vector<std::pair<std::string, std::string>>;
 
-  // Starts `path` with `args` (argv[1..]) and the test's environment with `overrides` set.
+  // Starts `path` with `args` (argv[1..]) and the test's environment with `overrides` set; its
+  // stdout and stderr appended to `log_file`, or the test's own when it is empty.
   ChildProcess(const std::string &path, const std::vector<std::string> &args,
-               const Environment &overrides) {
+               const Environment &overrides, const std::filesystem::path &log_file = {}) {
     auto child =
-        process::spawn({.program = path, .args = args, .env = overrides}, process::Group::Caller);
+        process::spawn({.program = path, .args = args, .env = overrides, .log_file = log_file},
+                       process::Group::Caller);
     if (!child)
       FAIL("cannot start " << path << ": " << child.error().to_string());
     pid_ = child->pid;
