@@ -1,14 +1,14 @@
 # Debian packages (cpack -G DEB, or tools/package): rsca (install component runtime) and rsca-dev
 # (component dev). The runtime package's dependencies are computed by dpkg-shlibdeps from what
 # its programs link, so they are the Debian packages rsca was built against; the dev package
-# depends on the -dev packages its headers include. Configure with -DCMAKE_INSTALL_PREFIX=/usr
-# for Debian's multiarch library folder.
+# depends on the -dev packages its headers include. The packages install under the build's
+# prefix (/usr unless given), which the systemd units name.
 set(CPACK_GENERATOR DEB)
 set(CPACK_PACKAGE_NAME rsca)
 set(CPACK_PACKAGE_VENDOR "rsca")
 set(CPACK_PACKAGE_CONTACT "rsca developers <rsca-dev@localhost>")
 set(CPACK_PACKAGE_DESCRIPTION_SUMMARY "${PROJECT_DESCRIPTION}")
-set(CPACK_PACKAGING_INSTALL_PREFIX /usr)
+set(CPACK_PACKAGING_INSTALL_PREFIX ${CMAKE_INSTALL_PREFIX})
 set(CPACK_DEB_COMPONENT_INSTALL ON)
 set(CPACK_COMPONENTS_ALL runtime dev)
 set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)

@@ -15,16 +15,22 @@ fail() { printf 'FAIL: %s\n' "$*" >&2; exit 1; }
 runtime="$(ls "$work"/rsca_*.deb)"
 dev="$(ls "$work"/rsca-dev_*.deb)"
 
-has() { dpkg-deb -c "$1" | awk '{print $6}' | grep -qx "$2" || fail "$(basename "$1") lacks $2"; }
+# A file by its path in the package; `L` stands for the library folder (lib/<arch> on Debian).
+has() {
+  dpkg-deb -c "$1" | awk '{print $6}' | grep -Eqx "${2//L/lib(/[a-z0-9_-]+)?}" ||
+    fail "$(basename "$1") lacks $2"
+}
 lacks() { ! dpkg-deb -c "$1" | awk '{print $6}' | grep -q "$2" || fail "$(basename "$1") holds $2"; }
 for f in ./usr/bin/rsca ./usr/bin/rsca-domaind ./usr/bin/rsca-noded ./usr/bin/rsca-component-host \
-         ./usr/lib/rsca/librsca_xml_reader.so ./usr/libexec/rsca/rsca-producer \
-         ./usr/share/rsca/profiles/dom/domain/DomainManager.dmd.xml ./usr/share/rsca/schemas/sad.xsd; do
+         ./usr/L/rsca/librsca_xml_reader.so ./usr/L/librsca_runtime.so.0 \
+         ./usr/libexec/rsca/rsca-producer ./usr/share/rsca/profiles/dom/domain/DomainManager.dmd.xml \
+         ./usr/share/rsca/schemas/sad.xsd ./L/systemd/system/rsca-domaind.service \
+         ./L/systemd/system/rsca-noded@.service; do
   has "$runtime" "$f"
 done
 lacks "$runtime" "^./usr/include/"
-for f in ./usr/include/rsca/component/export.hpp ./usr/lib/cmake/rsca/rscaConfig.cmake \
-         ./usr/lib/cmake/rsca/RscaAddComponent.cmake ./usr/lib/pkgconfig/rsca.pc; do
+for f in ./usr/include/rsca/component/export.hpp ./usr/L/cmake/rsca/rscaConfig.cmake \
+         ./usr/L/cmake/rsca/RscaAddComponent.cmake ./usr/L/pkgconfig/rsca.pc ./usr/L/librsca_runtime.so; do
   has "$dev" "$f"
 done
 lacks "$dev" "^./usr/bin/"
@@ -33,6 +39,7 @@ dpkg-deb -f "$dev" Depends | grep -q "^rsca (= " || fail "rsca-dev does not depe
 # Depends: every library outside the package that an ELF file of it links directly.
 root="$work/root"
 dpkg-deb -x "$runtime" "$root"
+libdir="$(dirname "$(find "$root" -name 'librsca_runtime.so.0' -print -quit)")"
 depends="$(dpkg-deb -f "$runtime" Depends | tr ',' '\n' | sed 's/(.*//; s/ //g')"
 owner() { # the package that holds a library file, under either of usrmerge's paths
   local path="$1" p
@@ -46,7 +53,7 @@ owner() { # the package that holds a library file, under either of usrmerge's pa
 needed_paths() {
   local needed
   needed="$(readelf -d "$1" | sed -n 's/.*(NEEDED).*\[\(.*\)\]/\1/p')"
-  LD_LIBRARY_PATH="$root/usr/lib" ldd "$1" | awk '$2 == "=>" && $3 ~ /^\// {print $1, $3}' |
+  LD_LIBRARY_PATH="$libdir" ldd "$1" | awk '$2 == "=>" && $3 ~ /^\// {print $1, $3}' |
     while read -r soname path; do
       grep -qx "$soname" <<<"$needed" && echo "$path"
     done
@@ -66,6 +73,13 @@ while IFS= read -r -d '' elf; do
   done < <(needed_paths "$elf")
 done < <(find "$root" -type f -print0)
 [ "$checked" -ge 10 ] || fail "only $checked ELF files checked"
+
+# The units start the package's own programs.
+for unit in "$root"/lib/systemd/system/rsca-*.service; do
+  exec_start="$(sed -n 's/^ExecStart=\([^ ]*\).*/\1/p' "$unit")"
+  [ -n "$exec_start" ] && [ -x "$root$exec_start" ] ||
+    fail "$(basename "$unit") starts \"$exec_start\", which the package does not hold"
+done
 
 # Unpacked anywhere, the CLI finds its schemas' reader and its profiles.
 "$root/usr/bin/rsca" validate --strict "$root/usr/share/rsca/profiles" >"$work/validate.log" ||

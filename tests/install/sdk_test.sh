@@ -59,10 +59,11 @@ cmake --install "$work/build" --prefix "$sdr" >/dev/null
 [ -f "$sdr/dom/components/Greeter/libGreeter.so" ] || fail "the library was not installed"
 
 step "compile it again with pkg-config"
-pc="$(PKG_CONFIG_PATH="$usr/lib/pkgconfig" pkg-config --cflags --libs rsca)"
+libdir="$(dirname "$(find "$usr" -name 'librsca_runtime.so.0' -print -quit)")"
+pc="$(PKG_CONFIG_PATH="$libdir/pkgconfig" pkg-config --cflags --libs rsca)"
 # shellcheck disable=SC2086 # pkg-config's output is a list of flags
 g++ $flags "$work/src/Greeter/src/Greeter.cpp" $pc -o "$work/greeter-pkgconfig"
-LD_LIBRARY_PATH="$usr/lib" ldd "$work/greeter-pkgconfig" | grep -qF "librsca_runtime.so.0 => $usr/lib/" ||
+LD_LIBRARY_PATH="$libdir" ldd "$work/greeter-pkgconfig" | grep -qF "librsca_runtime.so.0 => $libdir/" ||
   fail "the program pkg-config built does not link the installed runtime"
 
 # The same component as a library a host loads: its SPD naming lib<name>.so, as the generated
