@@ -1,4 +1,5 @@
 #include "common/cpu_list.hpp"
+#include "common/text.hpp"
 
 #include <algorithm>
 #include <charconv>
@@ -8,13 +9,6 @@
 
 namespace rsca {
 namespace {
-
-std::string_view trim(std::string_view text) {
-  const auto first = text.find_first_not_of(" \t\r\n");
-  if (first == std::string_view::npos)
-    return {};
-  return text.substr(first, text.find_last_not_of(" \t\r\n") - first + 1);
-}
 
 tl::expected<unsigned, std::string> number(std::string_view text) {
   text = trim(text);

@@ -1,4 +1,5 @@
 #include "dds/dds_settings.hpp"
+#include "common/text.hpp"
 
 #include <algorithm>
 
@@ -29,11 +30,6 @@ std::uint64_t env_number_or(const char *name, std::uint64_t fallback) {
   char *end = nullptr;
   auto parsed = std::strtoull(value, &end, 10);
   return (end != nullptr && *end == '\0') ? parsed : fallback;
-}
-
-void replace_all(std::string &text, std::string_view key, const std::string &value) {
-  for (auto at = text.find(key); at != std::string::npos; at = text.find(key, at + value.size()))
-    text.replace(at, key.size(), value);
 }
 
 } // namespace

@@ -8,6 +8,7 @@
 
 #include "common/content_filter.hpp"
 #include "common/cpu_list.hpp"
+#include "common/text.hpp"
 #include "profile/connection_qos.hpp"
 #include "profile/read_context.hpp"
 
@@ -29,13 +30,6 @@ std::optional<Enum> enum_attr(ReadContext &ctx, const XmlElement &e, std::string
 }
 
 constexpr std::string_view kDeviceManagerRepId = "IDL:CF/DeviceManager:1.0";
-
-std::string_view trim_text(std::string_view text) {
-  const auto first = text.find_first_not_of(" \t\r\n");
-  if (first == std::string_view::npos)
-    return {};
-  return text.substr(first, text.find_last_not_of(" \t\r\n") - first + 1);
-}
 
 template <typename Int>
 tl::expected<Int, std::string> parse_int(std::string_view text) {
@@ -171,7 +165,7 @@ std::optional<std::uint32_t> read_start_order(ReadContext &ctx, const XmlElement
   const std::string *text = e.attribute("startorder");
   if (text == nullptr)
     return std::nullopt;
-  auto order = parse_int<std::uint32_t>(trim_text(*text));
+  auto order = parse_int<std::uint32_t>(trim(*text));
   if (!order)
     ctx.warn(e, "value",
              fmt::format("startorder \"{}\" is not a whole number: the instance has no start "
@@ -195,12 +189,12 @@ std::optional<std::string> affinity_value_problem(ProcessorAffinity::Class direc
     return list ? std::nullopt : std::optional(list.error());
   }
   if (directive == Class::Nice) {
-    auto nice = parse_int<int>(trim_text(value));
+    auto nice = parse_int<int>(trim(value));
     if (!nice || *nice < -20 || *nice > 19)
       return "a nice value is a whole number from -20 to 19";
     return std::nullopt;
   }
-  if (trim_text(value).empty() || value.size() > 15) // IFNAMSIZ - 1
+  if (trim(value).empty() || value.size() > 15) // IFNAMSIZ - 1
     return "a network interface name has 1 to 15 characters";
   return std::nullopt;
 }
@@ -236,8 +230,7 @@ std::optional<ProcessorAffinity> read_affinity(ReadContext &ctx, const XmlElemen
                          name));
     return std::nullopt;
   }
-  ProcessorAffinity affinity{known->second, std::string(trim_text(value_ref->attr("value"))),
-                             ctx.at(e)};
+  ProcessorAffinity affinity{known->second, std::string(trim(value_ref->attr("value"))), ctx.at(e)};
   if (auto problem = affinity_value_problem(affinity.directive, affinity.value)) {
     ctx.warn(*value_ref, "value",
              fmt::format("affinity {} \"{}\": {}: ignored", name, affinity.value, *problem));

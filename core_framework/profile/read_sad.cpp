@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "common/names.hpp"
+#include "common/text.hpp"
 #include "profile/read_context.hpp"
 #include "profile/sad.hpp"
 
@@ -25,11 +26,7 @@ void read_reservation(ReadContext &ctx, const XmlElement &e, HostCollocation &hc
         fmt::format("reservation kind \"{}\" is not one rsca reserves (cpucores): ignored", kind));
     return;
   }
-  std::string_view value = e.attr("value");
-  const auto first = value.find_first_not_of(" \t\r\n");
-  value = first == std::string_view::npos
-              ? std::string_view{}
-              : value.substr(first, value.find_last_not_of(" \t\r\n") - first + 1);
+  const std::string_view value = trim(e.attr("value"));
   double cores = 0;
   const auto [end, ec] = std::from_chars(value.data(), value.data() + value.size(), cores);
   if (ec != std::errc() || end != value.data() + value.size() || !std::isfinite(cores) ||

@@ -1,4 +1,5 @@
 #include "profile/xml_document.hpp"
+#include "common/text.hpp"
 
 #include <cctype>
 #include <fstream>
@@ -103,14 +104,6 @@ std::pair<int, int> position_of(std::string_view text, std::size_t at) {
   return {line, static_cast<int>(at - line_start) + 1};
 }
 
-std::string_view trim_xml_space(std::string_view s) {
-  auto first = s.find_first_not_of(" \t\r\n");
-  if (first == std::string_view::npos)
-    return {};
-  auto last = s.find_last_not_of(" \t\r\n");
-  return s.substr(first, last - first + 1);
-}
-
 } // namespace
 
 const std::string *XmlElement::attribute(std::string_view attribute_name) const {
@@ -139,7 +132,7 @@ std::string XmlElement::child_text(std::string_view child_name) const {
 }
 
 std::string XmlElement::trimmed_text() const {
-  return std::string(trim_xml_space(text));
+  return std::string(trim(text));
 }
 
 Expected<XmlDocument> read_xml_profile_text(std::string_view text, std::string file_name) {

@@ -34,7 +34,7 @@ namespace rsca::profile {
 
 // Generated from schemas/*.xsd by cmake/RscaEmbed.cmake.
 namespace schemas {
-std::pair<std::string_view, std::string_view> const *embedded_files(std::size_t &count);
+std::string_view embedded_file(std::string_view name);
 }
 
 // Declared here, defined below: the resolver serves the schemas compiled into this module.
@@ -457,12 +457,7 @@ ReaderPool &reader_pool() {
 } // namespace
 
 std::string_view embedded_schema(std::string_view file_name) {
-  std::size_t count = 0;
-  const auto *files = schemas::embedded_files(count);
-  for (std::size_t i = 0; i < count; ++i)
-    if (files[i].first == file_name)
-      return files[i].second;
-  return {};
+  return schemas::embedded_file(file_name);
 }
 
 } // namespace rsca::profile

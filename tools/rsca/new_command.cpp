@@ -14,11 +14,13 @@
 #include <tl/expected.hpp>
 
 #include "commands.hpp"
+#include "common/text.hpp"
 #include "exit_codes.hpp"
 
 namespace rsca::cli {
 namespace templates {
-std::pair<std::string_view, std::string_view> const *embedded_files(std::size_t &count);
+// Generated from templates/*.in by cmake/RscaEmbed.cmake.
+std::string_view embedded_file(std::string_view name);
 } // namespace templates
 
 namespace {
@@ -36,21 +38,6 @@ constexpr ProjectFile kComponentFiles[] = {
     {"component.spd.xml.in", "NAME.spd.xml"},          {"component.prf.xml.in", "NAME.prf.xml"},
     {"component.scd.xml.in", "NAME.scd.xml"},          {"component.sad.xml.in", "NAME.sad.xml"},
 };
-
-std::string_view template_text(std::string_view name) {
-  std::size_t count = 0;
-  const auto *files = templates::embedded_files(count);
-  for (std::size_t i = 0; i < count; ++i)
-    if (files[i].first == name)
-      return files[i].second;
-  return {}; // every name above is embedded (tools/rsca/CMakeLists.txt)
-}
-
-std::string replace_all(std::string text, std::string_view from, std::string_view to) {
-  for (auto at = text.find(from); at != std::string::npos; at = text.find(from, at + to.size()))
-    text.replace(at, from.size(), to);
-  return text;
-}
 
 // A random (version 4) UUID, for the SPD's and the SAD's DCE ids.
 std::string random_uuid() {
@@ -91,13 +78,15 @@ tl::expected<std::vector<fs::path>, std::string> write_project(const std::string
   const std::string spd_id = random_uuid(), sad_id = random_uuid();
   std::vector<fs::path> written;
   for (const auto &file : kComponentFiles) {
-    std::string text(template_text(file.template_name));
+    // Every template named above is embedded (tools/rsca/CMakeLists.txt).
+    std::string text(templates::embedded_file(file.template_name));
     for (const auto &[from, to] : {std::pair<std::string_view, std::string_view>{"@NAME@", name},
                                    {"@SPD_ID@", spd_id},
                                    {"@SAD_ID@", sad_id},
                                    {"@RSCA_VERSION@", RSCA_VERSION}})
-      text = replace_all(std::move(text), from, to);
-    const fs::path relative = replace_all(std::string(file.path), "NAME", name);
+      replace_all(text, from, to);
+    std::string relative(file.path);
+    replace_all(relative, "NAME", name);
     if (!write_file(staging / relative, text)) {
       fs::remove_all(staging, ec);
       return tl::unexpected(fmt::format("cannot write {}", (staging / relative).string()));
