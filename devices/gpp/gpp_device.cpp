@@ -145,20 +145,16 @@ GppDevice::execute(const protocol::node::ExecuteRequest &r,
       request.env.emplace_back(shm::kArenaVariable, reserved->second);
     }
   }
-  // The process starts on its CPUs (it inherits this thread's mask while it is set).
-  std::optional<ScopedThreadCpus> pinned;
-  if (placement && !placement->cpus.empty()) {
-    pinned.emplace(placement->cpus);
-    if (!pinned->pinned()) {
-      if (page)
-        context_.host_data->release_page(*page);
-      return control::call_error(
-          Status::Failed, fmt::format("{}: cannot run on CPUs {}: {}", context_.id,
-                                      fmt::join(placement->cpus, ","), std::strerror(errno)));
-    }
-  }
-  auto pid = launcher_.execute(request);
-  pinned.reset();
+  // The process starts on its CPUs: it inherits the spawning thread's mask while it is set.
+  const std::vector<unsigned> cpus = placement ? placement->cpus : std::vector<unsigned>{};
+  auto pid = spawner_.run([&]() -> Expected<ProcessId> {
+    std::optional<ScopedThreadCpus> pinned;
+    if (!cpus.empty() && !pinned.emplace(cpus).pinned())
+      return make_error(
+          {}, "execute",
+          fmt::format("cannot run on CPUs {}: {}", fmt::join(cpus, ","), std::strerror(errno)));
+    return launcher_.execute(request);
+  });
   if (!pid) {
     if (page)
       context_.host_data->release_page(*page);

@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "node/logical_device.hpp"
+#include "process/spawn_thread.hpp"
 #include "process_launcher.hpp"
 
 namespace rsca::gpp {
@@ -44,6 +45,9 @@ private:
   std::map<ProcessId, protocol::domain::ComponentExitedReport> owners_;
   // The package each process runs inside, kept in the node's cache while it runs.
   std::map<ProcessId, std::shared_ptr<const node::PackageLease>> packages_;
+  // Every process starts from this thread, which outlives them all (process/spawn_thread.hpp):
+  // destroyed after the launcher has stopped them.
+  process::SpawnThread spawner_;
   ProcessLauncher launcher_; // last: destroyed (terminating children) first
 };
 

@@ -257,6 +257,32 @@ TEST_CASE("a node daemon stopped after or while it ends a process exits cleanly,
   fs::remove(marker.string() + ".ready");
 }
 
+TEST_CASE("a node daemon stopped while an application runs ends its components in order, each "
+          "asked to shut down, none killed with the thread that started it",
+          "[integration][node][failure]") {
+  // Linux sends a child's parent-death signal (component/process.cpp asks for SIGKILL) when the
+  // thread that forked it exits: components started from the node's request threads died with
+  // them at shutdown, before the ordered stop (SIGINT first). Started from the GPP's own thread,
+  // each has the stop's first signal and says so in its log.
+  TestDomain domain(1);
+  const Json app = domain.launch_shipped("ProducerConsumer");
+  const auto status = domain.stop_node(1);
+  REQUIRE(status.has_value());
+  CHECK(WIFEXITED(*status));
+  for (const auto &c : app.at("components")) {
+    fs::path log;
+    for (const auto &f : fs::recursive_directory_iterator(domain.run_dir() / "logs"))
+      if (f.path().filename() == c.at("id").get<std::string>() + ".log")
+        log = f.path();
+    REQUIRE_FALSE(log.empty());
+    std::ifstream in(log);
+    const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    INFO(c.at("id").get<std::string>() << "'s log " << log << ":\n" << text);
+    CHECK(text.find("shutting down") != std::string::npos);
+    CHECK_FALSE(process_exists(c.at("pid").get<long>()));
+  }
+}
+
 TEST_CASE("a node daemon restarted within its lease is taken for a new run: its components are "
           "exited, its devices fresh, and a release is clean",
           "[integration][domain][failure]") {
