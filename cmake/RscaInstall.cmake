@@ -17,6 +17,8 @@ install(DIRECTORY schemas/ DESTINATION ${CMAKE_INSTALL_DATADIR}/rsca/schemas COM
         FILES_MATCHING PATTERN "*.xsd")
 install(DIRECTORY profiles/ DESTINATION ${CMAKE_INSTALL_DATADIR}/rsca/profiles COMPONENT runtime
         FILES_MATCHING PATTERN "*.xml")
+# Where rsca-noded@NAME.service reads its node's DCD (/etc/rsca/nodes/NAME.dcd.xml), empty.
+install(DIRECTORY DESTINATION ${CMAKE_INSTALL_FULL_SYSCONFDIR}/rsca/nodes COMPONENT runtime)
 
 # The SDK.
 install(TARGETS rsca_runtime rsca_sdk_headers rsca_component_headers EXPORT rscaTargets

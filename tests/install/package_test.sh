@@ -25,7 +25,7 @@ for f in ./usr/bin/rsca ./usr/bin/rsca-domaind ./usr/bin/rsca-noded ./usr/bin/rs
          ./usr/L/rsca/librsca_xml_reader.so ./usr/L/librsca_runtime.so.0 \
          ./usr/libexec/rsca/rsca-producer ./usr/share/rsca/profiles/dom/domain/DomainManager.dmd.xml \
          ./usr/share/rsca/schemas/sad.xsd ./L/systemd/system/rsca-domaind.service \
-         ./L/systemd/system/rsca-noded@.service; do
+         ./L/systemd/system/rsca-noded@.service ./etc/rsca/nodes/; do
   has "$runtime" "$f"
 done
 lacks "$runtime" "^./usr/include/"
