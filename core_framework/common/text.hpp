@@ -18,6 +18,8 @@ inline std::string_view trim(std::string_view text) {
 // Every occurrence of `key` in `text` replaced by `value` (a value holding the key is not
 // replaced again).
 inline void replace_all(std::string &text, std::string_view key, std::string_view value) {
+  if (key.empty())
+    return;
   for (auto at = text.find(key); at != std::string::npos; at = text.find(key, at + value.size()))
     text.replace(at, key.size(), value);
 }

@@ -72,24 +72,24 @@ std::string unique_name(std::string_view what) {
   return fmt::format("{}-{}-{}", what, ::getpid(), ++counter);
 }
 
-// A file's bytes: its text, or its base64 decoded; at most `budget` of them.
-CallResult<std::string> content_of(const InstallFile &f, std::uint64_t budget) {
-  using protocol::domain::FileEncoding;
-  std::optional<std::string> bytes = f.content;
-  if (f.encoding.value_or(FileEncoding::Text) == FileEncoding::Base64)
-    bytes = content::base64_decode(f.content);
-  if (!bytes)
-    return control::call_error(Status::BadRequest,
-                               fmt::format("file {}: its content is not base64", excerpt(f.path)));
-  if (bytes->size() > budget)
-    return control::call_error(Status::BadRequest,
-                               fmt::format("file {}: an install carries at most {} MiB in all",
-                                           excerpt(f.path),
-                                           protocol::domain::kMaxInstallBytes >> 20U));
-  return std::move(*bytes);
+auto over_budget(const InstallFile &f) {
+  return control::call_error(
+      Status::BadRequest, fmt::format("file {}: an install carries at most {} MiB in all",
+                                      excerpt(f.path), protocol::domain::kMaxInstallBytes >> 20U));
 }
 
-CallResult<void> write_file(const fs::path &file, const std::string &bytes, bool executable) {
+// A base64 file's bytes, decoded only once its size is known to fit `budget`.
+CallResult<std::string> decoded(const InstallFile &f, std::uint64_t budget) {
+  const auto size = content::base64_decoded_size(f.content);
+  if (!size)
+    return control::call_error(Status::BadRequest,
+                               fmt::format("file {}: its content is not base64", excerpt(f.path)));
+  if (*size > budget)
+    return over_budget(f);
+  return *content::base64_decode(f.content);
+}
+
+CallResult<void> write_file(const fs::path &file, std::string_view bytes, bool executable) {
   std::error_code ec;
   fs::create_directories(file.parent_path(), ec);
   std::ofstream out(file, std::ios::binary);
@@ -113,11 +113,20 @@ CallResult<void> write_files(const fs::path &dir, const std::vector<InstallFile>
       return control::call_error(
           Status::BadRequest,
           fmt::format("file path \"{}\" is not inside an SDR root", excerpt(f.path)));
-    auto bytes = content_of(f, budget);
-    if (!bytes)
-      return tl::unexpected(bytes.error());
-    budget -= bytes->size();
-    if (auto written = write_file(dir / *rel, *bytes, f.executable.value_or(false)); !written)
+    std::string decoded_bytes;
+    std::string_view bytes = f.content;
+    if (f.encoding.value_or(protocol::domain::FileEncoding::Text) ==
+        protocol::domain::FileEncoding::Base64) {
+      auto code = decoded(f, budget);
+      if (!code)
+        return tl::unexpected(code.error());
+      decoded_bytes = std::move(*code);
+      bytes = decoded_bytes;
+    }
+    if (bytes.size() > budget)
+      return over_budget(f);
+    budget -= bytes.size();
+    if (auto written = write_file(dir / *rel, bytes, f.executable.value_or(false)); !written)
       return written;
   }
   return {};

@@ -11,6 +11,7 @@
 #include <condition_variable>
 #include <functional>
 #include <future>
+#include <memory>
 #include <mutex>
 #include <queue>
 #include <thread>
@@ -27,11 +28,16 @@ public:
 
   // Runs `task` on the thread and returns its result (or rethrows what it threw). Whatever the
   // child should inherit from its parent thread (a CPU mask, a nice value) is set inside `task`.
+  // A task that calls run() itself runs inline (it would otherwise wait for itself).
   template <typename Task>
   std::invoke_result_t<Task> run(Task &&task) {
-    std::packaged_task<std::invoke_result_t<Task>()> packaged(std::forward<Task>(task));
-    auto result = packaged.get_future();
-    post([&packaged] { packaged(); });
+    if (std::this_thread::get_id() == thread_.get_id())
+      return std::forward<Task>(task)();
+    // The task is the posted function's own: the caller may wake and go before it returns.
+    auto packaged = std::make_shared<std::packaged_task<std::invoke_result_t<Task>()>>(
+        std::forward<Task>(task));
+    auto result = packaged->get_future();
+    post([packaged] { (*packaged)(); });
     return result.get();
   }
 

@@ -123,12 +123,19 @@ void collect_files(const ResolvedSoftPkg &pkg, std::set<std::filesystem::path> &
   }
 }
 
+// Code named by a relative path that stays beside or below its SPD; an absolute one is on the
+// node itself (as REDHAWK allows), and one above the SPD's folder is not the package's to carry.
+bool carried_code(const std::string &name) {
+  const auto path = std::filesystem::path(name).lexically_normal();
+  return !name.empty() && path.is_relative() && !path.empty() && *path.begin() != "..";
+}
+
 void collect_code(const ResolvedSoftPkg &pkg, std::set<std::filesystem::path> &files) {
   for (const auto &impl : pkg.implementations) {
     const auto &name = impl.implementation->code.file.name;
     std::error_code ec;
     if (const auto code = pkg.spd_path.parent_path() / name;
-        !name.empty() && std::filesystem::is_regular_file(code, ec))
+        carried_code(name) && std::filesystem::is_regular_file(code, ec))
       files.insert(code.lexically_normal());
     for (const auto &dep : impl.dependencies)
       collect_code(*dep.softpkg, files);

@@ -18,16 +18,31 @@ namespace fs = std::filesystem;
 
 constexpr const char *kModuleName = "librsca_xml_reader.so";
 
+// The folder of the file this code was loaded from: the program itself, or the runtime library
+// (librsca_runtime.so) of a component built against an installed rsca, which may run from any
+// folder (its package in a node's cache) while the runtime sits in the library folder.
+fs::path own_object_folder() {
+  Dl_info info{};
+  if (dladdr(reinterpret_cast<const void *>(&own_object_folder), &info) == 0 ||
+      info.dli_fname == nullptr)
+    return {};
+  std::error_code ec;
+  const auto file = fs::canonical(info.dli_fname, ec);
+  return ec ? fs::path() : file.parent_path();
+}
+
 // Where the module is: $RSCA_XML_READER alone when set; else rsca's library folders as seen from
-// the running program (an installed tree or the build tree), then the build tree this library was
-// built in (for programs outside both, such as a component built elsewhere).
+// the running program (an installed tree or the build tree), then `rsca/` beside the runtime
+// library this code is in. No path of the build is compiled in: it would be a place the
+// installed daemons load code from.
 std::vector<fs::path> module_candidates() {
   if (const char *path = std::getenv("RSCA_XML_READER"); path != nullptr && *path != '\0')
     return {fs::path(path)};
   std::vector<fs::path> out;
   for (const auto &folder : layout::library_folders())
     out.push_back(folder / kModuleName);
-  out.push_back(fs::path(RSCA_XML_READER_BUILD_DIR) / kModuleName);
+  if (const auto folder = own_object_folder(); !folder.empty())
+    out.push_back(folder / "rsca" / kModuleName);
   return out;
 }
 

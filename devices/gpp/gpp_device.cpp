@@ -147,19 +147,22 @@ GppDevice::execute(const protocol::node::ExecuteRequest &r,
   }
   // The process starts on its CPUs: it inherits the spawning thread's mask while it is set.
   const std::vector<unsigned> cpus = placement ? placement->cpus : std::vector<unsigned>{};
-  auto pid = spawner_.run([&]() -> Expected<ProcessId> {
+  auto pid = spawner_.run([&]() -> node::CallResult<ProcessId> {
     std::optional<ScopedThreadCpus> pinned;
     if (!cpus.empty() && !pinned.emplace(cpus).pinned())
-      return make_error(
-          {}, "execute",
-          fmt::format("cannot run on CPUs {}: {}", fmt::join(cpus, ","), std::strerror(errno)));
-    return launcher_.execute(request);
+      return control::call_error(Status::Failed,
+                                 fmt::format("{}: cannot run on CPUs {}: {}", context_.id,
+                                             fmt::join(cpus, ","), std::strerror(errno)));
+    auto started = launcher_.execute(request);
+    if (!started)
+      return control::call_error(Status::Failed,
+                                 fmt::format("{}: {}", context_.id, started.error().to_string()));
+    return *started;
   });
   if (!pid) {
     if (page)
       context_.host_data->release_page(*page);
-    return control::call_error(Status::Failed,
-                               fmt::format("{}: {}", context_.id, pid.error().to_string()));
+    return tl::unexpected(pid.error());
   }
   if (placement) {
     if (auto applied = apply_nice(*pid, *placement); !applied) {

@@ -15,12 +15,18 @@ fail() { printf 'FAIL: %s\n' "$*" >&2; exit 1; }
 runtime="$(ls "$work"/rsca_*.deb)"
 dev="$(ls "$work"/rsca-dev_*.deb)"
 
+# A package's file list, listed once into a file: grep -q on a pipe ends it early, and pipefail
+# then takes the writer's SIGPIPE for a failure.
+listing() {
+  local list="$work/$(basename "$1").list"
+  [ -f "$list" ] || dpkg-deb -c "$1" | awk '{print $6}' >"$list"
+  echo "$list"
+}
 # A file by its path in the package; `L` stands for the library folder (lib/<arch> on Debian).
 has() {
-  dpkg-deb -c "$1" | awk '{print $6}' | grep -Eqx "${2//L/lib(/[a-z0-9_-]+)?}" ||
-    fail "$(basename "$1") lacks $2"
+  grep -Eqx "${2//L/lib(/[a-z0-9_-]+)?}" "$(listing "$1")" || fail "$(basename "$1") lacks $2"
 }
-lacks() { ! dpkg-deb -c "$1" | awk '{print $6}' | grep -q "$2" || fail "$(basename "$1") holds $2"; }
+lacks() { ! grep -q "$2" "$(listing "$1")" || fail "$(basename "$1") holds $2"; }
 for f in ./usr/bin/rsca ./usr/bin/rsca-domaind ./usr/bin/rsca-noded ./usr/bin/rsca-component-host \
          ./usr/L/rsca/librsca_xml_reader.so ./usr/L/librsca_runtime.so.0 \
          ./usr/libexec/rsca/rsca-producer ./usr/share/rsca/profiles/dom/domain/DomainManager.dmd.xml \
@@ -34,7 +40,7 @@ for f in ./usr/include/rsca/component/export.hpp ./usr/L/cmake/rsca/rscaConfig.c
   has "$dev" "$f"
 done
 lacks "$dev" "^./usr/bin/"
-dpkg-deb -f "$dev" Depends | grep -q "^rsca (= " || fail "rsca-dev does not depend on rsca"
+dpkg-deb -f "$dev" Depends | grep "^rsca (= " >/dev/null || fail "rsca-dev does not depend on rsca"
 
 # Depends: every library outside the package that an ELF file of it links directly.
 root="$work/root"
@@ -73,6 +79,11 @@ while IFS= read -r -d '' elf; do
   done < <(needed_paths "$elf")
 done < <(find "$root" -type f -print0)
 [ "$checked" -ge 10 ] || fail "only $checked ELF files checked"
+
+# Nothing of it names the build: a path compiled in would be a place the installed daemons load
+# code from on the robot.
+build_real="$(realpath "$build")"
+if grep -rlF -- "$build_real" "$root"; then fail "files of the package name the build folder $build_real"; fi
 
 # The units start the package's own programs.
 for unit in "$root"/lib/systemd/system/rsca-*.service; do

@@ -63,7 +63,7 @@ libdir="$(dirname "$(find "$usr" -name 'librsca_runtime.so.0' -print -quit)")"
 pc="$(PKG_CONFIG_PATH="$libdir/pkgconfig" pkg-config --cflags --libs rsca)"
 # shellcheck disable=SC2086 # pkg-config's output is a list of flags
 g++ $flags "$work/src/Greeter/src/Greeter.cpp" $pc -o "$work/greeter-pkgconfig"
-LD_LIBRARY_PATH="$libdir" ldd "$work/greeter-pkgconfig" | grep -qF "librsca_runtime.so.0 => $libdir/" ||
+LD_LIBRARY_PATH="$libdir" ldd "$work/greeter-pkgconfig" | grep -F "librsca_runtime.so.0 => $libdir/" >/dev/null ||
   fail "the program pkg-config built does not link the installed runtime"
 
 # The same component as a library a host loads: its SPD naming lib<name>.so, as the generated
@@ -90,7 +90,7 @@ step "launch both forms"
 "$rsca" launch "$sdr/dom/waveforms/GreeterLib/GreeterLib.sad.xml"
 wait_ticks Greeter
 wait_ticks GreeterLib
-"$rsca" --json show GreeterLib | grep -q '"state": "running"' || fail "GreeterLib is not running"
+"$rsca" --json show GreeterLib | grep '"state": "running"' >/dev/null || fail "GreeterLib is not running"
 
 step "release, domain down, nothing left"
 "$rsca" release Greeter
