@@ -1,6 +1,7 @@
 // rsca-noded: a node daemon (DeviceManager). Its devices are libraries its DCD's SPDs name
-// (node/device_export.hpp), loaded when the node starts; it exports the rsca code they call. Runs in the
-// foreground (for systemd and similar supervisors); `rsca domain up` starts it in the background.
+// (node/device_export.hpp), loaded when the node starts; it exports the rsca code they call. Runs
+// in the foreground (for systemd and similar supervisors); `rsca domain up` starts it in the
+// background.
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>

@@ -33,8 +33,8 @@ std::optional<std::string> DeviceLibraries::load(const fs::path &library,
     return fmt::format("cannot load {}: {}", library.string(), dlerror());
   auto entry = reinterpret_cast<DeviceFactoriesExport>(dlsym(handle, kDeviceFactoriesSymbol));
   if (entry == nullptr)
-    return fmt::format("{} exports no {} (declare its devices with RSCA_DEVICES)",
-                       library.string(), kDeviceFactoriesSymbol);
+    return fmt::format("{} exports no {} (declare its devices with RSCA_DEVICES)", library.string(),
+                       kDeviceFactoriesSymbol);
   entry(&registry);
   return std::nullopt;
 }

@@ -26,8 +26,8 @@ public:
   // implementation names, loaded into `registry` the first time. Fails with why, naming the file
   // and the symbol: the SPD names no library, the library cannot be loaded, exports no
   // kDeviceFactoriesSymbol, or registers no device of the SPD's name.
-  tl::expected<const DeviceFactory *, std::string> factory_of(const profile::ResolvedSoftPkg &softpkg,
-                                                             DeviceRegistry &registry);
+  tl::expected<const DeviceFactory *, std::string>
+  factory_of(const profile::ResolvedSoftPkg &softpkg, DeviceRegistry &registry);
 
 private:
   std::optional<std::string> load(const std::filesystem::path &library, DeviceRegistry &registry);

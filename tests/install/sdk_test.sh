@@ -65,7 +65,8 @@ libdir="$(dirname "$(find "$usr" -name 'librsca_runtime.so.0' -print -quit)")"
 pc="$(PKG_CONFIG_PATH="$libdir/pkgconfig" pkg-config --cflags --libs rsca)"
 # shellcheck disable=SC2086 # pkg-config's output is a list of flags
 g++ $flags "$work/src/Greeter/src/Greeter.cpp" $pc -o "$work/greeter-pkgconfig"
-LD_LIBRARY_PATH="$libdir" ldd "$work/greeter-pkgconfig" | grep -qF "librsca_runtime.so.0 => $libdir/" ||
+# grep reads all of ldd's output (not -q): ldd cut off by SIGPIPE fails the pipe (pipefail).
+LD_LIBRARY_PATH="$libdir" ldd "$work/greeter-pkgconfig" | grep -F "librsca_runtime.so.0 => $libdir/" >/dev/null ||
   fail "the program pkg-config built does not link the installed runtime"
 
 # The same component as a library a host loads: its SPD naming lib<name>.so, as the generated
@@ -92,12 +93,14 @@ thermo_dcd="$sdr/dev/nodes/Thermo_node/DeviceManager.dcd.xml"
 [ -f "$sdr/dev/devices/Thermo/libThermo.so" ] || fail "the device library was not installed"
 [ -f "$sdr/dev/devices/Thermo/Thermo.spd.xml" ] || fail "the device's SPD was not installed"
 [ -f "$thermo_dcd" ] || fail "the device's node DCD was not installed"
-if readelf -d "$sdr/dev/devices/Thermo/libThermo.so" | grep -q 'NEEDED.*librsca'; then
+if readelf -d "$sdr/dev/devices/Thermo/libThermo.so" | grep 'NEEDED.*librsca'; then
   fail "the device library links an rsca library (rsca-noded provides the code)"
 fi
+# The generated profiles are valid.
+"$rsca" validate "$sdr"
 
 step "the installed daemons come up, one node with the new device"
-"$rsca" domain up --nodes 1 --node "$thermo_dcd" --run-dir "$work/run"
+"$rsca" domain up --nodes 1 --node "$thermo_dcd" --run-dir "$work/run" || { tail -n 20 "$work"/run/*.log >&2; fail "the daemons did not come up"; }
 domaind="$(cat "$work/run/domaind.pid")"
 [ "$(readlink "/proc/$domaind/exe")" = "$usr/bin/rsca-domaind" ] || fail "domaind is not the installed one"
 

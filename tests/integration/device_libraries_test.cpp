@@ -37,9 +37,10 @@ TEST_CASE("a node whose devices cannot be loaded starts with the others and says
           "[integration][devices]") {
   TestDomain domain(1);
   const fs::path log = domain.run_dir() / "partial.log";
-  ChildProcess node((kBin / "rsca-noded").string(),
-                    {"--dcd", kPartialNode.string(), "--log-dir", (domain.run_dir() / "logs").string()},
-                    domain.env(), log);
+  ChildProcess node(
+      (kBin / "rsca-noded").string(),
+      {"--dcd", kPartialNode.string(), "--log-dir", (domain.run_dir() / "logs").string()},
+      domain.env(), log);
   REQUIRE(TestDomain::wait_for([&] {
     auto nodes = domain.call("domain.nodes");
     return nodes && nodes->at("nodes").size() == 2;
@@ -49,10 +50,10 @@ TEST_CASE("a node whose devices cannot be loaded starts with the others and says
 
   const std::string text = read_file(log);
   INFO(text);
-  CHECK_THAT(text, Catch::Contains("device partial:NoLibrary_1 (NoLibrary) not started: cannot "
-                                   "load " +
-                                   (kTestSdr / "dev/devices/NoLibrary/librsca-no-such-device.so")
-                                       .string()));
+  CHECK_THAT(text, Catch::Contains(
+                       "device partial:NoLibrary_1 (NoLibrary) not started: cannot "
+                       "load " +
+                       (kTestSdr / "dev/devices/NoLibrary/librsca-no-such-device.so").string()));
   CHECK_THAT(text, Catch::Contains("device partial:NoSymbol_1 (NoSymbol) not started:"));
   CHECK_THAT(text, Catch::Contains("librsca_xml_reader.so exports no rsca_device_factories"));
 

@@ -40,8 +40,8 @@ TEST_CASE("a device library that is not there fails naming the file", "[node][de
   rsca::test::TempDir dir;
   DeviceLibraries libraries({kLibraries});
   DeviceRegistry registry;
-  auto factory = libraries.factory_of(softpkg("Gone", "librsca-no-such-device.so", dir.path()),
-                                      registry);
+  auto factory =
+      libraries.factory_of(softpkg("Gone", "librsca-no-such-device.so", dir.path()), registry);
   REQUIRE_FALSE(factory.has_value());
   CHECK_THAT(factory.error(), Catch::Contains("cannot load"));
   CHECK_THAT(factory.error(), Catch::Contains((dir.path() / "librsca-no-such-device.so").string()));
@@ -53,8 +53,8 @@ TEST_CASE("a library without the device symbol fails naming the file and the sym
   DeviceLibraries libraries({kLibraries});
   DeviceRegistry registry;
   // The XML reader module: a library rsca loads, found by name in rsca's library folder.
-  auto factory = libraries.factory_of(softpkg("Reader", "librsca_xml_reader.so", dir.path()),
-                                      registry);
+  auto factory =
+      libraries.factory_of(softpkg("Reader", "librsca_xml_reader.so", dir.path()), registry);
   REQUIRE_FALSE(factory.has_value());
   CHECK_THAT(factory.error(), Catch::Contains((kLibraries / "librsca_xml_reader.so").string()));
   CHECK_THAT(factory.error(), Catch::Contains(rsca::node::kDeviceFactoriesSymbol));

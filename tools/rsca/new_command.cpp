@@ -56,11 +56,10 @@ struct ProjectKind {
   std::string_view next;
 };
 
-constexpr ProjectKind kComponent{
-    "component", kComponentFiles,
-    "next:\n  cd {0} && cmake -B build && cmake --build build\n"
-    "  cmake --install build --prefix \"$SDRROOT\"\n"
-    "  rsca launch \"$SDRROOT/dom/waveforms/{1}/{1}.sad.xml\"\n"};
+constexpr ProjectKind kComponent{"component", kComponentFiles,
+                                 "next:\n  cd {0} && cmake -B build && cmake --build build\n"
+                                 "  cmake --install build --prefix \"$SDRROOT\"\n"
+                                 "  rsca launch \"$SDRROOT/dom/waveforms/{1}/{1}.sad.xml\"\n"};
 
 constexpr ProjectKind kDevice{
     "device", kDeviceFiles,
