@@ -11,65 +11,65 @@
 namespace {
 
 namespace fs = std::filesystem;
-using rsca::node::DeviceLibraries;
-using rsca::node::DeviceRegistry;
+using rsca::node::DeviceFactory;
 using rsca::profile::CodeType;
 
 const fs::path kLibraries = RSCA_LIBRARY_DIR;
 
-// A device package named `name` whose one implementation is `library` of code type `type`, its
-// SPD in `folder`.
-rsca::profile::ResolvedSoftPkg softpkg(const std::string &name, const std::string &library,
-                                       const fs::path &folder,
-                                       CodeType type = CodeType::SharedLibrary) {
-  auto spd = std::make_shared<rsca::profile::SoftPkg>();
-  spd->name = name;
-  rsca::profile::Implementation implementation;
-  implementation.code.type = type;
-  implementation.code.file.name = library;
-  spd->implementations.push_back(implementation);
-  rsca::profile::ResolvedSoftPkg out;
-  out.spd_path = folder / (name + ".spd.xml");
-  out.spd = spd;
-  return out;
-}
+// A node's libraries, its SPDs in a folder of their own and rsca's library folder the one to
+// look in by name.
+struct Node {
+  rsca::test::TempDir spds;
+  rsca::node::DeviceLibraries libraries{{kLibraries}};
+  rsca::node::DeviceRegistry registry;
+
+  // The factory of a device package `name` whose one implementation is `library` of code type
+  // `type`.
+  tl::expected<const DeviceFactory *, std::string>
+  factory_of(const std::string &name, const std::string &library,
+             CodeType type = CodeType::SharedLibrary) {
+    auto spd = std::make_shared<rsca::profile::SoftPkg>();
+    spd->name = name;
+    rsca::profile::Implementation implementation;
+    implementation.code.type = type;
+    implementation.code.file.name = library;
+    spd->implementations.push_back(implementation);
+    rsca::profile::ResolvedSoftPkg softpkg;
+    softpkg.spd_path = spds.path() / (name + ".spd.xml");
+    softpkg.spd = spd;
+    return libraries.factory_of(softpkg, registry);
+  }
+};
 
 } // namespace
 
 TEST_CASE("a device library that is not there fails naming the file", "[node][devices]") {
-  rsca::test::TempDir dir;
-  DeviceLibraries libraries({kLibraries});
-  DeviceRegistry registry;
-  auto factory =
-      libraries.factory_of(softpkg("Gone", "librsca-no-such-device.so", dir.path()), registry);
+  Node node;
+  auto factory = node.factory_of("Gone", "librsca-no-such-device.so");
   REQUIRE_FALSE(factory.has_value());
   CHECK_THAT(factory.error(), Catch::Contains("cannot load"));
-  CHECK_THAT(factory.error(), Catch::Contains((dir.path() / "librsca-no-such-device.so").string()));
+  CHECK_THAT(factory.error(),
+             Catch::Contains((node.spds.path() / "librsca-no-such-device.so").string()));
 }
 
 TEST_CASE("a library without the device symbol fails naming the file and the symbol",
           "[node][devices]") {
-  rsca::test::TempDir dir;
-  DeviceLibraries libraries({kLibraries});
-  DeviceRegistry registry;
+  Node node;
   // The XML reader module: a library rsca loads, found by name in rsca's library folder.
-  auto factory =
-      libraries.factory_of(softpkg("Reader", "librsca_xml_reader.so", dir.path()), registry);
+  auto factory = node.factory_of("Reader", "librsca_xml_reader.so");
   REQUIRE_FALSE(factory.has_value());
   CHECK_THAT(factory.error(), Catch::Contains((kLibraries / "librsca_xml_reader.so").string()));
   CHECK_THAT(factory.error(), Catch::Contains(rsca::node::kDeviceFactoriesSymbol));
 }
 
-TEST_CASE("a device library's devices are found by their SPD's name, the library loaded once",
+TEST_CASE("a device library's devices are found by their SPD's name, the library entered once",
           "[node][devices]") {
-  rsca::test::TempDir dir;
-  DeviceLibraries libraries({kLibraries});
-  DeviceRegistry registry;
+  Node node;
   const std::string library = "librsca-test-device.so";
-  auto found = libraries.factory_of(softpkg("TestDevice", library, dir.path()), registry);
+  auto found = node.factory_of("TestDevice", library);
   REQUIRE(found.has_value());
-  CHECK(*found == registry.find("TestDevice"));
-  auto again = libraries.factory_of(softpkg("TestDevice", library, dir.path()), registry);
+  CHECK(*found == node.registry.find("TestDevice"));
+  auto again = node.factory_of("TestDevice", library);
   REQUIRE(again.has_value());
   CHECK(*again == *found);
   // The library counts how often it was entered.
@@ -80,18 +80,15 @@ TEST_CASE("a device library's devices are found by their SPD's name, the library
   CHECK(entries() == 1);
   dlclose(loaded); // the reference RTLD_NOLOAD took
 
-  auto other = libraries.factory_of(softpkg("Other", library, dir.path()), registry);
+  auto other = node.factory_of("Other", library);
   REQUIRE_FALSE(other.has_value());
   CHECK_THAT(other.error(), Catch::Contains("registers no device named Other"));
   CHECK_THAT(other.error(), Catch::Contains(library));
 }
 
 TEST_CASE("a device whose SPD names no shared library has no implementation", "[node][devices]") {
-  rsca::test::TempDir dir;
-  DeviceLibraries libraries({kLibraries});
-  DeviceRegistry registry;
-  auto factory = libraries.factory_of(
-      softpkg("GPP", "bin/rsca-gpp", dir.path(), CodeType::Executable), registry);
+  Node node;
+  auto factory = node.factory_of("GPP", "bin/rsca-gpp", CodeType::Executable);
   REQUIRE_FALSE(factory.has_value());
   CHECK_THAT(factory.error(), Catch::Contains("names no SharedLibrary implementation"));
 }
