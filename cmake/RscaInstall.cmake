@@ -1,9 +1,9 @@
 # What `cmake --install` puts where (GNUInstallDirs), in two install components that CPack makes
 # into two Debian packages (cmake/RscaPackage.cmake):
 #   runtime  the daemons, the CLI, the component host, the runtime library, the XML reader module,
-#            the example components, the schemas and the default profiles (package rsca);
-#   dev      the component SDK: headers, the CMake package (find_package(rsca)) with
-#            rsca_add_component, and a pkg-config file (package rsca-dev).
+#            the device libraries, the example components, the schemas and the default profiles (package rsca);
+#   dev      the component and device SDK: headers, the CMake package (find_package(rsca)) with
+#            rsca_add_component and rsca_add_device, and a pkg-config file (package rsca-dev).
 # The programs find the rest from their own folder (common/install_layout.hpp), so an installed
 # tree works under any prefix and from a DESTDIR.
 include(CMakePackageConfigHelpers)
@@ -12,7 +12,10 @@ set(RSCA_INSTALL_CMAKEDIR ${CMAKE_INSTALL_LIBDIR}/cmake/rsca)
 
 install(TARGETS rsca rsca-domaind rsca-noded rsca-component-host rsca-sim-run
         RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime)
-install(TARGETS rsca_xml_reader LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}/rsca COMPONENT runtime)
+# The XML reader module and the device libraries, where common/install_layout.hpp finds them.
+get_property(rsca_devices GLOBAL PROPERTY RSCA_DEVICE_TARGETS)
+install(TARGETS rsca_xml_reader ${rsca_devices} LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}/rsca
+        COMPONENT runtime)
 install(DIRECTORY schemas/ DESTINATION ${CMAKE_INSTALL_DATADIR}/rsca/schemas COMPONENT runtime
         FILES_MATCHING PATTERN "*.xsd")
 install(DIRECTORY profiles/ DESTINATION ${CMAKE_INSTALL_DATADIR}/rsca/profiles COMPONENT runtime
@@ -21,7 +24,7 @@ install(DIRECTORY profiles/ DESTINATION ${CMAKE_INSTALL_DATADIR}/rsca/profiles C
 install(DIRECTORY DESTINATION ${CMAKE_INSTALL_FULL_SYSCONFDIR}/rsca/nodes COMPONENT runtime)
 
 # The SDK.
-install(TARGETS rsca_runtime rsca_sdk_headers rsca_component_headers EXPORT rscaTargets
+install(TARGETS rsca_runtime rsca_sdk_headers rsca_component_headers rsca_device_headers EXPORT rscaTargets
         LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT runtime NAMELINK_COMPONENT dev)
 foreach(header ${RSCA_SDK_HEADERS})
   get_filename_component(folder ${header} DIRECTORY)
@@ -36,7 +39,7 @@ write_basic_package_version_file(${CMAKE_BINARY_DIR}/cmake/rscaConfigVersion.cma
                                  COMPATIBILITY SameMinorVersion)
 install(FILES ${CMAKE_BINARY_DIR}/cmake/rscaConfig.cmake
               ${CMAKE_BINARY_DIR}/cmake/rscaConfigVersion.cmake cmake/RscaAddComponent.cmake
-        DESTINATION ${RSCA_INSTALL_CMAKEDIR} COMPONENT dev)
+              cmake/RscaAddDevice.cmake DESTINATION ${RSCA_INSTALL_CMAKEDIR} COMPONENT dev)
 
 # pkg-config: the prefix from the file's own place, so that a DESTDIR tree answers for itself.
 file(RELATIVE_PATH RSCA_PC_TO_PREFIX /${CMAKE_INSTALL_LIBDIR}/pkgconfig /)

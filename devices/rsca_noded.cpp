@@ -1,5 +1,7 @@
-// rsca-noded: a node daemon (DeviceManager) with every device this build provides. Runs in the
-// foreground (for systemd and similar supervisors); `rsca domain up` starts it in the background.
+// rsca-noded: a node daemon (DeviceManager). Its devices are libraries its DCD's SPDs name
+// (node/device_export.hpp), loaded when the node starts; it exports the rsca code they call. Runs
+// in the foreground (for systemd and similar supervisors); `rsca domain up` starts it in the
+// background.
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -10,10 +12,7 @@
 #include "common/process_priority.hpp"
 #include "common/termination_signals.hpp"
 #include "dds/participant.hpp"
-#include "gpp/gpp_device.hpp"
-#include "monitor/host_monitor.hpp"
 #include "node/device_manager.hpp"
-#include "robot/robot_devices.hpp"
 #include "service/systemd.hpp"
 
 int main(int argc, char **argv) {
@@ -88,10 +87,6 @@ int main(int argc, char **argv) {
   if (!control_socket.empty())
     options.control_socket = control_socket;
 
-  rsca::node::DeviceRegistry registry;
-  rsca::gpp::register_gpp(registry);
-  rsca::monitor::register_host_monitor(registry);
-  rsca::robot::register_robot_devices(registry);
   const auto dds = rsca::dds::DdsSettings::from_environment();
   rsca::service::notify_status(fmt::format("joining DDS domain {}", dds.domain_id));
   auto participant = rsca::dds::Participant::create(dds);
@@ -100,7 +95,7 @@ int main(int argc, char **argv) {
     return 1;
   }
   rsca::service::notify_status("starting the node of " + dcd + ": its devices, links and cache");
-  auto manager = rsca::node::DeviceManager::create(*participant, options, registry);
+  auto manager = rsca::node::DeviceManager::create(*participant, options);
   if (!manager) {
     spdlog::error("the node cannot start:\n{}", manager.error().to_string());
     return 1;

@@ -33,6 +33,18 @@ std::vector<fs::path> component_folders() {
   return out;
 }
 
+fs::path resolve_code(const fs::path &file, const fs::path &spd,
+                      const std::vector<fs::path> &folders) {
+  const fs::path named = file.is_absolute() ? file : spd.parent_path() / file;
+  std::error_code ec;
+  if (fs::exists(named, ec))
+    return named;
+  for (const auto &folder : folders)
+    if (fs::exists(folder / file.filename(), ec))
+      return folder / file.filename();
+  return named;
+}
+
 fs::path default_sdrroot() {
   const fs::path bin = own_folder();
   if (bin.empty())

@@ -15,6 +15,12 @@ std::vector<std::filesystem::path> library_folders();
 // Folders that may hold component code an SPD names: the program's own folder, the installed
 // libexec folder, then the library folders.
 std::vector<std::filesystem::path> component_folders();
+// A code file an SPD names (a library, a program): absolute, or relative to the SPD's folder; one
+// that is not there is looked up by file name in `folders`. Not found anywhere: where the SPD
+// names it, for the error to say.
+std::filesystem::path resolve_code(const std::filesystem::path &file,
+                                   const std::filesystem::path &spd,
+                                   const std::vector<std::filesystem::path> &folders);
 // The default SDR root: the installed profiles when this program is installed, else the
 // source tree's beside the build tree. Empty when neither is there.
 std::filesystem::path default_sdrroot();

@@ -29,14 +29,7 @@ using detail::ExitEvents;
 // there is looked up by name where rsca keeps component code (common/install_layout.hpp: the
 // example components' libraries, built or installed).
 fs::path resolve_library(const fs::path &library, const fs::path &spd) {
-  const fs::path named = library.is_absolute() ? library : spd.parent_path() / library;
-  std::error_code ec;
-  if (fs::exists(named, ec))
-    return named;
-  for (const auto &folder : layout::component_folders())
-    if (fs::exists(folder / library.filename(), ec))
-      return folder / library.filename();
-  return named;
+  return layout::resolve_code(library, spd, layout::component_folders());
 }
 
 // The library stays loaded for the life of the process (RTLD_NODELETE): its code runs on threads

@@ -9,7 +9,9 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "common/install_layout.hpp"
 #include "control/operation.hpp"
+#include "node/device_libraries.hpp"
 #include "profile/property_binding.hpp"
 #include "profile/property_json.hpp"
 #include "protocol/addresses.hpp"
@@ -61,11 +63,15 @@ struct DeviceManager::Impl {
   std::unique_ptr<PackageCache> cache; // fetches through the endpoint
   std::shared_ptr<const profile::DeviceConfiguration> dcd;
   profile::ResolvedNode node;
+  // The devices' implementations, from the libraries their SPDs name: before the devices, which
+  // their code made, so that the devices go first.
+  DeviceRegistry registry;
+  DeviceLibraries libraries{{}};
   std::vector<RunningDevice> devices;
   std::atomic<bool> stopping{false};
   std::mutex endpoint_mutex; // the endpoint's end against a process exit reported meanwhile
 
-  Expected<void> start_devices(const DeviceRegistry &registry);
+  Expected<void> start_devices();
   op::NodeAnnouncement announcement() const;
   void serve();
   ExecutableDevice *executable_device(const std::string &id) const;
@@ -117,20 +123,22 @@ void apply_logging_config(const profile::ResolvedNode &node) {
 
 } // namespace
 
-Expected<void> DeviceManager::Impl::start_devices(const DeviceRegistry &registry) {
+// A device that cannot be started as its profiles say (a file missing, its library not loaded)
+// is left out with the reason, and the node starts with the others: it loses nothing it could run.
+Expected<void> DeviceManager::Impl::start_devices() {
   for (const auto &[placed_ptr, ci_ptr] : start_order_of(node)) {
     const auto &placed = *placed_ptr;
     const auto &ci = *ci_ptr;
-    const DeviceFactory *factory = registry.find(placed.softpkg->spd->name);
     const std::string label = ci.usage_name.empty() ? ci.id : ci.usage_name;
     const std::string id = fmt::format("{}:{}", dcd->name, label);
     if (!placed.softpkg->unavailable.empty()) {
       spdlog::warn("device {} not started: {}", id, to_string(placed.softpkg->unavailable.front()));
       continue;
     }
-    if (factory == nullptr) {
-      spdlog::warn("device {}: no implementation of {} in this node daemon; skipped", id,
-                   placed.softpkg->spd->name);
+    auto factory = libraries.factory_of(*placed.softpkg, registry);
+    if (!factory) {
+      spdlog::warn("device {} ({}) not started: {}", id, placed.softpkg->spd->name,
+                   factory.error());
       continue;
     }
     DeviceContext context{id,
@@ -147,7 +155,7 @@ Expected<void> DeviceManager::Impl::start_devices(const DeviceRegistry &registry
                           [this](const auto &report) { report_exit(report); },
                           links.get(),
                           host_data.get()};
-    auto device = (*factory)(context);
+    auto device = (**factory)(context);
     if (!device)
       return tl::unexpected(device.error());
     spdlog::info("device {} ({}) started", id, placed.softpkg->spd->name);
@@ -302,10 +310,12 @@ const std::string &DeviceManager::node_name() const {
 }
 
 Expected<std::unique_ptr<DeviceManager>>
-DeviceManager::create(std::shared_ptr<dds::Participant> participant, NodeOptions options,
-                      const DeviceRegistry &registry) {
+DeviceManager::create(std::shared_ptr<dds::Participant> participant, NodeOptions options) {
   auto impl = std::make_unique<Impl>();
   impl->options = std::move(options);
+  if (impl->options.library_path.empty())
+    impl->options.library_path = layout::library_folders();
+  impl->libraries = DeviceLibraries(impl->options.library_path);
   impl->participant = participant;
   profile::ProfileLoader loader(impl->options.sdrroot);
   auto node = loader.load_node(impl->options.dcd);
@@ -355,7 +365,7 @@ DeviceManager::create(std::shared_ptr<dds::Participant> participant, NodeOptions
       return tl::unexpected(ok.error());
   if (auto ok = impl->open_cache(); !ok)
     return tl::unexpected(ok.error());
-  if (auto ok = impl->start_devices(registry); !ok)
+  if (auto ok = impl->start_devices(); !ok)
     return tl::unexpected(ok.error());
   impl->serve();
   impl->endpoint->start_serving();

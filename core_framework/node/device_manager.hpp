@@ -1,4 +1,5 @@
-// DeviceManager: the node daemon. Reads its DCD, starts the logical devices it names, announces
+// DeviceManager: the node daemon. Reads its DCD, starts the logical devices it names (each from
+// the library its SPD names, node/device_libraries.hpp), announces
 // the node and its devices to the domain, and serves node.execute / node.terminate for its
 // executable devices. It needs no registration protocol: its announcement is durable, so a
 // domain daemon that (re)starts sees it at once.
@@ -20,6 +21,9 @@ struct NodeOptions {
   std::optional<std::filesystem::path> sdrroot;
   std::string domain_name = "rsca";
   std::vector<std::filesystem::path> exec_path;
+  // Where a device library an SPD names without a path that is not beside it is looked for
+  // (node/device_libraries.hpp). Empty: rsca's library folders (common/install_layout.hpp).
+  std::vector<std::filesystem::path> library_path;
   std::filesystem::path log_dir = "/tmp/rsca/logs";
   // Where local clients (the CLI) connect for a link to the node (ProcessLinks::listen); none:
   // they use DDS.
@@ -35,8 +39,7 @@ struct NodeOptions {
 class DeviceManager {
 public:
   static Expected<std::unique_ptr<DeviceManager>>
-  create(std::shared_ptr<dds::Participant> participant, NodeOptions options,
-         const DeviceRegistry &registry);
+  create(std::shared_ptr<dds::Participant> participant, NodeOptions options);
   ~DeviceManager();
 
   const std::string &node_name() const;

@@ -4,6 +4,7 @@
 
 #include "component/component.hpp"
 #include "gpp/host_info.hpp"
+#include "node/device_export.hpp"
 #include "node/hosted_device.hpp"
 
 namespace rsca::monitor {
@@ -47,3 +48,5 @@ void register_host_monitor(node::DeviceRegistry &registry) {
 }
 
 } // namespace rsca::monitor
+
+RSCA_DEVICES(rsca::monitor::register_host_monitor)

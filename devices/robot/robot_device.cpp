@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include "component/component.hpp"
+#include "node/device_export.hpp"
 #include "node/hosted_device.hpp"
 #include "robot/robot_devices.hpp"
 #include "robot/robot_world.hpp"
@@ -257,3 +258,5 @@ void register_robot_devices(node::DeviceRegistry &registry) {
 }
 
 } // namespace rsca::robot
+
+RSCA_DEVICES(rsca::robot::register_robot_devices)

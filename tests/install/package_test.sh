@@ -29,14 +29,18 @@ has() {
 lacks() { ! grep -q "$2" "$(listing "$1")" || fail "$(basename "$1") holds $2"; }
 for f in ./usr/bin/rsca ./usr/bin/rsca-domaind ./usr/bin/rsca-noded ./usr/bin/rsca-component-host \
          ./usr/L/rsca/librsca_xml_reader.so ./usr/L/librsca_runtime.so.0 \
+         ./usr/L/rsca/librsca-gpp.so ./usr/L/rsca/librsca-host-monitor.so \
+         ./usr/L/rsca/librsca-robot-devices.so \
          ./usr/libexec/rsca/rsca-producer ./usr/share/rsca/profiles/dom/domain/DomainManager.dmd.xml \
          ./usr/share/rsca/schemas/sad.xsd ./L/systemd/system/rsca-domaind.service \
          ./L/systemd/system/rsca-noded@.service ./etc/rsca/nodes/; do
   has "$runtime" "$f"
 done
 lacks "$runtime" "^./usr/include/"
-for f in ./usr/include/rsca/component/export.hpp ./usr/L/cmake/rsca/rscaConfig.cmake \
-         ./usr/L/cmake/rsca/RscaAddComponent.cmake ./usr/L/pkgconfig/rsca.pc ./usr/L/librsca_runtime.so; do
+for f in ./usr/include/rsca/component/export.hpp ./usr/include/rsca/node/device_export.hpp \
+         ./usr/include/rsca/node/hosted_device.hpp ./usr/L/cmake/rsca/rscaConfig.cmake \
+         ./usr/L/cmake/rsca/RscaAddComponent.cmake ./usr/L/cmake/rsca/RscaAddDevice.cmake \
+         ./usr/L/pkgconfig/rsca.pc ./usr/L/librsca_runtime.so; do
   has "$dev" "$f"
 done
 lacks "$dev" "^./usr/bin/"

@@ -4,7 +4,9 @@
 # installed tree with find_package(rsca) (and compiled once more with pkg-config) and installed
 # into an SDR root of its own; the installed daemons come up, and the component runs in both of
 # its forms: a process of its own (rsca::runtime) and a library a component host loads
-# (rsca::component_library). Everything it started is stopped and checked gone.
+# (rsca::component_library). The installed `rsca new device` makes a device project, built the same
+# way into a library (rsca::device_library) that the installed rsca-noded loads for the generated
+# DCD; its properties answer. Everything it started is stopped and checked gone.
 # Usage: sdk_test.sh BUILD_DIR [FLAGS]   (FLAGS: the build's sanitizer flags, which a program
 # linking the installed runtime needs as well)
 set -euo pipefail
@@ -63,6 +65,7 @@ libdir="$(dirname "$(find "$usr" -name 'librsca_runtime.so.0' -print -quit)")"
 pc="$(PKG_CONFIG_PATH="$libdir/pkgconfig" pkg-config --cflags --libs rsca)"
 # shellcheck disable=SC2086 # pkg-config's output is a list of flags
 g++ $flags "$work/src/Greeter/src/Greeter.cpp" $pc -o "$work/greeter-pkgconfig"
+# grep reads all of ldd's output (not -q): ldd cut off by SIGPIPE fails the pipe (pipefail).
 LD_LIBRARY_PATH="$libdir" ldd "$work/greeter-pkgconfig" | grep -F "librsca_runtime.so.0 => $libdir/" >/dev/null ||
   fail "the program pkg-config built does not link the installed runtime"
 
@@ -80,8 +83,24 @@ sed -e 's|Greeter/Greeter.spd.xml|Greeter/GreeterLib.spd.xml|' \
 step "validate the SDR root strictly"
 "$rsca" validate --strict "$sdr"
 
-step "the installed daemons come up"
-"$rsca" domain up --nodes 1 --run-dir "$work/run"
+step "rsca new device Thermo: built against the installed SDK, installed into the SDR root"
+"$rsca" new device Thermo --dir "$work/src"
+cmake -S "$work/src/Thermo" -B "$work/build-thermo" -DCMAKE_PREFIX_PATH="$usr" \
+  -DCMAKE_CXX_FLAGS="$flags" -DCMAKE_MODULE_LINKER_FLAGS="$flags" >/dev/null
+cmake --build "$work/build-thermo" -j2 >/dev/null
+cmake --install "$work/build-thermo" --prefix "$sdr" >/dev/null
+thermo_dcd="$sdr/dev/nodes/Thermo_node/DeviceManager.dcd.xml"
+[ -f "$sdr/dev/devices/Thermo/libThermo.so" ] || fail "the device library was not installed"
+[ -f "$sdr/dev/devices/Thermo/Thermo.spd.xml" ] || fail "the device's SPD was not installed"
+[ -f "$thermo_dcd" ] || fail "the device's node DCD was not installed"
+if readelf -d "$sdr/dev/devices/Thermo/libThermo.so" | grep 'NEEDED.*librsca'; then
+  fail "the device library links an rsca library (rsca-noded provides the code)"
+fi
+# The generated profiles are valid.
+"$rsca" validate "$sdr"
+
+step "the installed daemons come up, one node with the new device"
+"$rsca" domain up --nodes 1 --node "$thermo_dcd" --run-dir "$work/run" || { tail -n 20 "$work"/run/*.log >&2; fail "the daemons did not come up"; }
 domaind="$(cat "$work/run/domaind.pid")"
 [ "$(readlink "/proc/$domaind/exe")" = "$usr/bin/rsca-domaind" ] || fail "domaind is not the installed one"
 
@@ -91,6 +110,20 @@ step "launch both forms"
 wait_ticks Greeter
 wait_ticks GreeterLib
 "$rsca" --json show GreeterLib | grep '"state": "running"' >/dev/null || fail "GreeterLib is not running"
+
+step "the device runs in the installed rsca-noded, and its properties answer"
+noded="$(cat "$work/run/Thermo_node.pid")"
+[ "$(readlink "/proc/$noded/exe")" = "$usr/bin/rsca-noded" ] || fail "the node is not the installed one"
+readings=0
+for _ in $(seq 300); do
+  readings="$("$rsca" --json query Thermo_node:Thermo_1 2>/dev/null |
+    python3 -c 'import json,sys; print(json.load(sys.stdin)["properties"]["readings"])' 2>/dev/null ||
+    echo 0)"
+  [ "$readings" -gt 2 ] && break
+  sleep 0.1
+done
+[ "$readings" -gt 2 ] || { cat "$work/run/Thermo_node.log" >&2; fail "Thermo took no readings"; }
+"$rsca" query Thermo_node:Thermo_1 | grep -q temperature_c || fail "Thermo has no temperature_c"
 
 step "release, domain down, nothing left"
 "$rsca" release Greeter

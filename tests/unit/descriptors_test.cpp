@@ -280,7 +280,8 @@ TEST_CASE("SPD: Producer and Consumer packages", "[descriptors][spd]") {
 
   // The GPP device package declares no demand of its own.
   const auto gpp = read<SoftPkg>(kGpp / "GPP.spd.xml");
-  CHECK(gpp.implementations.at(0).code.entrypoint == "bin/rsca-gpp");
+  CHECK(gpp.implementations.at(0).code.type == CodeType::SharedLibrary);
+  CHECK(gpp.implementations.at(0).code.file.name == "librsca-gpp.so");
   CHECK_FALSE(gpp.implementations.at(0).resource_demand.has_value());
 }
 

@@ -1,11 +1,15 @@
 // rsca new component NAME: a component's project to build outside rsca's tree against an
 // installed rsca — its source, SPD, PRF and SCD, a SAD that runs it alone, and a CMakeLists that
-// finds rsca with find_package and installs into an SDR root. The files are templates compiled
-// into the CLI (tools/rsca/templates), so the CLI and the SDK it belongs to never disagree.
+// finds rsca with find_package and installs into an SDR root.
+// rsca new device NAME: the same for a device — a library rsca-noded loads (node/device_export.hpp)
+// with its SPD, PRF and SCD, and a DCD of a node that runs it.
+// The files are templates compiled into the CLI (tools/rsca/templates), so the CLI and the SDK it
+// belongs to never disagree.
 #include <filesystem>
 #include <fstream>
 #include <random>
 #include <regex>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -39,6 +43,31 @@ constexpr ProjectFile kComponentFiles[] = {
     {"component.scd.xml.in", "NAME.scd.xml"},          {"component.sad.xml.in", "NAME.sad.xml"},
 };
 
+constexpr ProjectFile kDeviceFiles[] = {
+    {"device.CMakeLists.txt.in", "CMakeLists.txt"}, {"device.cpp.in", "src/NAME.cpp"},
+    {"device.spd.xml.in", "NAME.spd.xml"},          {"device.prf.xml.in", "NAME.prf.xml"},
+    {"device.scd.xml.in", "NAME.scd.xml"},          {"device.dcd.xml.in", "DeviceManager.dcd.xml"},
+};
+
+// What `rsca new` makes: its files, and what to do next ({0}: the project, {1}: the name).
+struct ProjectKind {
+  std::string_view kind;
+  std::span<const ProjectFile> files;
+  std::string_view next;
+};
+
+constexpr ProjectKind kComponent{"component", kComponentFiles,
+                                 "next:\n  cd {0} && cmake -B build && cmake --build build\n"
+                                 "  cmake --install build --prefix \"$SDRROOT\"\n"
+                                 "  rsca launch \"$SDRROOT/dom/waveforms/{1}/{1}.sad.xml\"\n"};
+
+constexpr ProjectKind kDevice{
+    "device", kDeviceFiles,
+    "next:\n  cd {0} && cmake -B build && cmake --build build\n"
+    "  cmake --install build --prefix \"$SDRROOT\"\n"
+    "  rsca domain up --node \"$SDRROOT/dev/nodes/{1}_node/DeviceManager.dcd.xml\"\n"
+    "  rsca query {1}_node:{1}_1\n"};
+
 // A random (version 4) UUID, for the SPD's and the SAD's DCE ids.
 std::string random_uuid() {
   std::random_device device;
@@ -70,19 +99,20 @@ bool write_file(const fs::path &path, std::string_view text) {
 
 // Writes the project in a hidden folder beside `target` and renames it into place, so that a
 // failure leaves nothing half-written. Returns the project's files, or the reason it failed.
-tl::expected<std::vector<fs::path>, std::string> write_project(const std::string &name,
-                                                               const fs::path &target) {
+tl::expected<std::vector<fs::path>, std::string>
+write_project(const ProjectKind &kind, const std::string &name, const fs::path &target) {
   const fs::path staging = target.parent_path() / fmt::format(".{}.rsca-new", name);
   std::error_code ec;
   fs::remove_all(staging, ec);
-  const std::string spd_id = random_uuid(), sad_id = random_uuid();
+  const std::string spd_id = random_uuid(), sad_id = random_uuid(), dcd_id = random_uuid();
   std::vector<fs::path> written;
-  for (const auto &file : kComponentFiles) {
+  for (const auto &file : kind.files) {
     // Every template named above is embedded (tools/rsca/CMakeLists.txt).
     std::string text(templates::embedded_file(file.template_name));
     for (const auto &[from, to] : {std::pair<std::string_view, std::string_view>{"@NAME@", name},
                                    {"@SPD_ID@", spd_id},
                                    {"@SAD_ID@", sad_id},
+                                   {"@DCD_ID@", dcd_id},
                                    {"@RSCA_VERSION@", RSCA_VERSION}})
       replace_all(text, from, to);
     std::string relative(file.path);
@@ -101,27 +131,29 @@ tl::expected<std::vector<fs::path>, std::string> write_project(const std::string
   return written;
 }
 
-int new_component(const std::string &name, const std::string &dir, const GlobalOptions &global) {
+int new_project(const ProjectKind &kind, const std::string &name, const std::string &dir,
+                const GlobalOptions &global) {
   if (!valid_name(name)) {
     fmt::print(stderr,
-               "rsca new component: \"{}\" is not a name: a letter, then letters, digits or _ "
+               "rsca new {}: \"{}\" is not a name: a letter, then letters, digits or _ "
                "(at most 64)\n",
-               name);
+               kind.kind, name);
     return kUsage;
   }
   const fs::path target = fs::absolute(fs::path(dir) / name).lexically_normal();
   std::error_code ec;
   if (fs::exists(target, ec)) {
-    fmt::print(stderr, "rsca new component: {} already exists; nothing written\n", target.string());
+    fmt::print(stderr, "rsca new {}: {} already exists; nothing written\n", kind.kind,
+               target.string());
     return kRejected;
   }
-  auto files = write_project(name, target);
+  auto files = write_project(kind, name, target);
   if (!files) {
-    fmt::print(stderr, "rsca new component: {}\n", files.error());
+    fmt::print(stderr, "rsca new {}: {}\n", kind.kind, files.error());
     return kFailed;
   }
   if (global.json) {
-    nlohmann::json out{{"component", name}, {"project", target.string()}, {"files", {}}};
+    nlohmann::json out{{std::string(kind.kind), name}, {"project", target.string()}, {"files", {}}};
     for (const auto &f : *files)
       out["files"].push_back(f.string());
     fmt::print("{}\n", out.dump(2));
@@ -130,28 +162,37 @@ int new_component(const std::string &name, const std::string &dir, const GlobalO
   fmt::print("created {}\n", target.string());
   for (const auto &f : *files)
     fmt::print("  {}\n", f.lexically_relative(target).string());
-  fmt::print("next:\n  cd {0} && cmake -B build && cmake --build build\n"
-             "  cmake --install build --prefix \"$SDRROOT\"\n"
-             "  rsca launch \"$SDRROOT/dom/waveforms/{1}/{1}.sad.xml\"\n",
-             target.string(), name);
+  fmt::print(fmt::runtime(kind.next), target.string(), name);
   return kOk;
+}
+
+void add_project_command(CLI::App &parent, const ProjectKind &kind, std::string description,
+                         const GlobalOptions &global, int &exit_code) {
+  auto *cmd = parent.add_subcommand(std::string(kind.kind), std::move(description));
+  auto name = std::make_shared<std::string>();
+  auto dir = std::make_shared<std::string>(".");
+  cmd->add_option("name", *name, fmt::format("The {}'s name (a C++ identifier)", kind.kind))
+      ->required();
+  cmd->add_option("--dir", *dir, "Where the project's folder NAME is made")->capture_default_str();
+  cmd->callback([&kind, name, dir, &global, &exit_code] {
+    exit_code = new_project(kind, *name, *dir, global);
+  });
 }
 
 } // namespace
 
 void add_new_command(CLI::App &app, const GlobalOptions &global, int &exit_code) {
-  auto *cmd = app.add_subcommand("new", "Create a project for a new component, built against an "
-                                        "installed rsca (find_package(rsca))");
+  auto *cmd = app.add_subcommand("new", "Create a project for a new component or device, built "
+                                        "against an installed rsca (find_package(rsca))");
   cmd->require_subcommand(1);
-  auto *component = cmd->add_subcommand(
-      "component", "A component: its source, SPD, PRF, SCD, a SAD that runs it, and a CMakeLists");
-  auto name = std::make_shared<std::string>();
-  auto dir = std::make_shared<std::string>(".");
-  component->add_option("name", *name, "The component's name (a C++ identifier)")->required();
-  component->add_option("--dir", *dir, "Where the project's folder NAME is made")
-      ->capture_default_str();
-  component->callback(
-      [name, dir, &global, &exit_code] { exit_code = new_component(*name, *dir, global); });
+  add_project_command(
+      *cmd, kComponent,
+      "A component: its source, SPD, PRF, SCD, a SAD that runs it, and a CMakeLists", global,
+      exit_code);
+  add_project_command(*cmd, kDevice,
+                      "A device: its source (a library rsca-noded loads), SPD, PRF, SCD, a DCD "
+                      "of a node that runs it, and a CMakeLists",
+                      global, exit_code);
 }
 
 } // namespace rsca::cli
