@@ -16,18 +16,26 @@ bool is_folder(const fs::path &path) {
 
 } // namespace
 
+// The installed tree's folders when this program is installed, else the build tree's: an
+// installed program never looks in bin/../lib, which is the system's /usr/lib.
 std::vector<fs::path> library_folders() {
   const fs::path bin = own_folder();
   if (bin.empty())
     return {};
-  return {(bin / installed::kLibFromBin).lexically_normal(), (bin / "../lib").lexically_normal()};
+  if (const auto installed = (bin / installed::kLibFromBin).lexically_normal();
+      is_folder(installed))
+    return {installed};
+  return {(bin / "../lib").lexically_normal()};
 }
 
 std::vector<fs::path> component_folders() {
   const fs::path bin = own_folder();
   if (bin.empty())
     return {};
-  std::vector<fs::path> out{bin, (bin / installed::kLibexecFromBin).lexically_normal()};
+  std::vector<fs::path> out{bin}; // rsca's own programs (the component host)
+  if (const auto libexec = (bin / installed::kLibexecFromBin).lexically_normal();
+      is_folder(libexec))
+    out.push_back(libexec);
   for (auto &folder : library_folders())
     out.push_back(std::move(folder));
   return out;

@@ -10,7 +10,7 @@
 
 namespace rsca::layout {
 
-// Folders that may hold rsca's loadable libraries, the installed one first.
+// Folders that may hold rsca's loadable libraries: the installed one, or else the build tree's.
 std::vector<std::filesystem::path> library_folders();
 // Folders that may hold component code an SPD names: the program's own folder, the installed
 // libexec folder, then the library folders.

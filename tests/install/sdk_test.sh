@@ -48,9 +48,12 @@ step "rsca new component Greeter"
 if "$rsca" new component Greeter --dir "$work/src" 2>/dev/null; then
   fail "rsca new component wrote over an existing project"
 fi
-if "$rsca" new component "no good" --dir "$work/src" 2>/dev/null; then
-  fail "rsca new component took a name that is no identifier"
-fi
+for bad in "no good" class Component test; do
+  if "$rsca" new component "$bad" --dir "$work/src" 2>/dev/null; then
+    fail "rsca new component took \"$bad\", which would not build"
+  fi
+done
+[ -z "$(ls -A "$work/src" | grep -v '^Greeter$')" ] || fail "rsca new left something behind"
 
 step "build it against the installed SDK (find_package) and install it into an SDR root"
 cmake -S "$work/src/Greeter" -B "$work/build" -DCMAKE_PREFIX_PATH="$usr" \

@@ -5,6 +5,7 @@
 // with its SPD, PRF and SCD, and a DCD of a node that runs it.
 // The files are templates compiled into the CLI (tools/rsca/templates), so the CLI and the SDK it
 // belongs to never disagree.
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -83,10 +84,51 @@ std::string random_uuid() {
                      b[12], b[13], b[14], b[15]);
 }
 
-// The name becomes a C++ class, file names and profile names: an identifier, of a sane length.
+// Names that are identifiers yet would not build: C++'s keywords and alternative tokens, what the
+// templates' own code calls by its short name, and targets CMake keeps for itself.
+constexpr std::string_view kReservedNames[] = {"alignas",       "alignof",     "and",
+                                               "and_eq",        "asm",         "auto",
+                                               "bitand",        "bitor",       "bool",
+                                               "break",         "case",        "catch",
+                                               "char",          "char8_t",     "char16_t",
+                                               "char32_t",      "class",       "compl",
+                                               "concept",       "const",       "consteval",
+                                               "constexpr",     "constinit",   "const_cast",
+                                               "continue",      "co_await",    "co_return",
+                                               "co_yield",      "decltype",    "default",
+                                               "delete",        "do",          "double",
+                                               "dynamic_cast",  "else",        "enum",
+                                               "explicit",      "export",      "extern",
+                                               "false",         "float",       "for",
+                                               "friend",        "goto",        "if",
+                                               "inline",        "int",         "long",
+                                               "mutable",       "namespace",   "new",
+                                               "noexcept",      "not",         "not_eq",
+                                               "nullptr",       "operator",    "or",
+                                               "or_eq",         "private",     "protected",
+                                               "public",        "register",    "reinterpret_cast",
+                                               "requires",      "return",      "short",
+                                               "signed",        "sizeof",      "static",
+                                               "static_assert", "static_cast", "struct",
+                                               "switch",        "template",    "this",
+                                               "thread_local",  "throw",       "true",
+                                               "try",           "typedef",     "typeid",
+                                               "typename",      "union",       "unsigned",
+                                               "using",         "virtual",     "void",
+                                               "volatile",      "wchar_t",     "while",
+                                               "xor",           "xor_eq",      "rsca",
+                                               "std",           "Clock",       "Component",
+                                               "Context",       "Result",      "all",
+                                               "clean",         "help",        "install",
+                                               "package",       "test"};
+
+// The name becomes a C++ class, file names and profile names: an identifier, of a sane length,
+// that builds.
 bool valid_name(const std::string &name) {
   static const std::regex identifier("[A-Za-z][A-Za-z0-9_]{0,63}");
-  return std::regex_match(name, identifier);
+  return std::regex_match(name, identifier) &&
+         std::find(std::begin(kReservedNames), std::end(kReservedNames), name) ==
+             std::end(kReservedNames);
 }
 
 bool write_file(const fs::path &path, std::string_view text) {
@@ -101,14 +143,18 @@ bool write_file(const fs::path &path, std::string_view text) {
 // failure leaves nothing half-written. Returns the project's files, or the reason it failed.
 tl::expected<std::vector<fs::path>, std::string>
 write_project(const ProjectKind &kind, const std::string &name, const fs::path &target) {
-  const fs::path staging = target.parent_path() / fmt::format(".{}.rsca-new", name);
+  // Its own staging folder: a concurrent `rsca new` of the same name keeps its own.
+  const fs::path staging =
+      target.parent_path() / fmt::format(".{}.rsca-new-{}", name, random_uuid());
   std::error_code ec;
-  fs::remove_all(staging, ec);
   const std::string spd_id = random_uuid(), sad_id = random_uuid(), dcd_id = random_uuid();
   std::vector<fs::path> written;
   for (const auto &file : kind.files) {
-    // Every template named above is embedded (tools/rsca/CMakeLists.txt).
     std::string text(templates::embedded_file(file.template_name));
+    if (text.empty()) { // every template named above is embedded (tools/rsca/CMakeLists.txt)
+      fs::remove_all(staging, ec);
+      return tl::unexpected(fmt::format("no template {} in this rsca", file.template_name));
+    }
     for (const auto &[from, to] : {std::pair<std::string_view, std::string_view>{"@NAME@", name},
                                    {"@SPD_ID@", spd_id},
                                    {"@SAD_ID@", sad_id},
@@ -125,8 +171,9 @@ write_project(const ProjectKind &kind, const std::string &name, const fs::path &
   }
   fs::rename(staging, target, ec);
   if (ec) {
+    const std::string why = ec.message();
     fs::remove_all(staging, ec);
-    return tl::unexpected(fmt::format("cannot create {}: {}", target.string(), ec.message()));
+    return tl::unexpected(fmt::format("cannot create {}: {}", target.string(), why));
   }
   return written;
 }
@@ -136,7 +183,8 @@ int new_project(const ProjectKind &kind, const std::string &name, const std::str
   if (!valid_name(name)) {
     fmt::print(stderr,
                "rsca new {}: \"{}\" is not a name: a letter, then letters, digits or _ "
-               "(at most 64)\n",
+               "(at most 64), and not a C++ keyword nor a name the project's code or CMake "
+               "keeps for itself\n",
                kind.kind, name);
     return kUsage;
   }
