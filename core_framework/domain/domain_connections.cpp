@@ -1,6 +1,8 @@
 // The DomainManager's devices, connections and channels: what components
 // announce, where a connection's end is served, the connections' live state, runtime connections
 // kept across restarts, and event channels.
+#include <unistd.h>
+
 #include <algorithm>
 
 #include <fmt/format.h>
@@ -336,6 +338,16 @@ CallResult<domain_ops::NodesReply> DomainManager::Impl::list_nodes() {
 
 CallResult<domain_ops::DevicesReply> DomainManager::Impl::list_devices() {
   return domain_ops::DevicesReply{allocator::to_json(allocator.snapshot())};
+}
+
+CallResult<domain_ops::TopReply> DomainManager::Impl::top() {
+  char host[256] = {};
+  gethostname(host, sizeof(host) - 1);
+  const auto self = ::getpid();
+  auto own = sampler.read(self);
+  if (!own)
+    return control::call_error(Status::Failed, "cannot read the domain's own /proc figures");
+  return domain_ops::TopReply{host, {self, own->cpu_percent, own->rss_bytes, own->threads}};
 }
 
 CallResult<connection_ops::ChannelsReply> DomainManager::Impl::list_channels() {

@@ -4,12 +4,15 @@
 
 #include <atomic>
 #include <mutex>
+#include <set>
 #include <unistd.h>
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include "control/operation.hpp"
+#include "node/process_logs.hpp"
+#include "process/proc_figures.hpp"
 #include "profile/property_binding.hpp"
 #include "profile/property_json.hpp"
 #include "protocol/addresses.hpp"
@@ -35,6 +38,10 @@ Json overrides_of(const profile::ComponentInstantiation &ci, const profile::Reso
     out[profile::common_of(*definition).label()] = profile::to_json(*value);
   }
   return out;
+}
+
+op::ProcessFigures figures_of(pid_t pid, const process::Figures &f) {
+  return {pid, f.cpu_percent, f.rss_bytes, f.threads};
 }
 
 } // namespace
@@ -63,7 +70,8 @@ struct DeviceManager::Impl {
   profile::ResolvedNode node;
   std::vector<RunningDevice> devices;
   std::atomic<bool> stopping{false};
-  std::mutex endpoint_mutex; // the endpoint's end against a process exit reported meanwhile
+  std::mutex endpoint_mutex;   // the endpoint's end against a process exit reported meanwhile
+  process::CpuSampler sampler; // node.top's: its last reading of each process
 
   Expected<void> start_devices(const DeviceRegistry &registry);
   op::NodeAnnouncement announcement() const;
@@ -74,6 +82,8 @@ struct DeviceManager::Impl {
   Expected<void> open_cache();
   CallResult<op::TerminateReply> terminate(const op::TerminateRequest &request) const;
   op::StatusReply status() const;
+  std::vector<op::ProcessRecord> running() const;
+  CallResult<op::TopReply> top();
 };
 
 namespace {
@@ -251,14 +261,19 @@ DeviceManager::Impl::terminate(const op::TerminateRequest &request) const {
       Status::NotFound, fmt::format("node {} did not start process {}", dcd->name, request.pid));
 }
 
-op::StatusReply DeviceManager::Impl::status() const {
-  auto a = announcement();
-  op::StatusReply status{
-      std::move(a.node), a.pid, std::move(a.host), std::move(a.devices), {}, {}, {}};
+std::vector<op::ProcessRecord> DeviceManager::Impl::running() const {
+  std::vector<op::ProcessRecord> out;
   for (const auto &d : devices)
     if (d.executable() != nullptr)
       for (auto &p : d.executable()->processes())
-        status.processes.push_back(std::move(p));
+        out.push_back(std::move(p));
+  return out;
+}
+
+op::StatusReply DeviceManager::Impl::status() const {
+  auto a = announcement();
+  op::StatusReply status{
+      std::move(a.node), a.pid, std::move(a.host), std::move(a.devices), running(), {}, {}};
   if (host_data) {
     const auto held = host_data->counts();
     status.shared_memory =
@@ -271,6 +286,31 @@ op::StatusReply DeviceManager::Impl::status() const {
   return status;
 }
 
+// The node daemon's figures and those of each process its devices run; a process that exited
+// meanwhile is left out.
+CallResult<op::TopReply> DeviceManager::Impl::top() {
+  char host[256] = {};
+  gethostname(host, sizeof(host) - 1);
+  const auto self = ::getpid();
+  auto own = sampler.read(self);
+  if (!own)
+    return control::call_error(Status::Failed, "cannot read the node's own /proc figures");
+  op::TopReply reply{dcd->name, host, figures_of(self, *own), {}};
+  std::set<pid_t> alive{self};
+  for (const auto &p : running()) {
+    const auto pid = static_cast<pid_t>(p.pid);
+    auto figures = sampler.read(pid);
+    if (!figures || reply.processes.size() >= op::TopReply::kMaxProcesses)
+      continue;
+    alive.insert(pid);
+    auto [application, component] = op::split_process_label(p.label);
+    reply.processes.push_back(
+        {std::move(application), std::move(component), figures_of(pid, *figures)});
+  }
+  sampler.keep_only(alive);
+  return reply;
+}
+
 void DeviceManager::Impl::serve() {
   control::serve<op::Execute>(
       *endpoint, [this](const auto &request, const auto &) { return execute(request); });
@@ -278,6 +318,10 @@ void DeviceManager::Impl::serve() {
       *endpoint, [this](const auto &request, const auto &) { return terminate(request); });
   control::serve<op::Status>(*endpoint, [this](const auto &, const auto &) {
     return CallResult<op::StatusReply>(status());
+  });
+  control::serve<op::Top>(*endpoint, [this](const auto &, const auto &) { return top(); });
+  control::serve<op::Logs>(*endpoint, [this](const auto &request, const auto &) {
+    return read_log(options.log_dir, request, running());
   });
 }
 
