@@ -2,6 +2,9 @@
 // run the processes (node.top, node.logs), the domain daemon's figures from itself (domain.top).
 #include <catch2/catch.hpp>
 
+#include <csignal>
+#include <fstream>
+#include <iterator>
 #include <sstream>
 
 #include "domain_fixture.hpp"
@@ -130,4 +133,40 @@ TEST_CASE("rsca logs of a component or an application that does not exist is not
   INFO(nout);
   CHECK(nrc == 3);
   CHECK(nout.find("is a node") != std::string::npos);
+}
+
+TEST_CASE("rsca logs --since leaves out older lines", "[integration][logs]") {
+  TestDomain domain(1);
+  domain.launch_shipped("ProducerConsumer");
+  auto [rc, out] = domain.cli({"logs", "ProducerConsumer/Producer_1", "--since", "3600s"});
+  INFO(out);
+  CHECK(rc == 0);
+  CHECK(out.find("serving at") != std::string::npos);
+  // The lines logged at launch are older than "now" once the second they were logged in is over.
+  std::string recent;
+  CHECK(TestDomain::wait_for([&] {
+    recent = domain.cli({"logs", "ProducerConsumer/Producer_1", "--since", "0s"}).second;
+    return recent.find("serving at") == std::string::npos;
+  }));
+  INFO(recent);
+  CHECK(domain.cli({"logs", "ProducerConsumer/Producer_1", "--since", "soon"}).first == 2);
+}
+
+TEST_CASE("rsca logs -f goes on printing what the component logs", "[integration][logs]") {
+  TestDomain domain(1);
+  domain.launch_shipped("ProducerConsumer");
+  const fs::path out = domain.run_dir() / "follow.out";
+  ChildProcess follow((kBin / "rsca").string(), {"logs", "-f", "ProducerConsumer/Producer_1"},
+                      domain.env(), out);
+  auto text = [&] {
+    std::ifstream in(out);
+    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  };
+  REQUIRE(TestDomain::wait_for([&] { return text().find("serving at") != std::string::npos; }));
+  CHECK(text().find("stopped") == std::string::npos);
+  REQUIRE(domain.call("app.stop", Json{{"app", "ProducerConsumer"}}).has_value());
+  CHECK(TestDomain::wait_for([&] { return text().find("stopped") != std::string::npos; }));
+  INFO(text());
+  follow.signal(SIGINT);
+  CHECK(follow.wait_exit(5s).has_value());
 }

@@ -1,9 +1,10 @@
-// rsca logs APP[/COMP] [-n LINES] [-f]: the logs of an application's component processes, read
-// by the nodes that run them (node.logs), so they come from any host. The domain says where each
-// component runs (app.show); each node is asked for the components it runs. -f follows: the
-// nodes are asked again every half second from where their last reply ended.
+// rsca logs APP[/COMP] [-n LINES] [--since T] [-f]: the logs of an application's component
+// processes, read by the nodes that run them (node.logs), so they come from any host. The domain
+// says where each component runs (app.show); each node is asked for the components it runs. -f
+// follows: the nodes are asked again every half second from where their last reply ended.
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <string>
 #include <thread>
 #include <vector>
@@ -11,6 +12,7 @@
 #include <fmt/format.h>
 
 #include "commands.hpp"
+#include "common/units.hpp"
 #include "domain_client.hpp"
 #include "exit_codes.hpp"
 #include "protocol/application_ops.hpp"
@@ -28,6 +30,7 @@ using control::Json;
 struct LogsOptions {
   std::string target; // APP or APP/COMP
   std::size_t lines = 100;
+  std::string since; // a duration ("300s"): only the lines logged since then
   bool follow = false;
 };
 
@@ -37,7 +40,37 @@ constexpr std::chrono::milliseconds kFollowPace{500};
 struct Source {
   std::string node_address;
   node_ops::LogsRequest request;
+  bool keeping = false; // --since: whether the last line read was kept
 };
+
+// A component's log lines start with the component runtime's local time, "[YYYY-MM-DD
+// HH:MM:SS.mmm]", which orders them as text: --since compares that with the time it names. A
+// line without it (a program's own output) goes with the line before it.
+std::string local_stamp(std::chrono::system_clock::time_point at) {
+  const std::time_t t = std::chrono::system_clock::to_time_t(at);
+  std::tm local{};
+  localtime_r(&t, &local);
+  return fmt::format("{:04}-{:02}-{:02} {:02}:{:02}:{:02}", local.tm_year + 1900, local.tm_mon + 1,
+                     local.tm_mday, local.tm_hour, local.tm_min, local.tm_sec);
+}
+
+constexpr std::size_t kStampLength = 19; // YYYY-MM-DD HH:MM:SS
+
+std::vector<std::string> since(std::vector<std::string> lines, const std::string &stamp,
+                               bool &keeping) {
+  if (stamp.empty())
+    return lines;
+  std::vector<std::string> kept;
+  for (auto &line : lines) {
+    const bool stamped = line.size() > kStampLength && line[0] == '[' && line[5] == '-' &&
+                         line[kStampLength - 2] == ':';
+    if (stamped)
+      keeping = line.compare(1, kStampLength, stamp) >= 0;
+    if (keeping)
+      kept.push_back(std::move(line));
+  }
+  return kept;
+}
 
 std::vector<std::string> lines_of(const std::string &text) {
   std::vector<std::string> lines;
@@ -120,7 +153,7 @@ void print_lines(const Source &source, const std::vector<std::string> &lines, st
 
 // Reads each source once, from where it stands; the exit code of the first failure.
 int read_once(const DomainClient &client, std::vector<Source> &sources, std::size_t keep,
-              const GlobalOptions &global) {
+              const std::string &stamp, const GlobalOptions &global) {
   std::vector<std::future<control::CallResult<Json>>> pending;
   for (const auto &s : sources)
     pending.push_back(client.call_async_at<node_ops::Logs>(
@@ -135,7 +168,8 @@ int read_once(const DomainClient &client, std::vector<Source> &sources, std::siz
       continue;
     }
     sources[i].request.offset = reply->next;
-    print_lines(sources[i], lines_of(reply->text), keep, sources.size() > 1, global);
+    print_lines(sources[i], since(lines_of(reply->text), stamp, sources[i].keeping), keep,
+                sources.size() > 1, global);
   }
   return rc;
 }
@@ -146,16 +180,28 @@ int logs(const LogsOptions &options, const GlobalOptions &global) {
     fmt::print(stderr, "rsca logs: {}\n", client.error().to_string());
     return kFailed;
   }
+  std::string stamp;
+  if (!options.since.empty()) {
+    auto ago = parse_duration(options.since);
+    if (!ago || ago->infinite()) {
+      fmt::print(stderr, "rsca logs: --since {}: {}\n", options.since,
+                 ago ? "a duration, not infinite" : ago.error());
+      return kUsage;
+    }
+    stamp =
+        local_stamp(std::chrono::system_clock::now() -
+                    std::chrono::duration_cast<std::chrono::system_clock::duration>(*ago->value));
+  }
   int rc = kOk;
   auto sources = sources_of(*client, options, global, rc);
   if (sources.empty())
     return rc;
-  rc = read_once(*client, sources, options.lines, global);
+  rc = read_once(*client, sources, options.lines, stamp, global);
   if (!options.follow)
     return rc;
   for (;;) { // until interrupted
     std::this_thread::sleep_for(kFollowPace);
-    (void)read_once(*client, sources, SIZE_MAX, global);
+    (void)read_once(*client, sources, SIZE_MAX, stamp, global);
   }
 }
 
@@ -169,6 +215,8 @@ void add_logs_command(CLI::App &app, const GlobalOptions &global, int &exit_code
   cmd->add_option("target", options->target, "APP or APP/COMPONENT")->required();
   cmd->add_option("-n,--lines", options->lines, "the last LINES lines of each log")
       ->capture_default_str();
+  cmd->add_option("--since", options->since,
+                  "only the lines logged in the last T (a duration: 90s, 3600s)");
   cmd->add_flag("-f,--follow", options->follow, "go on printing what is logged, until Ctrl-C");
   cmd->callback([options, &global, &exit_code] { exit_code = logs(*options, global); });
 }
