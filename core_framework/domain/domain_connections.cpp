@@ -9,6 +9,7 @@
 #include <spdlog/spdlog.h>
 
 #include "allocator/plan_json.hpp"
+#include "common/host_name.hpp"
 #include "common/names.hpp"
 #include "control/operation.hpp"
 #include "domain/domain_manager_impl.hpp"
@@ -341,13 +342,11 @@ CallResult<domain_ops::DevicesReply> DomainManager::Impl::list_devices() {
 }
 
 CallResult<domain_ops::TopReply> DomainManager::Impl::top() {
-  char host[256] = {};
-  gethostname(host, sizeof(host) - 1);
   const auto self = ::getpid();
   auto own = sampler.read(self);
   if (!own)
     return control::call_error(Status::Failed, "cannot read the domain's own /proc figures");
-  return domain_ops::TopReply{host, {self, own->cpu_percent, own->rss_bytes, own->threads}};
+  return domain_ops::TopReply{host_name(), {self, own->cpu_percent, own->rss_bytes, own->threads}};
 }
 
 CallResult<connection_ops::ChannelsReply> DomainManager::Impl::list_channels() {

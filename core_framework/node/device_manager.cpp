@@ -10,6 +10,8 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "common/host_name.hpp"
+#include "common/periodic.hpp"
 #include "control/operation.hpp"
 #include "node/process_logs.hpp"
 #include "process/proc_figures.hpp"
@@ -39,6 +41,10 @@ Json overrides_of(const profile::ComponentInstantiation &ci, const profile::Reso
   }
   return out;
 }
+
+// How often the logs' sizes are looked at: a process logging fast overshoots its bound by at most
+// what it logs in this time.
+constexpr std::chrono::seconds kLogRotationPeriod{1};
 
 op::ProcessFigures figures_of(pid_t pid, const process::Figures &f) {
   return {pid, f.cpu_percent, f.rss_bytes, f.threads};
@@ -70,8 +76,9 @@ struct DeviceManager::Impl {
   profile::ResolvedNode node;
   std::vector<RunningDevice> devices;
   std::atomic<bool> stopping{false};
-  std::mutex endpoint_mutex;   // the endpoint's end against a process exit reported meanwhile
-  process::CpuSampler sampler; // node.top's: its last reading of each process
+  std::mutex endpoint_mutex;        // the endpoint's end against a process exit reported meanwhile
+  process::CpuSampler sampler;      // node.top's: its last reading of each process
+  std::optional<Periodic> rotation; // of its processes' logs, by size
 
   Expected<void> start_devices(const DeviceRegistry &registry);
   op::NodeAnnouncement announcement() const;
@@ -84,6 +91,7 @@ struct DeviceManager::Impl {
   op::StatusReply status() const;
   std::vector<op::ProcessRecord> running() const;
   CallResult<op::TopReply> top();
+  void rotate_logs() const;
 };
 
 namespace {
@@ -172,9 +180,7 @@ Expected<void> DeviceManager::Impl::start_devices(const DeviceRegistry &registry
 }
 
 op::NodeAnnouncement DeviceManager::Impl::announcement() const {
-  char host[256] = {};
-  gethostname(host, sizeof(host) - 1);
-  op::NodeAnnouncement out{dcd->name, static_cast<std::int64_t>(getpid()), host, {}, true};
+  op::NodeAnnouncement out{dcd->name, static_cast<std::int64_t>(getpid()), host_name(), {}, true};
   for (const auto &d : devices) {
     op::DeviceRecord record{d.id,
                             d.label,
@@ -289,13 +295,11 @@ op::StatusReply DeviceManager::Impl::status() const {
 // The node daemon's figures and those of each process its devices run; a process that exited
 // meanwhile is left out.
 CallResult<op::TopReply> DeviceManager::Impl::top() {
-  char host[256] = {};
-  gethostname(host, sizeof(host) - 1);
   const auto self = ::getpid();
   auto own = sampler.read(self);
   if (!own)
     return control::call_error(Status::Failed, "cannot read the node's own /proc figures");
-  op::TopReply reply{dcd->name, host, figures_of(self, *own), {}};
+  op::TopReply reply{dcd->name, host_name(), figures_of(self, *own), {}};
   std::set<pid_t> alive{self};
   for (const auto &p : running()) {
     const auto pid = static_cast<pid_t>(p.pid);
@@ -309,6 +313,14 @@ CallResult<op::TopReply> DeviceManager::Impl::top() {
   }
   sampler.keep_only(alive);
   return reply;
+}
+
+void DeviceManager::Impl::rotate_logs() const {
+  for (const auto &p : running())
+    if (auto rotated = rotate_if_over(p.log, options.log_max_bytes); !rotated)
+      spdlog::warn("{}: {}", p.label, rotated.error().to_string());
+    else if (*rotated)
+      spdlog::debug("{}: log rotated", p.label);
 }
 
 void DeviceManager::Impl::serve() {
@@ -328,6 +340,7 @@ void DeviceManager::Impl::serve() {
 DeviceManager::DeviceManager(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 
 DeviceManager::~DeviceManager() {
+  impl_->rotation.reset(); // it reads the devices' processes
   impl_->stopping = true;
   impl_->endpoint->withdraw();
   impl_->links->close(); // relays under way fail: the endpoint's handlers return
@@ -401,6 +414,8 @@ DeviceManager::create(std::shared_ptr<dds::Participant> participant, NodeOptions
     return tl::unexpected(ok.error());
   if (auto ok = impl->start_devices(registry); !ok)
     return tl::unexpected(ok.error());
+  if (impl->options.log_max_bytes > 0)
+    impl->rotation.emplace(kLogRotationPeriod, [raw = impl.get()] { raw->rotate_logs(); });
   impl->serve();
   impl->endpoint->start_serving();
   // The domain is the node's caller, and the node calls it: both ways are made now, so the

@@ -21,6 +21,8 @@ struct NodeOptions {
   std::string domain_name = "rsca";
   std::vector<std::filesystem::path> exec_path;
   std::filesystem::path log_dir = "/tmp/rsca/logs";
+  // A process's log past this is rotated, one older file kept (node/process_logs.hpp); 0: never.
+  std::uint64_t log_max_bytes = 10ULL << 20U;
   // Where local clients (the CLI) connect for a link to the node (ProcessLinks::listen); none:
   // they use DDS.
   std::optional<std::filesystem::path> control_socket;

@@ -14,6 +14,7 @@
 namespace fs = std::filesystem;
 namespace op = rsca::protocol::node;
 using rsca::node::read_log;
+using rsca::node::rotate_if_over;
 using rsca::node::utf8_or_replaced;
 
 namespace {
@@ -28,6 +29,9 @@ struct LogFolder {
   }
   void write(const std::string &name, const std::string &text) const {
     std::ofstream(dir / "App" / name, std::ios::binary) << text;
+  }
+  void append(const std::string &name, const std::string &text) const {
+    std::ofstream(dir / "App" / name, std::ios::binary | std::ios::app) << text;
   }
 };
 
@@ -65,7 +69,9 @@ TEST_CASE("a tail starts at a whole line", "[logs]") {
   CHECK(tail->offset == 11);
 }
 
-TEST_CASE("a log read from past its end (rotated since) is read from its start", "[logs]") {
+TEST_CASE(
+    "a log read from past its end with no older file (truncated since) is read from its start",
+    "[logs]") {
   LogFolder logs;
   logs.write("Comp_1.log", "new\n");
   auto r = request("Comp_1");
@@ -109,4 +115,37 @@ TEST_CASE("log text becomes valid UTF-8, keeping what already is", "[logs]") {
   CHECK(utf8_or_replaced("\xC3") == "\xEF\xBF\xBD");                         // cut short
   CHECK(utf8_or_replaced("\xC0\xAF") == "\xEF\xBF\xBD\xEF\xBF\xBD");         // overlong
   CHECK(utf8_or_replaced("\xED\xA0\x80").find("\xED") == std::string::npos); // a surrogate
+}
+
+TEST_CASE("a log past its bound is rotated to LOG.1 and emptied, one under it is left", "[logs]") {
+  LogFolder logs;
+  logs.write("Comp_1.log", "0123456789\n");
+  CHECK_FALSE(*rotate_if_over(logs.dir / "App/Comp_1.log", 11));
+  CHECK_FALSE(*rotate_if_over(logs.dir / "App/Comp_1.log", 0)); // 0: never
+  CHECK(*rotate_if_over(logs.dir / "App/Comp_1.log", 10));
+  CHECK(fs::file_size(logs.dir / "App/Comp_1.log") == 0);
+  CHECK(fs::file_size(logs.dir / "App/Comp_1.log.1") == 11);
+}
+
+TEST_CASE("reading a log goes across its rotation", "[logs]") {
+  LogFolder logs;
+  const auto log = logs.dir / "App/Comp_1.log";
+  logs.write("Comp_1.log", "first\nsecond\n");
+  auto before = read_log(logs.dir, request("Comp_1"), {});
+  REQUIRE(before.has_value());
+  logs.append("Comp_1.log", "third\n");
+  REQUIRE(*rotate_if_over(log, 10));
+  logs.append("Comp_1.log", "fourth\n");
+  // A follower reads what it had not: the rest of LOG.1, then the log from its start.
+  auto r = request("Comp_1");
+  r.offset = before->next;
+  auto followed = read_log(logs.dir, r, {});
+  REQUIRE(followed.has_value());
+  CHECK(followed->text == "third\nfourth\n");
+  CHECK(followed->next == 7);
+  // A tail longer than the log begins in LOG.1.
+  auto tail = read_log(logs.dir, request("Comp_1"), {});
+  REQUIRE(tail.has_value());
+  CHECK(tail->text == "first\nsecond\nthird\nfourth\n");
+  CHECK(tail->next == 7);
 }
