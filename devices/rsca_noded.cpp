@@ -37,6 +37,11 @@ int main(int argc, char **argv) {
   app.add_option("--log-dir", log_dir, "Component logs go here")
       ->capture_default_str()
       ->take_last();
+  std::uint64_t log_max_kib = options.log_max_bytes >> 10U;
+  app.add_option("--log-max-kib", log_max_kib,
+                 "A component's log past this many KiB is rotated, one older file kept (LOG.1); "
+                 "0: never")
+      ->capture_default_str();
   std::string control_socket;
   app.add_option("--control-socket", control_socket,
                  "A Unix socket where local clients (the CLI) reach the domain through this node "
@@ -82,6 +87,7 @@ int main(int argc, char **argv) {
   if (options.exec_path.empty())
     options.exec_path = rsca::layout::component_folders();
   options.log_dir = log_dir;
+  options.log_max_bytes = log_max_kib << 10U;
   options.cache.dir = cache_dir;
   options.cache.max_bytes = cache_mib << 20U;
   if (!control_socket.empty())

@@ -10,21 +10,7 @@ void bound_daemon_heap() {
   mallopt(M_TRIM_THRESHOLD, kThreshold);
 }
 
-HeapTrimmer::HeapTrimmer(std::chrono::milliseconds period) {
-  thread_ = std::thread([this, period] {
-    std::unique_lock lock(mutex_);
-    while (!wake_.wait_for(lock, period, [this] { return stopping_; }))
-      malloc_trim(0);
-  });
-}
-
-HeapTrimmer::~HeapTrimmer() {
-  {
-    std::lock_guard lock(mutex_);
-    stopping_ = true;
-  }
-  wake_.notify_all();
-  thread_.join();
-}
+HeapTrimmer::HeapTrimmer(std::chrono::milliseconds period)
+    : trim_(period, [] { malloc_trim(0); }) {}
 
 } // namespace rsca

@@ -8,9 +8,8 @@
 #pragma once
 
 #include <chrono>
-#include <condition_variable>
-#include <mutex>
-#include <thread>
+
+#include "common/periodic.hpp"
 
 namespace rsca {
 
@@ -23,15 +22,11 @@ void bound_daemon_heap();
 class HeapTrimmer {
 public:
   explicit HeapTrimmer(std::chrono::milliseconds period = std::chrono::seconds(5));
-  ~HeapTrimmer();
   HeapTrimmer(const HeapTrimmer &) = delete;
   HeapTrimmer &operator=(const HeapTrimmer &) = delete;
 
 private:
-  std::mutex mutex_;
-  std::condition_variable wake_;
-  bool stopping_ = false;
-  std::thread thread_;
+  Periodic trim_;
 };
 
 } // namespace rsca

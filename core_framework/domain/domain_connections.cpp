@@ -1,12 +1,15 @@
 // The DomainManager's devices, connections and channels: what components
 // announce, where a connection's end is served, the connections' live state, runtime connections
 // kept across restarts, and event channels.
+#include <unistd.h>
+
 #include <algorithm>
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include "allocator/plan_json.hpp"
+#include "common/host_name.hpp"
 #include "common/names.hpp"
 #include "control/operation.hpp"
 #include "domain/domain_manager_impl.hpp"
@@ -336,6 +339,14 @@ CallResult<domain_ops::NodesReply> DomainManager::Impl::list_nodes() {
 
 CallResult<domain_ops::DevicesReply> DomainManager::Impl::list_devices() {
   return domain_ops::DevicesReply{allocator::to_json(allocator.snapshot())};
+}
+
+CallResult<domain_ops::TopReply> DomainManager::Impl::top() {
+  const auto self = ::getpid();
+  auto own = sampler.read(self);
+  if (!own)
+    return control::call_error(Status::Failed, "cannot read the domain's own /proc figures");
+  return domain_ops::TopReply{host_name(), {self, own->cpu_percent, own->rss_bytes, own->threads}};
 }
 
 CallResult<connection_ops::ChannelsReply> DomainManager::Impl::list_channels() {

@@ -357,6 +357,7 @@ void DomainManager::Impl::serve() {
   serve_op<domain_ops::Installed>(&Impl::list_installed);
   serve_op<domain_ops::Nodes>(&Impl::list_nodes);
   serve_op<domain_ops::Devices>(&Impl::list_devices);
+  serve_op<domain_ops::Top>(&Impl::top);
   control::serve<domain_ops::ComponentExited>(
       *endpoint, [this](const auto &report, const auto &) { return component_exited(report); });
   control::serve<domain_ops::ConnectionProblem>(

@@ -26,6 +26,7 @@
 #include "domain/installed_repository.hpp"
 #include "domain/launch_tracker.hpp"
 #include "domain/node_directory.hpp"
+#include "process/proc_figures.hpp"
 #include "protocol/application_ops.hpp"
 #include "protocol/component_ops.hpp"
 #include "protocol/connection_ops.hpp"
@@ -68,6 +69,7 @@ struct DomainManager::Impl {
   ApplicationRegistry applications;
   LaunchTracker launches;
   std::uint64_t incarnation = 0; // this run of the daemon, counted in the store
+  process::CpuSampler sampler;   // domain.top's: its last reading of this daemon
   std::atomic<std::uint64_t> launch_counter{0};
   // Held while an uninstall checks for launches of the application and removes it, and while a
   // launch finds its installed application and reserves its name: neither slips between the
@@ -142,6 +144,7 @@ struct DomainManager::Impl {
   CallResult<ResolvedEnd> resolve_device_end(const PortRef &ref, profile::PortDirection direction);
   CallResult<domain_ops::NodesReply> list_nodes();
   CallResult<domain_ops::DevicesReply> list_devices();
+  CallResult<domain_ops::TopReply> top();
   CallResult<connection_ops::ChannelsReply> list_channels();
   CallResult<connection_ops::ChannelView> create_channel(const domain_ops::Named &request);
   CallResult<domain_ops::Named> destroy_channel(const domain_ops::Named &request);

@@ -4,14 +4,19 @@
 
 #include <atomic>
 #include <mutex>
+#include <set>
 #include <unistd.h>
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "common/host_name.hpp"
 #include "common/install_layout.hpp"
+#include "common/periodic.hpp"
 #include "control/operation.hpp"
 #include "node/device_libraries.hpp"
+#include "node/process_logs.hpp"
+#include "process/proc_figures.hpp"
 #include "profile/property_binding.hpp"
 #include "profile/property_json.hpp"
 #include "protocol/addresses.hpp"
@@ -37,6 +42,14 @@ Json overrides_of(const profile::ComponentInstantiation &ci, const profile::Reso
     out[profile::common_of(*definition).label()] = profile::to_json(*value);
   }
   return out;
+}
+
+// How often the logs' sizes are looked at: a process logging fast overshoots its bound by at most
+// what it logs in this time.
+constexpr std::chrono::seconds kLogRotationPeriod{1};
+
+op::ProcessFigures figures_of(pid_t pid, const process::Figures &f) {
+  return {pid, f.cpu_percent, f.rss_bytes, f.threads};
 }
 
 } // namespace
@@ -69,7 +82,9 @@ struct DeviceManager::Impl {
   DeviceLibraries libraries{{}};
   std::vector<RunningDevice> devices;
   std::atomic<bool> stopping{false};
-  std::mutex endpoint_mutex; // the endpoint's end against a process exit reported meanwhile
+  std::mutex endpoint_mutex;        // the endpoint's end against a process exit reported meanwhile
+  process::CpuSampler sampler;      // node.top's: its last reading of each process
+  std::optional<Periodic> rotation; // of its processes' logs, by size
 
   Expected<void> start_devices();
   op::NodeAnnouncement announcement() const;
@@ -80,6 +95,9 @@ struct DeviceManager::Impl {
   Expected<void> open_cache();
   CallResult<op::TerminateReply> terminate(const op::TerminateRequest &request) const;
   op::StatusReply status() const;
+  std::vector<op::ProcessRecord> running() const;
+  CallResult<op::TopReply> top();
+  void rotate_logs() const;
 };
 
 namespace {
@@ -170,9 +188,7 @@ Expected<void> DeviceManager::Impl::start_devices() {
 }
 
 op::NodeAnnouncement DeviceManager::Impl::announcement() const {
-  char host[256] = {};
-  gethostname(host, sizeof(host) - 1);
-  op::NodeAnnouncement out{dcd->name, static_cast<std::int64_t>(getpid()), host, {}, true};
+  op::NodeAnnouncement out{dcd->name, static_cast<std::int64_t>(getpid()), host_name(), {}, true};
   for (const auto &d : devices) {
     op::DeviceRecord record{d.id,
                             d.label,
@@ -259,14 +275,19 @@ DeviceManager::Impl::terminate(const op::TerminateRequest &request) const {
       Status::NotFound, fmt::format("node {} did not start process {}", dcd->name, request.pid));
 }
 
-op::StatusReply DeviceManager::Impl::status() const {
-  auto a = announcement();
-  op::StatusReply status{
-      std::move(a.node), a.pid, std::move(a.host), std::move(a.devices), {}, {}, {}};
+std::vector<op::ProcessRecord> DeviceManager::Impl::running() const {
+  std::vector<op::ProcessRecord> out;
   for (const auto &d : devices)
     if (d.executable() != nullptr)
       for (auto &p : d.executable()->processes())
-        status.processes.push_back(std::move(p));
+        out.push_back(std::move(p));
+  return out;
+}
+
+op::StatusReply DeviceManager::Impl::status() const {
+  auto a = announcement();
+  op::StatusReply status{
+      std::move(a.node), a.pid, std::move(a.host), std::move(a.devices), running(), {}, {}};
   if (host_data) {
     const auto held = host_data->counts();
     status.shared_memory =
@@ -279,6 +300,37 @@ op::StatusReply DeviceManager::Impl::status() const {
   return status;
 }
 
+// The node daemon's figures and those of each process its devices run; a process that exited
+// meanwhile is left out.
+CallResult<op::TopReply> DeviceManager::Impl::top() {
+  const auto self = ::getpid();
+  auto own = sampler.read(self);
+  if (!own)
+    return control::call_error(Status::Failed, "cannot read the node's own /proc figures");
+  op::TopReply reply{dcd->name, host_name(), figures_of(self, *own), {}};
+  std::set<pid_t> alive{self};
+  for (const auto &p : running()) {
+    const auto pid = static_cast<pid_t>(p.pid);
+    auto figures = sampler.read(pid);
+    if (!figures || reply.processes.size() >= op::TopReply::kMaxProcesses)
+      continue;
+    alive.insert(pid);
+    auto [application, component] = op::split_process_label(p.label);
+    reply.processes.push_back(
+        {std::move(application), std::move(component), figures_of(pid, *figures)});
+  }
+  sampler.keep_only(alive);
+  return reply;
+}
+
+void DeviceManager::Impl::rotate_logs() const {
+  for (const auto &p : running())
+    if (auto rotated = rotate_if_over(p.log, options.log_max_bytes); !rotated)
+      spdlog::warn("{}: {}", p.label, rotated.error().to_string());
+    else if (*rotated)
+      spdlog::debug("{}: log rotated", p.label);
+}
+
 void DeviceManager::Impl::serve() {
   control::serve<op::Execute>(
       *endpoint, [this](const auto &request, const auto &) { return execute(request); });
@@ -287,11 +339,16 @@ void DeviceManager::Impl::serve() {
   control::serve<op::Status>(*endpoint, [this](const auto &, const auto &) {
     return CallResult<op::StatusReply>(status());
   });
+  control::serve<op::Top>(*endpoint, [this](const auto &, const auto &) { return top(); });
+  control::serve<op::Logs>(*endpoint, [this](const auto &request, const auto &) {
+    return read_log(options.log_dir, request, running());
+  });
 }
 
 DeviceManager::DeviceManager(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 
 DeviceManager::~DeviceManager() {
+  impl_->rotation.reset(); // it reads the devices' processes
   impl_->stopping = true;
   impl_->endpoint->withdraw();
   impl_->links->close(); // relays under way fail: the endpoint's handlers return
@@ -367,6 +424,8 @@ DeviceManager::create(std::shared_ptr<dds::Participant> participant, NodeOptions
     return tl::unexpected(ok.error());
   if (auto ok = impl->start_devices(); !ok)
     return tl::unexpected(ok.error());
+  if (impl->options.log_max_bytes > 0)
+    impl->rotation.emplace(kLogRotationPeriod, [raw = impl.get()] { raw->rotate_logs(); });
   impl->serve();
   impl->endpoint->start_serving();
   // The domain is the node's caller, and the node calls it: both ways are made now, so the

@@ -25,6 +25,8 @@ struct NodeOptions {
   // (node/device_libraries.hpp). Empty: rsca's library folders (common/install_layout.hpp).
   std::vector<std::filesystem::path> library_path;
   std::filesystem::path log_dir = "/tmp/rsca/logs";
+  // A process's log past this is rotated, one older file kept (node/process_logs.hpp); 0: never.
+  std::uint64_t log_max_bytes = 10ULL << 20U;
   // Where local clients (the CLI) connect for a link to the node (ProcessLinks::listen); none:
   // they use DDS.
   std::optional<std::filesystem::path> control_socket;

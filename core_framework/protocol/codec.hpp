@@ -16,6 +16,9 @@
 // EnumNames table, nested messages, and std::vector, std::optional and std::map<std::string, T>
 // of them.
 //
+// A message may also say what its fields alone cannot (a bound, a range) in a `check()`, which
+// decode() runs on the message read (checked() below).
+//
 // Bytes are a JSON binary value: never text. The one field of a reply named kPayloadField may
 // hold them; the control plane carries it beside the reply's JSON (control.idl, Reply.payload).
 #pragma once
@@ -170,6 +173,17 @@ Json encode_message(const M &message) {
   return out;
 }
 
+// What a message's fields alone do not say (a bound on a list's size, a number's range): a message
+// with `std::optional<DecodeError> check() const` is refused when it finds something.
+template <MessageType M>
+DecodeResult checked(const M &message) {
+  if constexpr (requires { message.check(); }) {
+    if (auto wrong = message.check())
+      return tl::unexpected(std::move(*wrong));
+  }
+  return {};
+}
+
 template <MessageType M>
 DecodeResult decode_message(const Json &json, M &out) {
   if (!json.is_object())
@@ -195,7 +209,9 @@ DecodeResult decode_message(const Json &json, M &out) {
             ...);
       },
       M::fields());
-  if (!result || known == json.size())
+  if (result && known == json.size())
+    return checked(out);
+  if (!result)
     return result;
   for (const auto &[key, value] : json.items()) {
     bool listed = false;
@@ -204,7 +220,7 @@ DecodeResult decode_message(const Json &json, M &out) {
     if (!listed)
       return detail::invalid(fmt::format("unknown field \"{}\"", key));
   }
-  return result;
+  return checked(out);
 }
 
 template <typename T>

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "protocol/codec.hpp"
+#include "protocol/node_ops.hpp"
 
 namespace rsca::protocol::domain {
 
@@ -192,6 +193,20 @@ struct Nodes {
   static constexpr std::string_view name = "domain.nodes";
   using Request = Empty;
   using Reply = NodesReply;
+};
+// The domain daemon's own figures, for `rsca top` (the nodes report theirs: node.top).
+struct TopReply {
+  std::string host;
+  node::ProcessFigures daemon;
+  static constexpr auto fields() {
+    return std::tuple{required("host", &TopReply::host), required("daemon", &TopReply::daemon)};
+  }
+};
+
+struct Top {
+  static constexpr std::string_view name = "domain.top";
+  using Request = Empty;
+  using Reply = TopReply;
 };
 struct Devices {
   static constexpr std::string_view name = "domain.devices";

@@ -70,6 +70,18 @@ struct TerminateReply {
   static constexpr auto fields() { return std::tuple{required("pid", &TerminateReply::pid)}; }
 };
 
+// A process's label, APPLICATION/COMPONENT (ProcessRecord), made and read here only. A component
+// id holds no '/', so the last one splits it.
+inline std::string process_label(std::string_view application, std::string_view component) {
+  return fmt::format("{}/{}", application, component);
+}
+inline std::pair<std::string, std::string> split_process_label(std::string_view label) {
+  const auto slash = label.rfind('/');
+  if (slash == std::string_view::npos)
+    return {std::string(label), {}};
+  return {std::string(label.substr(0, slash)), std::string(label.substr(slash + 1))};
+}
+
 // A process an executable device runs.
 struct ProcessRecord {
   std::int64_t pid = 0;
@@ -189,6 +201,107 @@ struct StatusReply {
   }
 };
 
+// A process's figures (process/proc_figures.hpp), for `rsca top`. CPU % is of one CPU (a process
+// busy on two is 200) since the node's last reading of that process, or since it started.
+struct ProcessFigures {
+  static constexpr double kMaxCpuPercent = 100.0 * 4096; // a CPU each, on the largest hosts
+  std::int64_t pid = 0;
+  double cpu_percent = 0;
+  std::uint64_t rss_bytes = 0;
+  std::uint64_t threads = 0;
+  static constexpr auto fields() {
+    using R = ProcessFigures;
+    return std::tuple{required("pid", &R::pid), required("cpu_percent", &R::cpu_percent),
+                      required("rss_bytes", &R::rss_bytes), required("threads", &R::threads)};
+  }
+  std::optional<DecodeError> check() const {
+    if (pid <= 0)
+      return DecodeError{"pid", "not a process id"};
+    if (!(cpu_percent >= 0 && cpu_percent <= kMaxCpuPercent)) // NaN too
+      return DecodeError{"cpu_percent", "out of range"};
+    return std::nullopt;
+  }
+};
+
+// One process a node's GPP runs, as node.top reports it.
+struct TopProcess {
+  static constexpr std::size_t kMaxName = 256;
+  std::string application;
+  std::string component; // the component's id, or the component host's name
+  ProcessFigures figures;
+  static constexpr auto fields() {
+    using R = TopProcess;
+    return std::tuple{required("application", &R::application),
+                      required("component", &R::component), required("figures", &R::figures)};
+  }
+  std::optional<DecodeError> check() const {
+    if (application.size() > kMaxName || component.size() > kMaxName)
+      return DecodeError{"component", "a name too long"};
+    return std::nullopt;
+  }
+};
+
+struct TopReply {
+  // More than a node starts (a launch of a hundred components is a hundred processes at most).
+  static constexpr std::size_t kMaxProcesses = 4096;
+  std::string node;
+  std::string host;
+  ProcessFigures daemon; // the node daemon itself
+  std::vector<TopProcess> processes;
+  static constexpr auto fields() {
+    using R = TopReply;
+    return std::tuple{required("node", &R::node), required("host", &R::host),
+                      required("daemon", &R::daemon), required("processes", &R::processes)};
+  }
+  std::optional<DecodeError> check() const {
+    if (processes.size() > kMaxProcesses)
+      return DecodeError{"processes", fmt::format("more than {}", kMaxProcesses)};
+    if (node.size() > TopProcess::kMaxName || host.size() > TopProcess::kMaxName)
+      return DecodeError{"node", "a name too long"};
+    return std::nullopt;
+  }
+};
+
+// The log of a process the node's GPP started (its stdout and stderr), named by its application
+// and component (never by a path: the node makes the path in its log folder). A hosted component
+// writes to its component host's log: `pid` (app.show's) then finds it among the processes.
+struct LogsRequest {
+  static constexpr std::uint64_t kMaxBytes = 1ULL << 20U;
+  static constexpr std::uint64_t kDefaultBytes = 64ULL << 10U;
+  std::string application;
+  std::string component;
+  std::optional<std::int64_t> pid;
+  // Where to read from (a reply's `next`, to follow the log); absent: its last `max_bytes`,
+  // from the first whole line.
+  std::optional<std::uint64_t> offset;
+  std::optional<std::uint64_t> max_bytes; // at most kMaxBytes; absent: kDefaultBytes
+  static constexpr auto fields() {
+    using R = LogsRequest;
+    return std::tuple{required("application", &R::application),
+                      required("component", &R::component), optional("pid", &R::pid),
+                      optional("offset", &R::offset), optional("max_bytes", &R::max_bytes)};
+  }
+};
+
+struct LogsReply {
+  std::string log;          // the log's name in the node's log folder: APPLICATION/COMPONENT.log
+  std::uint64_t offset = 0; // where `text` starts in the log
+  std::uint64_t next = 0;   // where the next read goes on
+  std::string text;         // invalid UTF-8 replaced, so that it travels as JSON text
+  static constexpr auto fields() {
+    using R = LogsReply;
+    return std::tuple{required("log", &R::log), required("offset", &R::offset),
+                      required("next", &R::next), required("text", &R::text)};
+  }
+  std::optional<DecodeError> check() const {
+    if (text.size() > LogsRequest::kMaxBytes * 3) // each invalid byte may become 3 (U+FFFD)
+      return DecodeError{"text", "longer than asked"};
+    if (next < offset)
+      return DecodeError{"next", "before offset"};
+    return std::nullopt;
+  }
+};
+
 struct Execute {
   static constexpr std::string_view name = "node.execute";
   using Request = ExecuteRequest;
@@ -203,6 +316,16 @@ struct Status {
   static constexpr std::string_view name = "node.status";
   using Request = Empty;
   using Reply = StatusReply;
+};
+struct Top {
+  static constexpr std::string_view name = "node.top";
+  using Request = Empty;
+  using Reply = TopReply;
+};
+struct Logs {
+  static constexpr std::string_view name = "node.logs";
+  using Request = LogsRequest;
+  using Reply = LogsReply;
 };
 
 } // namespace rsca::protocol::node

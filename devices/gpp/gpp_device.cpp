@@ -122,7 +122,7 @@ GppDevice::execute(const protocol::node::ExecuteRequest &r,
   // The component dies with this node: it checks that its parent is still this process.
   request.env.emplace_back(kNodePidVariable, std::to_string(::getpid()));
   request.log_file = context_.log_dir / application / (component + ".log");
-  request.label = fmt::format("{}/{}", application, component);
+  request.label = protocol::node::process_label(application, component);
   // The process's control goes through this node (node/process_links.hpp): it gets its end of
   // the link as a known descriptor.
   std::optional<std::pair<process::Fd, process::Fd>> link;

@@ -88,6 +88,13 @@ int main(int argc, char **argv) {
     for (;;)
       ::pause();
   }
+  // "busy": a thread that burns a CPU for as long as the process runs (rsca top's test).
+  if (g_fault == "busy")
+    std::thread([] {
+      volatile std::uint64_t spin = 0;
+      for (;;)
+        spin = spin + 1;
+    }).detach();
   if (g_fault == "never_register")
     for (;;)
       std::this_thread::sleep_for(std::chrono::hours(1)); // the fault itself: never register

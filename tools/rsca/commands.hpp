@@ -26,6 +26,8 @@ void add_domain_command(CLI::App &app, const GlobalOptions &global, int &exit_co
 void add_plan_command(CLI::App &app, const GlobalOptions &global, int &exit_code);
 void add_events_command(CLI::App &app, const GlobalOptions &global, int &exit_code);
 void add_new_command(CLI::App &app, const GlobalOptions &global, int &exit_code);
+void add_top_command(CLI::App &app, const GlobalOptions &global, int &exit_code);
+void add_logs_command(CLI::App &app, const GlobalOptions &global, int &exit_code);
 // rsca completion bash: made from `app`'s commands, so register it after them.
 void add_completion_command(CLI::App &app, int &exit_code);
 

@@ -13,6 +13,7 @@
 #include <spdlog/spdlog.h>
 
 #include "commands.hpp"
+#include "common/host_name.hpp"
 #include "control/endpoint.hpp"
 #include "control/link_socket.hpp"
 #include "control/node_link.hpp"
@@ -54,10 +55,8 @@ std::vector<fs::path> node_sockets() {
 namespace {
 
 std::string own_address(const GlobalOptions &global) {
-  char host[128] = {};
-  gethostname(host, sizeof(host) - 1);
   static std::atomic<int> counter{0};
-  return protocol::cli_address(global.domain, host, getpid(), ++counter);
+  return protocol::cli_address(global.domain, host_name(), getpid(), ++counter);
 }
 
 // How long a node has to answer the link's hello: a hung node's socket still accepts, and the CLI

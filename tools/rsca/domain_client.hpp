@@ -42,8 +42,15 @@ public:
   template <control::Operation Op>
   std::future<control::CallResult<control::Json>>
   call_async(const typename Op::Request &request, std::chrono::milliseconds timeout) const {
-    return server_->call(protocol::domain_address(domain_), std::string(Op::name),
-                         protocol::encode(request), timeout);
+    return call_async_at<Op>(protocol::domain_address(domain_), request, timeout);
+  }
+  // A call to another party than the domain (a node, whose address domain.nodes gives): through
+  // the same link or endpoint.
+  template <control::Operation Op>
+  std::future<control::CallResult<control::Json>>
+  call_async_at(const std::string &address, const typename Op::Request &request,
+                std::chrono::milliseconds timeout) const {
+    return server_->call(address, std::string(Op::name), protocol::encode(request), timeout);
   }
   const std::string &domain() const { return domain_; }
   // The node's control socket the calls go through; empty when they go over DDS.

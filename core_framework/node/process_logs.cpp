@@ -1,0 +1,194 @@
+#include "node/process_logs.hpp"
+
+#include <algorithm>
+#include <fstream>
+#include <optional>
+
+#include <fmt/format.h>
+
+#include "common/names.hpp"
+
+namespace rsca::node {
+namespace {
+
+namespace fs = std::filesystem;
+namespace op = protocol::node;
+using control::CallResult;
+using protocol::Status;
+
+// The log of the process named: the running process's own, a hosted component's host's (by
+// pid), or the file a process of that name left in the folder; empty when there is none.
+fs::path log_of(const fs::path &log_dir, const op::LogsRequest &request,
+                const std::vector<op::ProcessRecord> &running) {
+  const auto label = op::process_label(request.application, request.component);
+  for (const auto &p : running)
+    if (p.label == label)
+      return p.log;
+  if (request.pid)
+    for (const auto &p : running)
+      if (p.pid == *request.pid && op::split_process_label(p.label).first == request.application)
+        return p.log;
+  auto file = log_dir / request.application / (request.component + ".log");
+  std::error_code ec;
+  return fs::is_regular_file(file, ec) ? file : fs::path();
+}
+
+struct Span {
+  std::uint64_t from = 0;
+  std::uint64_t to = 0;
+};
+
+// Whole lines only: a tail starts after its first newline (unless it is the log's start), and
+// any piece ends at its last one (unless it has none), so a line is never shown in two halves.
+Span whole_lines(const std::string &bytes, bool tail_from_inside) {
+  std::size_t begin = 0;
+  if (tail_from_inside)
+    if (auto nl = bytes.find('\n'); nl != std::string::npos)
+      begin = nl + 1;
+  std::size_t end = bytes.size();
+  if (auto nl = bytes.rfind('\n'); nl != std::string::npos && nl + 1 > begin)
+    end = nl + 1;
+  return {begin, end};
+}
+
+std::uint64_t size_of(const fs::path &file) {
+  std::error_code ec;
+  const auto size = fs::file_size(file, ec);
+  return ec ? 0 : size;
+}
+
+// Bytes [from, to) of `file`, or fewer where it ends.
+std::string bytes_of(const fs::path &file, Span span) {
+  if (span.to <= span.from)
+    return {};
+  std::ifstream in(file, std::ios::binary);
+  std::string bytes(span.to - span.from, '\0');
+  in.seekg(static_cast<std::streamoff>(span.from));
+  in.read(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  bytes.resize(static_cast<std::size_t>(std::max<std::streamsize>(in.gcount(), 0)));
+  return bytes;
+}
+
+fs::path previous_of(const fs::path &log) {
+  return fs::path(log.string() + ".1");
+}
+
+// What a read takes before it is cut to whole lines: bytes that end at `end` in the log and
+// start at `start` in it (nothing: they begin in LOG.1), and whether they start inside the text
+// (a tail's, whose first line is partial).
+struct Piece {
+  std::string bytes;
+  std::optional<std::uint64_t> start;
+  std::uint64_t end = 0;
+  bool from_inside = false;
+};
+
+// The last `max` bytes, reaching into LOG.1 when the log holds fewer.
+Piece tail_of(const fs::path &log, std::uint64_t size, std::uint64_t max) {
+  if (size >= max)
+    return {bytes_of(log, {size - max, size}), size - max, size, size > max};
+  const auto previous = previous_of(log);
+  const auto before = size_of(previous);
+  const auto wanted = std::min(before, max - size);
+  if (wanted == 0)
+    return {bytes_of(log, {0, size}), 0, size, false};
+  return {bytes_of(previous, {before - wanted, before}) + bytes_of(log, {0, size}), std::nullopt,
+          size, wanted < before};
+}
+
+// From `offset` on: in the log; past its end (it was rotated since), the rest of LOG.1 from there
+// and then the log from its start, at most half of `max` each when both are longer.
+Piece from_offset(const fs::path &log, std::uint64_t size, std::uint64_t offset,
+                  std::uint64_t max) {
+  if (offset <= size) {
+    const auto end = std::min(size, offset + max);
+    return {bytes_of(log, {offset, end}), offset, end, false};
+  }
+  const auto previous = previous_of(log);
+  const auto before = size_of(previous);
+  if (offset >= before) { // truncated, not rotated: nothing of LOG.1 is new
+    const auto end = std::min(size, max);
+    return {bytes_of(log, {0, end}), 0, end, false};
+  }
+  const auto end = std::min(size, std::max(max / 2, max - std::min(before - offset, max)));
+  const auto rest = std::min(before - offset, max - end);
+  return {bytes_of(previous, {before - rest, before}) + bytes_of(log, {0, end}), std::nullopt, end,
+          rest < before - offset};
+}
+
+} // namespace
+
+Expected<bool> rotate_if_over(const fs::path &log, std::uint64_t max_bytes) {
+  if (max_bytes == 0 || size_of(log) <= max_bytes)
+    return false;
+  std::error_code ec;
+  fs::copy_file(log, previous_of(log), fs::copy_options::overwrite_existing, ec);
+  if (!ec)
+    fs::resize_file(log, 0, ec);
+  if (ec)
+    return make_error({log.string(), 0, 0}, "io", fmt::format("cannot rotate: {}", ec.message()));
+  return true;
+}
+
+std::string utf8_or_replaced(std::string_view bytes) {
+  std::string out;
+  out.reserve(bytes.size());
+  std::size_t i = 0;
+  while (i < bytes.size()) {
+    const auto c = static_cast<unsigned char>(bytes[i]);
+    const std::size_t length = c < 0x80            ? 1
+                               : (c >> 5U) == 0x6  ? 2
+                               : (c >> 4U) == 0xE  ? 3
+                               : (c >> 3U) == 0x1E ? 4
+                                                   : 0;
+    bool valid = length != 0 && i + length <= bytes.size();
+    for (std::size_t k = 1; valid && k < length; ++k)
+      valid = (static_cast<unsigned char>(bytes[i + k]) >> 6U) == 0x2;
+    // Overlong forms and surrogates are invalid too (nlohmann::json refuses them when it writes).
+    if (valid && length == 2)
+      valid = c >= 0xC2;
+    if (valid && length >= 3) {
+      const auto d = static_cast<unsigned char>(bytes[i + 1]);
+      valid = !(c == 0xE0 && d < 0xA0) && !(c == 0xED && d >= 0xA0) && !(c == 0xF0 && d < 0x90) &&
+              !(c == 0xF4 && d >= 0x90) && c <= 0xF4;
+    }
+    if (!valid) {
+      out += "\xEF\xBF\xBD";
+      ++i;
+      continue;
+    }
+    out.append(bytes.substr(i, length));
+    i += length;
+  }
+  return out;
+}
+
+CallResult<op::LogsReply> read_log(const fs::path &log_dir, const op::LogsRequest &request,
+                                   const std::vector<op::ProcessRecord> &running) {
+  for (const auto &[what, name] : {std::pair{"the application", &request.application},
+                                   std::pair{"the component", &request.component}})
+    if (auto ok = check_name(what, *name); !ok)
+      return protocol::call_error(Status::BadRequest, ok.error());
+  const fs::path file = log_of(log_dir, request, running);
+  const auto what = op::process_label(request.application, request.component);
+  if (file.empty())
+    return protocol::call_error(Status::NotFound, fmt::format("no log of {} here", what));
+  std::error_code ec;
+  if (!fs::is_regular_file(file, ec))
+    return protocol::call_error(Status::Failed, fmt::format("the log of {} cannot be read", what));
+  const auto max = std::clamp<std::uint64_t>(
+      request.max_bytes.value_or(op::LogsRequest::kDefaultBytes), 1, op::LogsRequest::kMaxBytes);
+  const auto size = size_of(file);
+  const Piece piece =
+      request.offset ? from_offset(file, size, *request.offset, max) : tail_of(file, size, max);
+  const Span lines = whole_lines(piece.bytes, piece.from_inside);
+  const auto text = std::string_view(piece.bytes).substr(lines.from, lines.to - lines.from);
+  // Offsets are the log's own: the next read goes on after the last whole line returned.
+  const std::uint64_t cut = piece.bytes.size() - lines.to;
+  const std::uint64_t next = piece.end - std::min(piece.end, cut);
+  const std::uint64_t offset = piece.start ? *piece.start + lines.from : 0;
+  return op::LogsReply{file.lexically_relative(log_dir).string(), std::min(offset, next), next,
+                       utf8_or_replaced(text)};
+}
+
+} // namespace rsca::node

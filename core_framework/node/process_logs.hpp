@@ -1,0 +1,39 @@
+// node.logs: pieces of the logs of the processes a node's GPP started (their stdout and stderr,
+// <log folder>/APPLICATION/COMPONENT.log), for `rsca logs` on any host. The caller names an
+// application and a component, never a path: both are checked as names, and the path is made
+// here, inside the node's log folder.
+//
+// Logs are rotated by size (node option --log-max-kib), keeping one older file, LOG.1: the node
+// copies the log there and empties it (copytruncate), because the process writes to its own
+// descriptor of the file (appending: its next write lands at the emptied file's start), which a
+// rename would leave writing into LOG.1. What the process writes between the copy and the
+// truncation is lost; a rotation takes a few milliseconds, once per --log-max-kib logged.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "common/diagnostic.hpp"
+#include "control/caller.hpp"
+#include "protocol/node_ops.hpp"
+
+namespace rsca::node {
+
+// The piece of the log `request` asks for. `running`: the processes the node runs (a hosted
+// component's log is its component host's, found by the request's pid). Reads go across a
+// rotation: a tail shorter than asked begins in LOG.1, and an offset past the log's end (it was
+// rotated since) reads the rest of LOG.1 from there, then the log from its start.
+control::CallResult<protocol::node::LogsReply>
+read_log(const std::filesystem::path &log_dir, const protocol::node::LogsRequest &request,
+         const std::vector<protocol::node::ProcessRecord> &running);
+
+// Copies `log` to `log`.1 and empties it when it holds more than `max_bytes`; whether it did.
+Expected<bool> rotate_if_over(const std::filesystem::path &log, std::uint64_t max_bytes);
+
+// `bytes` as valid UTF-8 (JSON text must be): each byte that is not part of a valid sequence
+// becomes U+FFFD.
+std::string utf8_or_replaced(std::string_view bytes);
+
+} // namespace rsca::node

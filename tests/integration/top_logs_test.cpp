@@ -1,0 +1,175 @@
+// rsca top and rsca logs against real daemons: the figures and the logs come from the nodes that
+// run the processes (node.top, node.logs), the domain daemon's figures from itself (domain.top).
+#include <catch2/catch.hpp>
+
+#include <csignal>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+
+#include "domain_fixture.hpp"
+
+using namespace rsca::test;
+
+namespace {
+
+Json top_json(TestDomain &domain, const std::vector<std::string> &more = {}) {
+  std::vector<std::string> args{"top", "--json"};
+  args.insert(args.end(), more.begin(), more.end());
+  auto [rc, out] = domain.cli(args);
+  INFO(out);
+  REQUIRE(rc == 0);
+  return Json::parse(out);
+}
+
+// The row of `what` (rsca-noded, APP/COMP...) on `node`; null when there is none.
+Json row_of(const Json &top, const std::string &node, const std::string &what) {
+  for (const auto &row : top.at("processes"))
+    if (row.at("node") == node && row.at("what") == what)
+      return row;
+  return nullptr;
+}
+
+void check_sane(const Json &row) {
+  INFO(row.dump());
+  CHECK(row.at("pid").get<long>() > 0);
+  CHECK(row.at("rss_bytes").get<std::uint64_t>() > 0);
+  CHECK(row.at("threads").get<std::uint64_t>() >= 1);
+  CHECK(row.at("cpu_percent").get<double>() >= 0);
+}
+
+} // namespace
+
+TEST_CASE("rsca top lists the daemons and every component process with the pid app.show gives",
+          "[integration][top]") {
+  TestDomain domain(2);
+  const Json app = domain.launch_shipped("ProducerConsumer");
+  const Json top = top_json(domain);
+  INFO(top.dump(2));
+  CHECK(top.at("unreachable").empty());
+  const Json domaind = row_of(top, "domain", "rsca-domaind");
+  REQUIRE(domaind.is_object());
+  check_sane(domaind);
+  for (const char *node : {"node1", "node2"}) {
+    const Json noded = row_of(top, node, "rsca-noded");
+    REQUIRE(noded.is_object());
+    check_sane(noded);
+  }
+  for (const auto &c : app.at("components")) {
+    const std::string what = "ProducerConsumer/" + c.at("id").get<std::string>();
+    const Json row = row_of(top, c.at("node").get<std::string>(), what);
+    REQUIRE(row.is_object());
+    check_sane(row);
+    CHECK(row.at("pid") == c.at("pid"));
+    CHECK(row.at("application") == "ProducerConsumer");
+  }
+  // With an application: its processes only; an application that does not run is not found.
+  const Json only = top_json(domain, {"ProducerConsumer"});
+  CHECK(only.at("processes").size() == app.at("components").size());
+  auto [rc, out] = domain.cli({"top", "NoSuchApp"});
+  INFO(out);
+  CHECK(rc == 3);
+}
+
+TEST_CASE("rsca top shows a component that burns a CPU as busy", "[integration][top]") {
+  TestDomain domain(1);
+  const Json app = domain.create("Busy");
+  const long pid = pid_of(app, "Burner_1");
+  REQUIRE(pid > 0);
+  // Each rsca top is a reading; CPU % is since the node's previous one. The node daemon beside
+  // the burner is busy while it starts the component, idle after: one reading shows both.
+  double seen = 0;
+  double node = 0;
+  const bool busy = TestDomain::wait_for(
+      [&] {
+        const Json top = top_json(domain);
+        const Json row = row_of(top, "node1", "Busy/Burner_1");
+        const Json noded = row_of(top, "node1", "rsca-noded");
+        if (!row.is_object() || !noded.is_object() || row.at("pid") != pid)
+          return false;
+        seen = row.at("cpu_percent").get<double>();
+        node = noded.at("cpu_percent").get<double>();
+        return seen > 20.0 && seen > 2 * node;
+      },
+      20s);
+  INFO("last CPU %: " << seen << ", the node daemon's " << node);
+  CHECK(busy);
+}
+
+TEST_CASE("rsca logs prints what a component logged, read by its node", "[integration][logs]") {
+  TestDomain domain(2);
+  domain.launch_shipped("ProducerConsumer");
+  auto [rc, out] = domain.cli({"logs", "ProducerConsumer/Producer_1"});
+  INFO(out);
+  CHECK(rc == 0);
+  CHECK(out.find("serving at") != std::string::npos);
+  auto [jrc, jout] = domain.cli({"logs", "ProducerConsumer/Producer_1", "--json", "-n", "5"});
+  INFO(jout);
+  REQUIRE(jrc == 0);
+  std::size_t lines = 0;
+  std::istringstream in(jout);
+  for (std::string line; std::getline(in, line); ++lines) {
+    const Json parsed = Json::parse(line);
+    CHECK(parsed.at("component") == "Producer_1");
+    CHECK(parsed.contains("line"));
+  }
+  CHECK(lines >= 1);
+  CHECK(lines <= 5);
+  // Every component of the application, each line marked with its component.
+  auto [arc, aout] = domain.cli({"logs", "ProducerConsumer"});
+  INFO(aout);
+  CHECK(arc == 0);
+  CHECK(aout.find("Consumer_1 | ") != std::string::npos);
+}
+
+TEST_CASE("rsca logs of a component or an application that does not exist is not found",
+          "[integration][logs]") {
+  TestDomain domain(1);
+  domain.launch_shipped("ProducerConsumer");
+  auto [rc, out] = domain.cli({"logs", "ProducerConsumer/Nobody_9"});
+  INFO(out);
+  CHECK(rc == 3);
+  auto [arc, aout] = domain.cli({"logs", "NoSuchApp"});
+  INFO(aout);
+  CHECK(arc == 3);
+  auto [nrc, nout] = domain.cli({"logs", "node1"});
+  INFO(nout);
+  CHECK(nrc == 3);
+  CHECK(nout.find("is a node") != std::string::npos);
+}
+
+TEST_CASE("rsca logs --since leaves out older lines", "[integration][logs]") {
+  TestDomain domain(1);
+  domain.launch_shipped("ProducerConsumer");
+  auto [rc, out] = domain.cli({"logs", "ProducerConsumer/Producer_1", "--since", "3600s"});
+  INFO(out);
+  CHECK(rc == 0);
+  CHECK(out.find("serving at") != std::string::npos);
+  // The lines logged at launch are older than "now" once the second they were logged in is over.
+  std::string recent;
+  CHECK(TestDomain::wait_for([&] {
+    recent = domain.cli({"logs", "ProducerConsumer/Producer_1", "--since", "0s"}).second;
+    return recent.find("serving at") == std::string::npos;
+  }));
+  INFO(recent);
+  CHECK(domain.cli({"logs", "ProducerConsumer/Producer_1", "--since", "soon"}).first == 2);
+}
+
+TEST_CASE("rsca logs -f goes on printing what the component logs", "[integration][logs]") {
+  TestDomain domain(1);
+  domain.launch_shipped("ProducerConsumer");
+  const fs::path out = domain.run_dir() / "follow.out";
+  ChildProcess follow((kBin / "rsca").string(), {"logs", "-f", "ProducerConsumer/Producer_1"},
+                      domain.env(), out);
+  auto text = [&] {
+    std::ifstream in(out);
+    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  };
+  REQUIRE(TestDomain::wait_for([&] { return text().find("serving at") != std::string::npos; }));
+  CHECK(text().find("stopped") == std::string::npos);
+  REQUIRE(domain.call("app.stop", Json{{"app", "ProducerConsumer"}}).has_value());
+  CHECK(TestDomain::wait_for([&] { return text().find("stopped") != std::string::npos; }));
+  INFO(text());
+  follow.signal(SIGINT);
+  CHECK(follow.wait_exit(5s).has_value());
+}

@@ -1,0 +1,224 @@
+// rsca logs APP[/COMP] [-n LINES] [--since T] [-f]: the logs of an application's component
+// processes, read by the nodes that run them (node.logs), so they come from any host. The domain
+// says where each component runs (app.show); each node is asked for the components it runs. -f
+// follows: the nodes are asked again every half second from where their last reply ended.
+#include <algorithm>
+#include <chrono>
+#include <ctime>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "commands.hpp"
+#include "common/units.hpp"
+#include "domain_client.hpp"
+#include "exit_codes.hpp"
+#include "protocol/application_ops.hpp"
+#include "protocol/domain_ops.hpp"
+#include "protocol/node_ops.hpp"
+
+namespace rsca::cli {
+namespace {
+
+namespace app_ops = protocol::application;
+namespace domain_ops = protocol::domain;
+namespace node_ops = protocol::node;
+using control::Json;
+
+struct LogsOptions {
+  std::string target; // APP or APP/COMP
+  std::size_t lines = 100;
+  std::string since; // a duration ("300s"): only the lines logged since then
+  bool follow = false;
+};
+
+constexpr std::chrono::milliseconds kFollowPace{500};
+
+// One component's log, and where reading it goes on.
+struct Source {
+  std::string node_address;
+  node_ops::LogsRequest request;
+  bool keeping = false; // --since: whether the last line read was kept
+};
+
+// A component's log lines start with the component runtime's local time, "[YYYY-MM-DD
+// HH:MM:SS.mmm]", which orders them as text: --since compares that with the time it names. A
+// line without it (a program's own output) goes with the line before it.
+std::string local_stamp(std::chrono::system_clock::time_point at) {
+  const std::time_t t = std::chrono::system_clock::to_time_t(at);
+  std::tm local{};
+  localtime_r(&t, &local);
+  return fmt::format("{:04}-{:02}-{:02} {:02}:{:02}:{:02}", local.tm_year + 1900, local.tm_mon + 1,
+                     local.tm_mday, local.tm_hour, local.tm_min, local.tm_sec);
+}
+
+constexpr std::size_t kStampLength = 19; // YYYY-MM-DD HH:MM:SS
+
+std::vector<std::string> since(std::vector<std::string> lines, const std::string &stamp,
+                               bool &keeping) {
+  if (stamp.empty())
+    return lines;
+  std::vector<std::string> kept;
+  for (auto &line : lines) {
+    const bool stamped = line.size() > kStampLength && line[0] == '[' && line[5] == '-' &&
+                         line[kStampLength - 2] == ':';
+    if (stamped)
+      keeping = line.compare(1, kStampLength, stamp) >= 0;
+    if (keeping)
+      kept.push_back(std::move(line));
+  }
+  return kept;
+}
+
+std::vector<std::string> lines_of(const std::string &text) {
+  std::vector<std::string> lines;
+  std::size_t at = 0;
+  while (at < text.size()) {
+    auto nl = text.find('\n', at);
+    if (nl == std::string::npos)
+      nl = text.size();
+    lines.push_back(text.substr(at, nl - at));
+    at = nl + 1;
+  }
+  return lines;
+}
+
+bool is_node(const domain_ops::NodesReply &nodes, const std::string &name) {
+  return std::any_of(nodes.nodes.begin(), nodes.nodes.end(),
+                     [&](const auto &n) { return n.name == name; });
+}
+
+// The components the target names, each with its node's address. rc: the exit code when it fails.
+std::vector<Source> sources_of(const DomainClient &client, const LogsOptions &options,
+                               const GlobalOptions &global, int &rc) {
+  const std::chrono::milliseconds timeout(global.timeout_ms);
+  const auto slash = options.target.find('/');
+  const std::string app = options.target.substr(0, slash);
+  const std::string component =
+      slash == std::string::npos ? std::string() : options.target.substr(slash + 1);
+  auto nodes = client.call<domain_ops::Nodes>({}, timeout);
+  if (!nodes) {
+    rc = report_failure(global, "logs", nodes.error());
+    return {};
+  }
+  auto shown = client.call<app_ops::Show>({app}, timeout);
+  if (!shown) {
+    if (slash == std::string::npos && is_node(*nodes, app))
+      shown.error().message = fmt::format(
+          "{} is a node: a node daemon's own log is not served (yet); it is its standard error "
+          "(the journal under systemd, the run folder's log with `rsca domain up`)",
+          app);
+    rc = report_failure(global, "logs", shown.error());
+    return {};
+  }
+  std::vector<Source> sources;
+  for (const auto &c : shown->components) {
+    if (!component.empty() && c.id != component)
+      continue;
+    for (const auto &n : nodes->nodes)
+      if (n.name == c.node)
+        sources.push_back(
+            {n.address,
+             {shown->name, c.id, c.pid, std::nullopt, node_ops::LogsRequest::kMaxBytes}});
+  }
+  if (sources.empty())
+    rc = report_failure(global, "logs",
+                        {control::Status::NotFound,
+                         component.empty()
+                             ? fmt::format("no component of {} runs on a node", app)
+                             : fmt::format("{} has no component {} on a node", app, component)});
+  return sources;
+}
+
+// Prints a reply's lines (the last `keep` of them when not all), prefixed with the component when
+// the logs of several are shown.
+void print_lines(const Source &source, const std::vector<std::string> &lines, std::size_t keep,
+                 bool prefix, const GlobalOptions &global) {
+  const std::size_t first = lines.size() > keep ? lines.size() - keep : 0;
+  for (std::size_t i = first; i < lines.size(); ++i) {
+    if (global.json)
+      fmt::print("{}\n", Json{{"application", source.request.application},
+                              {"component", source.request.component},
+                              {"line", lines[i]}}
+                             .dump());
+    else if (prefix)
+      fmt::print("{} | {}\n", source.request.component, lines[i]);
+    else
+      fmt::print("{}\n", lines[i]);
+  }
+  std::fflush(stdout);
+}
+
+// Reads each source once, from where it stands; the exit code of the first failure.
+int read_once(const DomainClient &client, std::vector<Source> &sources, std::size_t keep,
+              const std::string &stamp, const GlobalOptions &global) {
+  std::vector<std::future<control::CallResult<Json>>> pending;
+  for (const auto &s : sources)
+    pending.push_back(client.call_async_at<node_ops::Logs>(
+        s.node_address, s.request, std::chrono::milliseconds(global.timeout_ms)));
+  int rc = kOk;
+  for (std::size_t i = 0; i < sources.size(); ++i) {
+    auto reply = control::reply_of<node_ops::Logs>(pending[i].get());
+    if (!reply) {
+      const int failed = report_failure(
+          global, fmt::format("logs {}", sources[i].request.component), reply.error());
+      rc = rc == kOk ? failed : rc;
+      continue;
+    }
+    sources[i].request.offset = reply->next;
+    print_lines(sources[i], since(lines_of(reply->text), stamp, sources[i].keeping), keep,
+                sources.size() > 1, global);
+  }
+  return rc;
+}
+
+int logs(const LogsOptions &options, const GlobalOptions &global) {
+  auto client = DomainClient::connect(global);
+  if (!client) {
+    fmt::print(stderr, "rsca logs: {}\n", client.error().to_string());
+    return kFailed;
+  }
+  std::string stamp;
+  if (!options.since.empty()) {
+    auto ago = parse_duration(options.since);
+    if (!ago || ago->infinite()) {
+      fmt::print(stderr, "rsca logs: --since {}: {}\n", options.since,
+                 ago ? "a duration, not infinite" : ago.error());
+      return kUsage;
+    }
+    stamp =
+        local_stamp(std::chrono::system_clock::now() -
+                    std::chrono::duration_cast<std::chrono::system_clock::duration>(*ago->value));
+  }
+  int rc = kOk;
+  auto sources = sources_of(*client, options, global, rc);
+  if (sources.empty())
+    return rc;
+  rc = read_once(*client, sources, options.lines, stamp, global);
+  if (!options.follow)
+    return rc;
+  for (;;) { // until interrupted
+    std::this_thread::sleep_for(kFollowPace);
+    (void)read_once(*client, sources, SIZE_MAX, stamp, global);
+  }
+}
+
+} // namespace
+
+void add_logs_command(CLI::App &app, const GlobalOptions &global, int &exit_code) {
+  auto *cmd = app.add_subcommand(
+      "logs", "The logs of a running application's components (APP) or of one (APP/COMP), read "
+              "by the nodes that run them");
+  auto options = std::make_shared<LogsOptions>();
+  cmd->add_option("target", options->target, "APP or APP/COMPONENT")->required();
+  cmd->add_option("-n,--lines", options->lines, "the last LINES lines of each log")
+      ->capture_default_str();
+  cmd->add_option("--since", options->since,
+                  "only the lines logged in the last T (a duration: 90s, 3600s)");
+  cmd->add_flag("-f,--follow", options->follow, "go on printing what is logged, until Ctrl-C");
+  cmd->callback([options, &global, &exit_code] { exit_code = logs(*options, global); });
+}
+
+} // namespace rsca::cli
