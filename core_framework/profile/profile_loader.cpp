@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include "common/install_layout.hpp"
 #include "profile/application_checks.hpp"
 
 namespace rsca::profile {
@@ -42,6 +43,32 @@ Error with_reference_note(Error error, const SourceLocation &referenced_at, cons
     error.add({referenced_at, "invalid-ref",
                fmt::format("the file referenced here, {}, is invalid", file.string())});
   return error;
+}
+
+// Where a DCD's or DMD's manager SPD is, and the reference to check it from. rsca's daemons are
+// the DeviceManager and the DomainManager, and their SPDs ship with rsca's profiles: a user's SDR
+// root (one `rsca new device` made) names them as a REDHAWK root would, without holding them, so
+// one missing there is looked up in rsca's default SDR root before it counts as missing. That one
+// lies outside the user's root by design, so it is read as a file of rsca's own, referenced from
+// nowhere in the user's root.
+struct ManagerSpd {
+  fs::path file;
+  SourceLocation referenced_at;
+};
+
+ManagerSpd manager_spd(const SdrRoot &root, const LocalFile &named, const fs::path &referencing,
+                       SdrTree tree) {
+  ManagerSpd own{root.resolve(named.name, referencing, tree), named.where};
+  std::error_code ec;
+  if (fs::exists(own.file, ec) || named.name.empty() || named.name.front() != '/')
+    return own;
+  const fs::path shipped_root = layout::default_sdrroot();
+  if (shipped_root.empty())
+    return own;
+  fs::path shipped = SdrRoot(shipped_root).resolve(named.name, referencing, tree);
+  if (!fs::exists(shipped, ec))
+    return own;
+  return {std::move(shipped), {}};
 }
 
 // Whether a file could not be used only because it does not exist (what REDHAWK tolerates until
@@ -166,8 +193,16 @@ const ResolvedSoftPkg *ResolvedApplication::softpkg_of(const ComponentPlacement 
 ProfileLoader::ProfileLoader(std::optional<fs::path> sdrroot) : sdrroot_(std::move(sdrroot)) {}
 
 Expected<SdrRoot> ProfileLoader::root_for(const fs::path &file) const {
-  if (sdrroot_)
-    return SdrRoot(fs::absolute(*sdrroot_).lexically_normal());
+  if (sdrroot_) {
+    SdrRoot given(fs::absolute(*sdrroot_).lexically_normal());
+    // rsca's own profiles (the managers' SPDs, manager_spd()) are read within their own root.
+    if (given.contains(file))
+      return given;
+    if (const fs::path shipped = layout::default_sdrroot();
+        !shipped.empty() && SdrRoot(shipped).contains(file))
+      return SdrRoot(shipped);
+    return given;
+  }
   if (auto root = SdrRoot::find_for(file))
     return *root;
   return make_error({file.string(), 0, 0}, "sdrroot",
@@ -383,7 +418,8 @@ Expected<ResolvedNode> ProfileLoader::load_node(const fs::path &dcd_file) {
   Error errors;
   // rsca-noded is the DeviceManager: its SPD is checked when it is there, and nothing needs it.
   if (const auto &mgr = (*dcd)->device_manager_softpkg; !mgr.name.empty()) {
-    auto spd = softpkg(root->resolve(mgr.name, node.dcd_path, SdrTree::Dev), mgr.where);
+    const ManagerSpd where = manager_spd(*root, mgr, node.dcd_path, SdrTree::Dev);
+    auto spd = softpkg(where.file, where.referenced_at);
     if (!spd && is_missing_file(spd.error())) {
       Diagnostic d = spd.error().diagnostics().front();
       d.severity = Severity::Warning;
@@ -440,7 +476,8 @@ Expected<DomainManagerConfiguration> ProfileLoader::load_domain(const fs::path &
     return tl::unexpected(dmd.error());
   // rsca-domaind is the DomainManager: its SPD is checked when it is there, and nothing needs it.
   const auto &mgr = (*dmd)->domain_manager_softpkg;
-  auto spd = softpkg(root->resolve(mgr.name, fs::absolute(dmd_file), SdrTree::Dom), mgr.where);
+  const ManagerSpd where = manager_spd(*root, mgr, fs::absolute(dmd_file), SdrTree::Dom);
+  auto spd = softpkg(where.file, where.referenced_at);
   if (!spd && !is_missing_file(spd.error()))
     return tl::unexpected(spd.error());
   return **dmd;

@@ -99,8 +99,14 @@ thermo_dcd="$sdr/dev/nodes/Thermo_node/DeviceManager.dcd.xml"
 if readelf -d "$sdr/dev/devices/Thermo/libThermo.so" | grep 'NEEDED.*librsca'; then
   fail "the device library links an rsca library (rsca-noded provides the code)"
 fi
-# The generated profiles are valid.
+# The generated profiles are valid, and the DeviceManager SPD the DCD names is rsca's own
+# (found in the installed profiles, so no warning says it is missing).
 "$rsca" validate "$sdr"
+"$rsca" validate "$thermo_dcd" >"$work/thermo-validate.txt" 2>&1 || fail "the device's DCD is invalid"
+if grep -i 'missing' "$work/thermo-validate.txt" >/dev/null; then
+  cat "$work/thermo-validate.txt" >&2
+  fail "validating the device's DCD warns of a missing file"
+fi
 
 step "the installed daemons come up, one node with the new device"
 "$rsca" domain up --nodes 1 --node "$thermo_dcd" --run-dir "$work/run" || { tail -n 20 "$work"/run/*.log >&2; fail "the daemons did not come up"; }
