@@ -4,10 +4,12 @@
 # of rsca's links, outside the package, belongs to a package that rsca's Depends names; and the
 # package's programs, unpacked into an empty root, find the rest of rsca from there (the CLI
 # validates the installed profiles with the installed XML reader).
-# Usage: package_test.sh BUILD_DIR [FLAGS]
+# Usage: package_test.sh BUILD_DIR FLAGS SONAME   (FLAGS: the build's sanitizer flags, if any;
+# SONAME: the runtime library's, e.g. librsca_runtime.so.0.1)
 set -euo pipefail
 build="$1"
-flags="${2:-}" # the build's sanitizer flags, if any
+flags="$2"
+runtime_soname="$3"
 work="$(mktemp -d /tmp/rsca-package-test.XXXXXX)"
 trap 'rm -rf "$work"' EXIT
 fail() { printf 'FAIL: %s\n' "$*" >&2; exit 1; }
@@ -29,7 +31,7 @@ has() {
 }
 lacks() { ! grep -q "$2" "$(listing "$1")" || fail "$(basename "$1") holds $2"; }
 for f in ./usr/bin/rsca ./usr/bin/rsca-domaind ./usr/bin/rsca-noded ./usr/bin/rsca-component-host \
-         ./usr/L/rsca/librsca_xml_reader.so ./usr/L/librsca_runtime.so.0 \
+         ./usr/L/rsca/librsca_xml_reader.so ./usr/L/$runtime_soname \
          ./usr/L/rsca/librsca-gpp.so ./usr/L/rsca/librsca-host-monitor.so \
          ./usr/L/rsca/librsca-robot-devices.so \
          ./usr/libexec/rsca/rsca-producer ./usr/share/rsca/profiles/dom/domain/DomainManager.dmd.xml \
@@ -50,7 +52,7 @@ dpkg-deb -f "$dev" Depends | grep "^rsca (= " >/dev/null || fail "rsca-dev does 
 # Depends: every library outside the package that an ELF file of it links directly.
 root="$work/root"
 dpkg-deb -x "$runtime" "$root"
-libdir="$(dirname "$(find "$root" -name 'librsca_runtime.so.0' -print -quit)")"
+libdir="$(dirname "$(find "$root" -name "$runtime_soname" -print -quit)")"
 depends="$(dpkg-deb -f "$runtime" Depends | tr ',' '\n' | sed 's/(.*//; s/ //g')"
 owner() { # the package that holds a library file, under either of usrmerge's paths
   local path="$1" p

@@ -7,11 +7,12 @@
 # (rsca::component_library). The installed `rsca new device` makes a device project, built the same
 # way into a library (rsca::device_library) that the installed rsca-noded loads for the generated
 # DCD; its properties answer. Everything it started is stopped and checked gone.
-# Usage: sdk_test.sh BUILD_DIR [FLAGS]   (FLAGS: the build's sanitizer flags, which a program
-# linking the installed runtime needs as well)
+# Usage: sdk_test.sh BUILD_DIR FLAGS SONAME   (FLAGS: the build's sanitizer flags, which a program
+# linking the installed runtime needs as well; SONAME: the runtime library's)
 set -euo pipefail
 build="$1"
-flags="${2:-}"
+flags="$2"
+soname="$3"
 work="$(mktemp -d /tmp/rsca-sdk-test.XXXXXX)"
 usr="$work/root/usr"
 rsca="$usr/bin/rsca"
@@ -64,12 +65,12 @@ cmake --install "$work/build" --prefix "$sdr" >/dev/null
 [ -f "$sdr/dom/components/Greeter/libGreeter.so" ] || fail "the library was not installed"
 
 step "compile it again with pkg-config"
-libdir="$(dirname "$(find "$usr" -name 'librsca_runtime.so.0' -print -quit)")"
+libdir="$(dirname "$(find "$usr" -name "$soname" -print -quit)")"
 pc="$(PKG_CONFIG_PATH="$libdir/pkgconfig" pkg-config --cflags --libs rsca)"
 # shellcheck disable=SC2086 # pkg-config's output is a list of flags
 g++ $flags "$work/src/Greeter/src/Greeter.cpp" $pc -o "$work/greeter-pkgconfig"
 # grep reads all of ldd's output (not -q): ldd cut off by SIGPIPE fails the pipe (pipefail).
-LD_LIBRARY_PATH="$libdir" ldd "$work/greeter-pkgconfig" | grep -F "librsca_runtime.so.0 => $libdir/" >/dev/null ||
+LD_LIBRARY_PATH="$libdir" ldd "$work/greeter-pkgconfig" | grep -F "$soname => $libdir/" >/dev/null ||
   fail "the program pkg-config built does not link the installed runtime"
 
 # The same component as a library a host loads: its SPD naming lib<name>.so, as the generated
