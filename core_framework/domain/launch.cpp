@@ -245,10 +245,13 @@ CallResult<void> ApplicationFactory::Launch::execute() {
   auto bytes = add_packages(requests, started_by);
   if (!bytes)
     return tl::unexpected(bytes.error());
+  const auto timeout = s_.call_timeout + delivery_allowance(*bytes);
   std::vector<Call> calls;
-  for (std::size_t k = 0; k < requests.size(); ++k)
+  for (std::size_t k = 0; k < requests.size(); ++k) {
+    requests[k].budget_ms = timeout.count();
     calls.push_back(call_of<protocol::node::Execute>(to[k].first, requests[k], to[k].second));
-  auto replies = call_each_of(*s_.endpoint, calls, s_.call_timeout + delivery_allowance(*bytes));
+  }
+  auto replies = call_each_of(*s_.endpoint, calls, timeout);
   // Record every process that did start, even when another failed, so rollback finds it.
   std::vector<CallResult<protocol::node::ExecuteReply>> started;
   for (std::size_t k = 0; k < calls.size(); ++k) {
@@ -396,7 +399,8 @@ ApplicationFactory::Launch::execute_request(const ComponentInstance &c) const {
           protocol::to_args(exec_params(c)),
           std::nullopt,
           std::nullopt,
-          affinity_of(c)};
+          affinity_of(c),
+          std::nullopt}; // budget_ms: set when the calls are made
 }
 
 protocol::node::ExecuteRequest
@@ -411,7 +415,8 @@ ApplicationFactory::Launch::host_request(const ComponentInstance &first) const {
           {},
           std::nullopt,
           std::nullopt,
-          affinity};
+          affinity,
+          std::nullopt}; // budget_ms: set when the calls are made
 }
 
 std::optional<protocol::node::AffinityDirective>

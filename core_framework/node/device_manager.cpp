@@ -28,6 +28,28 @@ namespace {
 using control::Status;
 namespace op = protocol::node;
 
+// What an execute leaves for the spawn and the reply's way back: a process started later than
+// this before the caller's budget ends would likely be answered to nobody.
+constexpr std::chrono::milliseconds kStartAllowance{50};
+
+// Refuses an execute whose caller has stopped waiting (its budget_ms, counted from the request's
+// arrival), or soon will: the caller has rolled its launch back, and the process would belong to
+// nobody. `before`: what would have come next, for the message.
+std::optional<control::CallError> budget_spent(const op::ExecuteRequest &request,
+                                               const control::RequestContext &context,
+                                               std::string_view before) {
+  if (!request.budget_ms)
+    return std::nullopt;
+  const auto spent = std::chrono::duration_cast<std::chrono::milliseconds>(
+      std::chrono::steady_clock::now() - context.received);
+  if (spent + kStartAllowance <= std::chrono::milliseconds(*request.budget_ms))
+    return std::nullopt;
+  spdlog::warn("{}/{} not started: its caller's {} ms ran out before {} ({} ms spent)",
+               request.application, request.component, *request.budget_ms, before, spent.count());
+  return control::CallError{Status::Timeout, fmt::format("the caller's {} ms ran out before {}",
+                                                         *request.budget_ms, before)};
+}
+
 // The DCD's property values for one device, keyed by property id and by name.
 Json overrides_of(const profile::ComponentInstantiation &ci, const profile::ResolvedSoftPkg &pkg) {
   Json out = Json::object();
@@ -91,7 +113,8 @@ struct DeviceManager::Impl {
   void serve();
   ExecutableDevice *executable_device(const std::string &id) const;
   void report_exit(const protocol::domain::ComponentExitedReport &report);
-  CallResult<op::ExecuteReply> execute(const op::ExecuteRequest &request) const;
+  CallResult<op::ExecuteReply> execute(const op::ExecuteRequest &request,
+                                       const control::RequestContext &context) const;
   Expected<void> open_cache();
   CallResult<op::TerminateReply> terminate(const op::TerminateRequest &request) const;
   op::StatusReply status() const;
@@ -224,13 +247,17 @@ void DeviceManager::Impl::report_exit(const protocol::domain::ComponentExitedRep
       *endpoint, protocol::domain_address(options.domain_name), report, std::chrono::seconds(2));
 }
 
-CallResult<op::ExecuteReply> DeviceManager::Impl::execute(const op::ExecuteRequest &request) const {
+CallResult<op::ExecuteReply>
+DeviceManager::Impl::execute(const op::ExecuteRequest &request,
+                             const control::RequestContext &context) const {
   ExecutableDevice *device = executable_device(request.device);
   if (device == nullptr)
     return control::call_error(Status::NotFound, fmt::format("node {} has no executable device {}",
                                                              dcd->name, request.device));
   if (request.launch && request.launch->size() > protocol::file::kMaxLaunchLength)
     return control::call_error(Status::BadRequest, "launch: an id too long");
+  if (auto spent = budget_spent(request, context, "the node took it up"))
+    return tl::unexpected(*spent);
   std::shared_ptr<const PackageLease> package;
   if (request.package) {
     auto acquired = cache->acquire(*request.package, request.launch.value_or(""));
@@ -241,6 +268,8 @@ CallResult<op::ExecuteReply> DeviceManager::Impl::execute(const op::ExecuteReque
                                  fmt::format("node {}: {}", dcd->name, acquired.error().message));
     }
     package = std::move(*acquired);
+    if (auto spent = budget_spent(request, context, "its package was delivered"))
+      return tl::unexpected(*spent);
   }
   return device->execute(request, std::move(package));
 }
@@ -332,8 +361,9 @@ void DeviceManager::Impl::rotate_logs() const {
 }
 
 void DeviceManager::Impl::serve() {
-  control::serve<op::Execute>(
-      *endpoint, [this](const auto &request, const auto &) { return execute(request); });
+  control::serve<op::Execute>(*endpoint, [this](const auto &request, const auto &context) {
+    return execute(request, context);
+  });
   control::serve<op::Terminate>(
       *endpoint, [this](const auto &request, const auto &) { return terminate(request); });
   control::serve<op::Status>(*endpoint, [this](const auto &, const auto &) {

@@ -41,6 +41,11 @@ struct ExecuteRequest {
   std::optional<Package> package;
   std::optional<std::string> launch; // the launch it is part of (its progress shows transfers)
   std::optional<AffinityDirective> affinity;
+  // How long the caller waits for the reply, in ms from the request's arrival: a node whose
+  // package fetch outlasts it does not start the process, which nobody would then own (the
+  // caller has rolled the launch back). Absent: no limit (an older domain).
+  std::optional<std::int64_t> budget_ms;
+  static constexpr std::int64_t kMaxBudgetMs = 24LL * 3600 * 1000;
   static constexpr auto fields() {
     using R = ExecuteRequest;
     return std::tuple{
@@ -48,7 +53,12 @@ struct ExecuteRequest {
         optional("device", &R::device),           required("entrypoint", &R::entrypoint),
         optional("spd_dir", &R::spd_dir),         required("args", &R::args),
         optional("package", &R::package),         optional("launch", &R::launch),
-        optional("affinity", &R::affinity)};
+        optional("affinity", &R::affinity),       optional("budget_ms", &R::budget_ms)};
+  }
+  std::optional<DecodeError> check() const {
+    if (budget_ms && (*budget_ms < 0 || *budget_ms > kMaxBudgetMs))
+      return DecodeError{"budget_ms", "out of range"};
+    return std::nullopt;
   }
 };
 

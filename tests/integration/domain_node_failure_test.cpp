@@ -200,6 +200,60 @@ TEST_CASE("the components of a node that dies are reported unreachable, with the
   domain.require_clean(pids_of(app));
 }
 
+TEST_CASE("a node does not start a process whose caller has stopped waiting, and starts one "
+          "whose caller still waits",
+          "[integration][node][failure]") {
+  // The domain gives each node.execute the time it waits for the reply (budget_ms). A node that
+  // takes the request up, or has its package, after that would start a process nobody owns: the
+  // launch has been rolled back. A budget of 0 is spent on arrival.
+  TestDomain domain(1);
+  auto nodes = domain.call("domain.nodes");
+  REQUIRE(nodes.has_value());
+  const std::string node = nodes->at("nodes")[0].at("address");
+  // A process that waits for its signal (and marks it in a file of this test's).
+  const fs::path marker = fs::temp_directory_path() / fmt::format("rsca-it-budget-{}", ::getpid());
+  auto execute = [&](std::int64_t budget_ms) {
+    return domain.client().call_sync(
+        node, "node.execute",
+        Json{{"application", "Budget"},
+             {"component", fmt::format("Late_{}", budget_ms)},
+             {"entrypoint", "rsca-test-faulty"},
+             {"spd_dir", ""},
+             {"args", {"fault", "mark_signals", "marker", marker.string(), "on_signal", "exit"}},
+             {"budget_ms", budget_ms}},
+        5s);
+  };
+  auto labels = [&] {
+    std::vector<std::string> out;
+    auto status = domain.client().call_sync(node, "node.status", Json::object(), 5s);
+    REQUIRE(status.has_value());
+    for (const auto &p : status->at("processes"))
+      out.push_back(p.at("label"));
+    return out;
+  };
+
+  auto late = execute(0);
+  REQUIRE_FALSE(late.has_value());
+  CHECK(late.error().status == rsca::control::Status::Timeout);
+  CHECK_THAT(late.error().message, Catch::Contains("ran out before the node took it up"));
+  CHECK(labels().empty());
+
+  // Out of range: refused as a bad request.
+  auto negative = execute(-1);
+  REQUIRE_FALSE(negative.has_value());
+  CHECK(negative.error().status == rsca::control::Status::BadRequest);
+
+  auto in_time = execute(60000);
+  REQUIRE(in_time.has_value());
+  const long pid = in_time->at("pid").get<long>();
+  CHECK(labels() == std::vector<std::string>{"Budget/Late_60000"});
+  auto ended = domain.client().call_sync(node, "node.terminate", Json{{"pid", pid}}, 15s);
+  CHECK(ended.has_value());
+  CHECK(TestDomain::wait_for([&] { return !process_exists(pid); }));
+  fs::remove(marker);
+  fs::remove(marker.string() + ".ready");
+}
+
 TEST_CASE("a node daemon stopped after or while it ends a process exits cleanly, the process gone",
           "[integration][node][failure]") {
   // The process dies of its first signal, or ignores SIGINT and SIGTERM, so that ending it runs

@@ -117,6 +117,15 @@ TEST_CASE("protocol: a malformed message names the field and what is wrong", "[p
 
   CHECK(decode<ExecuteRequest>(Json::array()).error() == "expected an object, found array");
 
+  // The caller's budget: a day at most, never negative.
+  Json budget = good;
+  budget["budget_ms"] = ExecuteRequest::kMaxBudgetMs;
+  CHECK(decode<ExecuteRequest>(budget).has_value());
+  for (const std::int64_t out : {std::int64_t{-1}, ExecuteRequest::kMaxBudgetMs + 1}) {
+    budget["budget_ms"] = out;
+    CHECK(decode<ExecuteRequest>(budget).error() == "field \"budget_ms\": out of range");
+  }
+
   using protocol::component::AwaitMatchedRequest;
   const Json nested{{"connections", {{{"port", "p"}, {"connection", 5}}}}};
   CHECK(decode<AwaitMatchedRequest>(nested).error() ==
