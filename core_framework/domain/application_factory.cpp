@@ -112,34 +112,66 @@ CallResult<std::vector<std::string>> ApplicationFactory::release(Application &ap
   services_.allocator->release(app.plan);
   app.plan = {};
   services_.channels->leave(app.name);
-  return released;
+  if (!released)
+    return tl::unexpected(released.error());
+  return std::move(released->unconfirmed);
 }
 
-CallResult<std::vector<std::string>> ApplicationFactory::release_processes(Application &app) {
+CallResult<ApplicationFactory::ProcessesReleased>
+ApplicationFactory::release_processes(Application &app) {
+  ProcessesReleased outcome;
   std::vector<Call> releases;
   for (auto &c : app.components)
     if (c.pid != 0 && services_.components->registered(c.address))
       releases.push_back(call_of<protocol::component::Release>(c.address, {}, c.id));
   const auto released = call_each_of(*services_.endpoint, releases, services_.call_timeout);
-  std::vector<std::string> unconfirmed;
   for (std::size_t i = 0; i < released.size(); ++i) {
     if (released[i])
       continue;
     spdlog::warn("{} of application {} did not confirm its release ({}); its node terminates it",
                  releases[i].what, app.name, released[i].error().message);
-    unconfirmed.push_back(releases[i].what);
+    outcome.unconfirmed.push_back(releases[i].what);
   }
-  // Whatever is still running is terminated by its node; the node reaps every process.
+  // Whatever is still running is terminated by its node; the node reaps every process. One its
+  // node cannot be asked to end now (the node is lost) is ended when the node is back.
+  const auto end_later = [&](const ComponentInstance &c) {
+    if (!services_.end_when_back)
+      return;
+    spdlog::warn("application {}: process {} of {} is ended when its node {} is back", app.name,
+                 c.pid, c.id, c.node);
+    services_.end_when_back(c.node, c.pid, fmt::format("{}/{}", app.name, c.id));
+    ++outcome.deferred;
+  };
   std::vector<Call> terminations;
+  std::vector<const ComponentInstance *> terminated_of; // per termination
   std::set<long> terminated_pids; // the components of a host share its process
   for (auto &c : app.components) {
     if (c.pid == 0 || !terminated_pids.insert(c.pid).second)
       continue;
     auto node = services_.node_address(c.node);
-    if (node)
-      terminations.push_back(call_of<protocol::node::Terminate>(*node, {c.pid}, c.id));
+    if (!node) {
+      end_later(c);
+      continue;
+    }
+    terminations.push_back(call_of<protocol::node::Terminate>(*node, {c.pid}, c.id));
+    terminated_of.push_back(&c);
   }
   auto terminated = call_each_of(*services_.endpoint, terminations, services_.call_timeout);
+  std::optional<control::CallError> failure;
+  for (std::size_t i = 0; i < terminated.size(); ++i) {
+    if (terminated[i]) {
+      ++outcome.terminated;
+      continue;
+    }
+    const Status status = terminated[i].error().status;
+    if (status == Status::NotFound) // it had ended
+      continue;
+    if (status == Status::Unavailable || status == Status::Timeout)
+      end_later(*terminated_of[i]); // its node went away, or does not answer
+    else if (!failure)
+      failure = control::CallError{
+          status, fmt::format("{}: {}", terminations[i].what, terminated[i].error().message)};
+  }
   for (auto &c : app.components) {
     services_.components->forget(c.address);
     services_.endpoint->forget(c.address);
@@ -148,12 +180,9 @@ CallResult<std::vector<std::string>> ApplicationFactory::release_processes(Appli
     c.state = ComponentState::Released;
     c.pid = 0;
   }
-  // A component whose node is gone cannot be terminated by it, and is gone with it.
-  for (std::size_t i = 0; i < terminated.size(); ++i)
-    if (!terminated[i] && terminated[i].error().status != Status::Unavailable &&
-        terminated[i].error().status != Status::NotFound)
-      return tl::unexpected(first_failure(terminations, terminated).error());
-  return unconfirmed;
+  if (failure)
+    return tl::unexpected(*failure);
+  return outcome;
 }
 
 } // namespace rsca::domain

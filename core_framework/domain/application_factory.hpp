@@ -72,6 +72,10 @@ struct DomainServices {
   // Makes the package each process gets (domain/file_manager.hpp). Null (a unit test's): the
   // processes get no package, and the paths of the domain's files.
   FileManager *files = nullptr;
+  // Has a process that could not be ended (its node is lost) ended when its node is back: a
+  // rolled-back launch or a release must not leave it running for nobody. Null (a unit test's):
+  // such a process is left to its node.
+  std::function<void(const std::string &node, long pid, const std::string &label)> end_when_back;
   std::chrono::milliseconds call_timeout{5000};
   std::chrono::milliseconds registration_timeout{10000};
   allocator::Strategy strategy = allocator::Strategy::Pack;
@@ -99,7 +103,14 @@ private:
   // The undoable parts of a release, which a failed launch also runs (its saga): the devices'
   // ends of the application's connections (how many), and its processes.
   std::size_t disconnect_devices(const Application &app);
-  control::CallResult<std::vector<std::string>> release_processes(Application &app);
+  // What releasing an application's processes left: components that did not confirm their
+  // release (their node terminated them), and processes left to end when their node is back.
+  struct ProcessesReleased {
+    std::vector<std::string> unconfirmed;
+    std::size_t terminated = 0;
+    std::size_t deferred = 0;
+  };
+  control::CallResult<ProcessesReleased> release_processes(Application &app);
   DomainServices services_;
 };
 

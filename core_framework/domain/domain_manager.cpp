@@ -77,6 +77,9 @@ ApplicationFactory DomainManager::Impl::factory() {
   };
   s.next_launch = [this] { return LaunchIdentity{incarnation, ++launch_counter}; };
   s.files = &*files;
+  s.end_when_back = [this](const std::string &node, long pid, const std::string &label) {
+    end_when_back(node, pid, label);
+  };
   s.call_timeout = options.call_timeout;
   s.registration_timeout = options.registration_timeout;
   s.strategy = options.strategy;

@@ -130,6 +130,7 @@ struct DomainManager::Impl {
   void node_gone(const std::string &address, bool withdrawn);
   void end_earlier_run(const std::string &address, const protocol::node::NodeAnnouncement &now);
   void mark_unreachable(const std::string &node, const std::string &why);
+  void end_when_back(const std::string &node, long pid, const std::string &label);
   void node_back(const std::string &node, std::uint64_t epoch);
   std::uint64_t node_epoch(const std::string &node);
   std::optional<std::set<long>> processes_on(const std::string &node, std::uint64_t epoch);

@@ -8,6 +8,7 @@
 // label) is reachable again in the state it had, one whose process ended is exited, and a process
 // of an application released meanwhile is terminated. A node that comes back as another run (its
 // pid changed) killed its processes when it died: its devices start empty.
+#include <algorithm>
 #include <set>
 
 #include <fmt/format.h>
@@ -126,9 +127,11 @@ void DomainManager::Impl::node_gone(const std::string &address, bool withdrawn) 
   for (const auto &component : components.node_gone(node, why))
     endpoint->abandon(component, why);
   // A node that stops ends its processes first: what is left ended with it.
-  if (withdrawn)
+  if (withdrawn) {
     mark_exited([&node](const ComponentInstance &c) { return c.node == node; }, why);
-  else
+    std::lock_guard lock(lost_mutex);
+    lost_processes.erase(node);
+  } else
     mark_unreachable(node, why);
   runtime_connections->owner_gone_later([prefix = node + ":"](const PortRef &ref) {
     return ref.kind == PortRef::Kind::Device && ref.owner.starts_with(prefix);
@@ -155,6 +158,19 @@ void DomainManager::Impl::mark_unreachable(const std::string &node, const std::s
           {{"application", app.name}, {"component", c.id}, {"node", node}, {"why", why}});
     }
   });
+}
+
+// A process a release could not have ended (its node lost, or not answering) joins those its
+// node's return ends (node_back). Kept also for a node not yet seen lost: its loss may be
+// noticed only after the call failed; a node that stops drops the list (node_gone).
+void DomainManager::Impl::end_when_back(const std::string &node, long pid,
+                                        const std::string &label) {
+  std::lock_guard lock(lost_mutex);
+  auto &processes = lost_processes[node];
+  // An application released while its node is lost: its processes were listed at the loss.
+  if (std::none_of(processes.begin(), processes.end(),
+                   [pid](const LostProcess &p) { return p.pid == pid; }))
+    processes.push_back({pid, label});
 }
 
 std::uint64_t DomainManager::Impl::node_epoch(const std::string &node) {
@@ -226,13 +242,14 @@ void DomainManager::Impl::node_back(const std::string &node, std::uint64_t epoch
       return claimed.count(p.pid) != 0 || !running || running->count(p.pid) == 0;
     });
   }
-  // A process of an application released while its node was lost runs for nobody: ended.
+  // A process of an application released, or of a launch rolled back, while its node was lost
+  // runs for nobody: ended.
   const auto address = nodes.address_of(node);
   for (const auto &p : lost) {
     if (!address)
       break;
-    spdlog::info("node {}: ending {} (pid {}): its application was released while the node was "
-                 "lost",
+    spdlog::info("node {}: ending {} (pid {}): it runs for nobody (its application was released, "
+                 "or its launch rolled back, while the node was lost)",
                  node, p.label, p.pid);
     auto ended = control::call<protocol::node::Terminate>(*endpoint, *address, {p.pid},
                                                           options.call_timeout);

@@ -203,10 +203,19 @@ CallResult<void> ApplicationFactory::Launch::execute() {
   // From here on, components are expected and routed, and processes may start: undone by
   // releasing them (and terminating what runs) whatever this step gets to.
   saga_.on_undo([this] {
-    const std::size_t started = process_ids(*app_).size();
-    ApplicationFactory(s_).release_processes(*app_);
-    return started == 0 ? std::string()
-                        : fmt::format("{} process{} terminated", started, started == 1 ? "" : "es");
+    auto released = ApplicationFactory(s_).release_processes(*app_);
+    if (!released)
+      return fmt::format("processes not all terminated: {}", released.error().message);
+    const auto plural = [](std::size_t n) { return n == 1 ? "" : "es"; };
+    std::string done;
+    if (released->terminated != 0)
+      done = fmt::format("{} process{} terminated", released->terminated,
+                         plural(released->terminated));
+    if (released->deferred != 0)
+      done += fmt::format("{}{} process{} to end when {} node is back", done.empty() ? "" : ", ",
+                          released->deferred, plural(released->deferred),
+                          released->deferred == 1 ? "its" : "their");
+    return done;
   });
   // Discovery of each component's endpoint starts now and overlaps with its process start.
   for (auto &c : app_->components) {

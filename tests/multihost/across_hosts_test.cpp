@@ -163,3 +163,47 @@ TEST_CASE("a host's link down for 5 s and back: its node lost and back, its comp
                         [](const auto &p) { return ::kill(p.second, 0) == 0; });
   }));
 }
+
+TEST_CASE("an application released while a node is lost: its process there runs on until the "
+          "node is back, then is ended",
+          "[multihost]") {
+  HostsDomain domain(2);
+  const auto launched =
+      domain.cli(1, {"launch", kProducerConsumer, "--strategy", "spread"}, HostsDomain::over_dds());
+  INFO(launched.out << launched.err);
+  REQUIRE(launched.rc == 0);
+  pid_t consumer = 0;
+  int consumer_node = 0;
+  std::vector<pid_t> pids;
+  const auto reply = launched.json();
+  for (const auto &c : reply.at("components")) {
+    pids.push_back(c.at("pid").get<pid_t>());
+    if (c.at("id") == "Consumer_1") {
+      consumer = c.at("pid").get<pid_t>();
+      consumer_node = c.at("node") == "node1" ? 1 : 2;
+    }
+  }
+  REQUIRE(consumer != 0);
+  REQUIRE(HostsDomain::wait_for([&] { return samples_flow(domain); }));
+
+  domain.hosts().set_link(HostsDomain::host_of_node(consumer_node), false);
+  REQUIRE(HostsDomain::wait_for([&] {
+    const auto listed =
+        domain.cli(1, {"--timeout-ms", "2000", "ls", "apps"}, HostsDomain::over_dds());
+    const auto json = listed.json();
+    return listed.rc == 0 && !json.is_discarded() && json.at("applications").size() == 1 &&
+           json.at("applications")[0].value("unreachable", Json::array()) ==
+               Json::array({"Consumer_1"});
+  }));
+  const auto released = domain.cli(1, {"release", "ProducerConsumer"}, HostsDomain::over_dds());
+  INFO(released.out << released.err);
+  CHECK(released.rc == 0);
+  // Its node could not be asked: the process runs on behind the pulled cable.
+  CHECK(::kill(consumer, 0) == 0);
+
+  domain.hosts().set_link(HostsDomain::host_of_node(consumer_node), true);
+  // Back: the node is asked what it runs, and the process that runs for nobody is ended.
+  CHECK(HostsDomain::wait_for([&] {
+    return std::none_of(pids.begin(), pids.end(), [](pid_t pid) { return ::kill(pid, 0) == 0; });
+  }));
+}

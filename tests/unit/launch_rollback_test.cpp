@@ -30,6 +30,7 @@ public:
 
   std::string fail_operation;
   int fail_from = 1;
+  std::string unavailable_operation; // its calls fail as to a node that is lost
   bool register_components = true;
   std::vector<control::Call> made;
   std::set<std::int64_t> started, terminated;
@@ -43,6 +44,11 @@ public:
       if (c.operation == fail_operation && ++failures_ >= fail_from) {
         out.emplace_back(tl::unexpect,
                          control::CallError{control::Status::Failed, "injected failure"});
+        continue;
+      }
+      if (c.operation == unavailable_operation) {
+        out.emplace_back(tl::unexpect,
+                         control::CallError{control::Status::Unavailable, "the node is lost"});
         continue;
       }
       out.push_back(answer(c));
@@ -233,6 +239,28 @@ TEST_CASE("launch: a failure at any step leaves nothing behind and says what was
       d.require_nothing_left();
     }
   }
+}
+
+TEST_CASE("launch: the processes a lost node runs are left to end at its return, and the report "
+          "says so, not that they were terminated",
+          "[launch]") {
+  Domain d;
+  d.caller.fail_operation = "component.start";       // the launch fails once its processes run
+  d.caller.unavailable_operation = "node.terminate"; // and their node is lost meanwhile
+  std::set<std::int64_t> later;
+  d.services.end_when_back = [&](const std::string &node, long pid, const std::string &label) {
+    CHECK(node == "node1");
+    CHECK_THAT(label, Catch::StartsWith("PC/"));
+    later.insert(pid);
+  };
+  std::vector<LaunchStep> steps;
+  auto app = d.launch(steps);
+  REQUIRE_FALSE(app.has_value());
+  CHECK_THAT(app.error().message, Catch::Contains("2 processes to end when their node is back"));
+  CHECK_THAT(app.error().message, !Catch::Contains("terminated"));
+  CHECK(later == d.caller.started);
+  CHECK(d.allocator.reservations() == 0);
+  CHECK(d.channels.list().empty());
 }
 
 TEST_CASE("launch: components that never register fail the register step, undone", "[launch]") {
