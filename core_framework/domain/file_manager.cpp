@@ -59,7 +59,7 @@ std::string FileManager::package_path(const fs::path &file) const {
 
 CallResult<protocol::Package>
 FileManager::package_of(const std::vector<PackagedComponent> &components) {
-  std::map<std::string, protocol::PackageFile> files; // by path: a file shared is there once
+  Contents contents;
   for (const auto &c : components) {
     const auto &implementations = c.softpkg->implementations;
     auto placed = std::find_if(implementations.begin(), implementations.end(),
@@ -68,13 +68,14 @@ FileManager::package_of(const std::vector<PackagedComponent> &components) {
       return protocol::call_error(Status::Failed, fmt::format("{}: the implementation placed is "
                                                               "not its SPD's",
                                                               c.name));
-    if (auto ok = add_softpkg(*c.softpkg, *placed, 0, files); !ok)
+    if (auto ok = add_softpkg(*c.softpkg, *placed, 0, contents); !ok)
       return protocol::call_error(Status::Failed,
                                   fmt::format("{}: {}", c.name, ok.error().message));
   }
-  protocol::Package package{repository_.string(), {}};
-  for (auto &[path, file] : files)
+  protocol::Package package{repository_.string(), {}, {}};
+  for (auto &[path, file] : contents.files)
     package.files.push_back(std::move(file));
+  package.library_dirs.assign(contents.library_dirs.begin(), contents.library_dirs.end());
   if (auto why = protocol::package_problem(package))
     return protocol::call_error(Status::Failed, fmt::format("its package: {}", *why));
   return package;
@@ -84,8 +85,8 @@ FileManager::package_of(const std::vector<PackagedComponent> &components) {
 // code with their profiles.
 CallResult<void> FileManager::add_softpkg(const profile::ResolvedSoftPkg &softpkg,
                                           const profile::ResolvedImplementation &implementation,
-                                          int depth,
-                                          std::map<std::string, protocol::PackageFile> &files) {
+                                          int depth, Contents &contents) {
+  auto &files = contents.files;
   if (depth > profile::kMaxSoftpkgDependencyDepth)
     return fail(Status::BadRequest, "softpkg dependencies nest too deep");
   for (const auto &source : softpkg.sources)
@@ -97,16 +98,39 @@ CallResult<void> FileManager::add_softpkg(const profile::ResolvedSoftPkg &softpk
       return ok;
   if (auto ok = add_code(softpkg, implementation, files); !ok)
     return ok;
+  if (depth > 0)
+    if (auto dir = library_dir(softpkg, implementation, files))
+      contents.library_dirs.insert(std::move(*dir));
   for (const auto &dependency : implementation.dependencies) {
     const auto &pkg = *dependency.softpkg;
     for (const auto &candidate : pkg.implementations) {
       if (dependency.implref && candidate.implementation->id != *dependency.implref)
         continue;
-      if (auto ok = add_softpkg(pkg, candidate, depth + 1, files); !ok)
+      if (auto ok = add_softpkg(pkg, candidate, depth + 1, contents); !ok)
         return ok;
     }
   }
   return {};
+}
+
+// Where a dependency's shared library code is in the package, for LD_LIBRARY_PATH: the folder of
+// its code file, or its code folder. None for other code, and for code installed on the node
+// itself (an absolute name: the node's own library path finds it).
+std::optional<std::string>
+FileManager::library_dir(const profile::ResolvedSoftPkg &softpkg,
+                         const profile::ResolvedImplementation &implementation,
+                         const std::map<std::string, protocol::PackageFile> &files) const {
+  const auto &code = implementation.implementation->code;
+  if (code.type != profile::CodeType::SharedLibrary || code.file.name.empty() ||
+      fs::path(code.file.name).is_absolute())
+    return std::nullopt;
+  const std::string path = package_path(softpkg.spd_path.parent_path() / code.file.name);
+  if (path.empty())
+    return std::nullopt;
+  if (files.count(path) == 0)
+    return path; // a folder of files
+  const std::string folder = fs::path(path).parent_path().generic_string();
+  return folder.empty() ? std::nullopt : std::optional<std::string>(folder);
 }
 
 // The code file (or folder) the implementation names, at its place beside the SPD in the package

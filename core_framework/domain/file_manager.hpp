@@ -16,6 +16,7 @@
 #include <map>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -61,12 +62,21 @@ private:
     profile::FileStamp stamp; // as it was hashed
     std::uint64_t last_use = 0;
   };
+  // What a package is made of, as it is gathered.
+  struct Contents {
+    std::map<std::string, protocol::PackageFile> files; // by path: a file shared is there once
+    std::set<std::string> library_dirs;
+  };
   CallResult<void> add_softpkg(const profile::ResolvedSoftPkg &softpkg,
                                const profile::ResolvedImplementation &implementation, int depth,
-                               std::map<std::string, protocol::PackageFile> &files);
+                               Contents &contents);
   CallResult<void> add_code(const profile::ResolvedSoftPkg &softpkg,
                             const profile::ResolvedImplementation &implementation,
                             std::map<std::string, protocol::PackageFile> &files);
+  std::optional<std::string>
+  library_dir(const profile::ResolvedSoftPkg &softpkg,
+              const profile::ResolvedImplementation &implementation,
+              const std::map<std::string, protocol::PackageFile> &files) const;
   CallResult<void> add_file(const std::filesystem::path &file, const std::string &path,
                             std::map<std::string, protocol::PackageFile> &files);
   std::optional<std::filesystem::path> find_code(const std::filesystem::path &spd_dir,

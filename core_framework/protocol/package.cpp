@@ -34,6 +34,28 @@ std::optional<std::string> package_path_problem(const std::string &path) {
   return std::nullopt;
 }
 
+namespace {
+
+// The library folders: few, sorted, each a folder some file of the package lies in.
+std::optional<std::string> library_dirs_problem(const Package &package) {
+  const auto &dirs = package.library_dirs;
+  if (dirs.size() > kMaxLibraryDirs)
+    return fmt::format("{} library folders (at most {})", dirs.size(), kMaxLibraryDirs);
+  for (std::size_t i = 0; i < dirs.size(); ++i) {
+    if (auto why = package_path_problem(dirs[i]))
+      return fmt::format("library folder {}: {}", i, *why);
+    if (i > 0 && !(dirs[i - 1] < dirs[i]))
+      return fmt::format("library folder {}: not sorted, or there twice", dirs[i]);
+    const std::string prefix = dirs[i] + "/";
+    const auto in_it = [&](const PackageFile &f) { return f.path.starts_with(prefix); };
+    if (std::none_of(package.files.begin(), package.files.end(), in_it))
+      return fmt::format("library folder {}: no file of the package is in it", dirs[i]);
+  }
+  return std::nullopt;
+}
+
+} // namespace
+
 std::optional<std::string> package_problem(const Package &package) {
   if (package.files.empty())
     return "a package without files";
@@ -62,7 +84,7 @@ std::optional<std::string> package_problem(const Package &package) {
          slash = f.path.find('/', slash + 1))
       if (paths.count(std::string_view(f.path).substr(0, slash)) != 0)
         return fmt::format("{} is a file and a folder", f.path.substr(0, slash));
-  return std::nullopt;
+  return library_dirs_problem(package);
 }
 
 void sort_files(Package &package) {

@@ -35,8 +35,13 @@ struct Package {
   // sources there, and the node rewrites them to the package's paths.
   std::string origin;
   std::vector<PackageFile> files; // sorted by path, no path twice
+  // Folders of the package that hold shared libraries its code needs (the code of its softpkg
+  // dependencies of type SharedLibrary): the node puts them on the process's LD_LIBRARY_PATH, as
+  // REDHAWK's GPP does. Sorted, each a folder of some file.
+  std::vector<std::string> library_dirs;
   static constexpr auto fields() {
-    return std::tuple{required("origin", &Package::origin), required("files", &Package::files)};
+    return std::tuple{required("origin", &Package::origin), required("files", &Package::files),
+                      optional("library_dirs", &Package::library_dirs)};
   }
   bool operator==(const Package &) const = default;
 };
@@ -45,6 +50,7 @@ struct Package {
 inline constexpr std::size_t kMaxPackageFiles = 4096;
 inline constexpr std::uint64_t kMaxPackageBytes = 16ULL << 30U; // 16 GiB
 inline constexpr std::size_t kMaxPackagePath = 1024;
+inline constexpr std::size_t kMaxLibraryDirs = 64;
 
 // Whether `text` has the form of a SHA-256 in lowercase hex (the hash is computed in content/).
 bool is_sha256_hex(std::string_view text);
@@ -53,7 +59,7 @@ bool is_sha256_hex(std::string_view text);
 // none when it may.
 std::optional<std::string> package_path_problem(const std::string &path);
 // Why `package` is not one to fetch (a bad path or hash, a path twice or out of order, too many
-// files or bytes); none when it is.
+// files or bytes, a library folder that is not one of its folders); none when it is.
 std::optional<std::string> package_problem(const Package &package);
 // Puts the files in the order package_problem() asks for.
 void sort_files(Package &package);

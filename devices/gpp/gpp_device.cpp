@@ -6,6 +6,7 @@
 #include <fmt/ranges.h>
 
 #include <cerrno>
+#include <cstdlib>
 #include <cstring>
 #include <spdlog/spdlog.h>
 
@@ -92,6 +93,21 @@ GppDevice::packaged_executable(const protocol::node::ExecuteRequest &r,
   return package.root() / inside;
 }
 
+namespace {
+
+// The process's LD_LIBRARY_PATH: its package's library folders (checked as the package's own
+// folders when the package was taken), then the node's own path, which it would have inherited.
+std::string library_path(const std::filesystem::path &root, const std::vector<std::string> &dirs) {
+  std::vector<std::string> parts;
+  for (const auto &dir : dirs)
+    parts.push_back((root / dir).string());
+  if (const char *inherited = std::getenv("LD_LIBRARY_PATH"); inherited && *inherited)
+    parts.emplace_back(inherited);
+  return fmt::format("{}", fmt::join(parts, ":"));
+}
+
+} // namespace
+
 CallResult<protocol::node::ExecuteReply>
 GppDevice::execute(const protocol::node::ExecuteRequest &r,
                    std::shared_ptr<const node::PackageLease> package) {
@@ -121,6 +137,9 @@ GppDevice::execute(const protocol::node::ExecuteRequest &r,
   request.env = context_.dds.component_environment();
   // The component dies with this node: it checks that its parent is still this process.
   request.env.emplace_back(kNodePidVariable, std::to_string(::getpid()));
+  if (package && r.package && !r.package->library_dirs.empty())
+    request.env.emplace_back("LD_LIBRARY_PATH",
+                             library_path(package->root(), r.package->library_dirs));
   request.log_file = context_.log_dir / application / (component + ".log");
   request.label = protocol::node::process_label(application, component);
   // The process's control goes through this node (node/process_links.hpp): it gets its end of

@@ -107,6 +107,42 @@ TEST_CASE("a component's files are delivered to its node once: verified, run fro
   domain.require_clean(all);
 }
 
+TEST_CASE("a component's shared-library dependency is delivered with it, and its folder is on "
+          "the process's LD_LIBRARY_PATH",
+          "[integration][delivery]") {
+  TestDomain domain;
+  domain.install("WithLibrary");
+  auto [rc, out] = domain.cli({"--json", "launch", "WithLibrary"});
+  INFO(out);
+  REQUIRE(rc == 0);
+  auto shown = domain.call("app.show", Json{{"app", "WithLibrary"}});
+  REQUIRE(shown.has_value());
+  const auto pids = pids_of(*shown);
+  REQUIRE(pids.size() == 1);
+  // The process's environment, as the node gave it (NUL-separated).
+  std::ifstream in(fmt::format("/proc/{}/environ", pids.front()), std::ios::binary);
+  const std::string variables((std::istreambuf_iterator<char>(in)),
+                              std::istreambuf_iterator<char>());
+  std::string path;
+  for (std::size_t at = 0; at < variables.size();) {
+    const std::size_t end = std::min(variables.find('\0', at), variables.size());
+    if (const std::string entry = variables.substr(at, end - at);
+        entry.starts_with("LD_LIBRARY_PATH="))
+      path = entry.substr(std::string("LD_LIBRARY_PATH=").size());
+    at = end + 1;
+  }
+  INFO(path);
+  const std::string first = path.substr(0, path.find(':'));
+  // The first folder is the dependency's, inside a package of the node's cache, and holds the
+  // library.
+  const fs::path packages = domain.run_dir() / "cache" / "node1" / "packages";
+  CHECK(first.rfind(packages.string(), 0) == 0);
+  CHECK(fs::path(first).filename() == "lib");
+  CHECK(fs::exists(fs::path(first) / "librsca-testlib.so"));
+  REQUIRE(domain.call("app.release", Json{{"app", "WithLibrary"}}).has_value());
+  domain.require_clean(pids);
+}
+
 TEST_CASE("a file that fails verification on its node fails the launch at execute, rolls it back, "
           "and leaves nothing in the node's cache",
           "[integration][delivery][failure]") {

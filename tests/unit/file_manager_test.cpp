@@ -87,6 +87,61 @@ TEST_CASE("file manager: a component's package names its profiles, model and cod
   CHECK(package->origin == fs::weakly_canonical(repo.root).string());
 }
 
+TEST_CASE("file manager: the code folders of shared-library dependencies are the package's "
+          "library folders",
+          "[package]") {
+  Repository repo;
+  // The Producer depends on a library softpkg with a code file and on one with a code folder.
+  const fs::path dom = repo.root / "applications/A/dom";
+  const auto dependency_spd = [](const std::string &name, const std::string &code) {
+    return fmt::format(R"(<?xml version="1.0" encoding="UTF-8"?>
+<softpkg id="DCE:{0}" name="{0}">
+  <author><name>rsca</name></author>
+  <implementation id="cpp">
+    <code type="SharedLibrary"><localfile name="{1}"/></code>
+    <os name="Linux"/>
+  </implementation>
+</softpkg>
+)",
+                       name, code);
+  };
+  write(dom / "deps/mathlib/mathlib.spd.xml", dependency_spd("mathlib", "lib/libmath.so"));
+  write(dom / "deps/mathlib/lib/libmath.so", "ELF?");
+  write(dom / "deps/plugins/plugins.spd.xml", dependency_spd("plugins", "plugins"));
+  write(dom / "deps/plugins/plugins/a.so", "ELF a");
+  write(dom / "deps/plugins/plugins/b.so", "ELF b");
+  const fs::path spd = repo.component / "Producer.spd.xml";
+  std::ifstream in(spd);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string depends = R"(<dependency type="runtime_requirements"><softpkgref>
+      <localfile name="/deps/mathlib/mathlib.spd.xml"/></softpkgref></dependency>
+    <dependency type="runtime_requirements"><softpkgref>
+      <localfile name="/deps/plugins/plugins.spd.xml"/></softpkgref></dependency>
+    )";
+  const auto end = text.find("<resourcedemand"); // dependencies come before it
+  REQUIRE(end != std::string::npos);
+  text.insert(end, depends);
+  write(spd, text);
+  profile::ProfileLoader loader;
+  auto softpkg = loader.load_softpkg(spd);
+  INFO((softpkg ? std::string() : softpkg.error().to_string()));
+  REQUIRE(softpkg.has_value());
+
+  domain::FileManager files(repo.root, {repo.bin});
+  auto package = files.package_of(
+      {{"Producer_1", softpkg->get(), (*softpkg)->implementations.at(0).implementation}});
+  REQUIRE(package.has_value());
+  CHECK_FALSE(protocol::package_problem(*package).has_value());
+  CHECK(package->library_dirs ==
+        std::vector<std::string>{"applications/A/dom/deps/mathlib/lib",
+                                 "applications/A/dom/deps/plugins/plugins"});
+  CHECK(file_named(*package, "applications/A/dom/deps/plugins/plugins/b.so") != nullptr);
+  // The component's own code (an executable) is no library folder.
+  auto alone = files.package_of({repo.producer()});
+  REQUIRE(alone.has_value());
+  CHECK(alone->library_dirs.empty());
+}
+
 TEST_CASE("file manager: code found nowhere fails the package, naming the component and the file",
           "[package]") {
   Repository repo;

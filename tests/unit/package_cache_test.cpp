@@ -111,7 +111,8 @@ struct Fixture {
   protocol::Package package(std::size_t code_bytes, char seed) {
     protocol::Package p{"/srv/repo",
                         {domain.add("apps/A/C/C.spd.xml", "<softpkg/>"),
-                         domain.add("apps/A/C/run", bytes_of_size(code_bytes, seed), true)}};
+                         domain.add("apps/A/C/run", bytes_of_size(code_bytes, seed), true)},
+                        {}};
     protocol::sort_files(p);
     return p;
   }
@@ -268,8 +269,8 @@ TEST_CASE("package cache: the same bytes executable in one package and not in an
           "[package]") {
   Fixture f;
   f.open();
-  protocol::Package plain{"/srv/repo", {f.domain.add("apps/A/data.sh", "echo hi", false)}};
-  protocol::Package runnable{"/srv/repo", {f.domain.add("apps/B/run.sh", "echo hi", true)}};
+  protocol::Package plain{"/srv/repo", {f.domain.add("apps/A/data.sh", "echo hi", false)}, {}};
+  protocol::Package runnable{"/srv/repo", {f.domain.add("apps/B/run.sh", "echo hi", true)}, {}};
   auto a = f.cache->acquire(plain, "");
   auto b = f.cache->acquire(runnable, "");
   REQUIRE(a.has_value());

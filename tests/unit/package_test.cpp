@@ -20,7 +20,8 @@ const std::string kHashB(64, 'b');
 protocol::Package two_files() {
   return {"/srv/repository",
           {{"applications/A/c/C.spd.xml", kHashA, 10, false},
-           {"applications/A/c/run", kHashB, 20, true}}};
+           {"applications/A/c/run", kHashB, 20, true}},
+          {}};
 }
 
 } // namespace
@@ -69,10 +70,33 @@ TEST_CASE("package: a path that could leave the package, a bad hash or a repeate
   CHECK_THAT(protocol::package_problem(file_and_folder).value(), Contains("a file and a folder"));
   // Not neighbours once sorted: '-' sorts before '/'.
   protocol::Package apart{
-      "/r", {{"a", kHashA, 1, false}, {"a-x", kHashA, 1, false}, {"a/b", kHashB, 1, false}}};
+      "/r", {{"a", kHashA, 1, false}, {"a-x", kHashA, 1, false}, {"a/b", kHashB, 1, false}}, {}};
   CHECK_THAT(protocol::package_problem(apart).value(), Contains("a file and a folder"));
   auto too_big = two_files();
   too_big.files[1].size = protocol::kMaxPackageBytes;
   CHECK(protocol::package_problem(too_big).has_value());
-  CHECK(protocol::package_problem({"/r", {}}).has_value());
+  CHECK(protocol::package_problem({"/r", {}, {}}).has_value());
+}
+
+TEST_CASE("package: library folders must be its own folders, sorted, and few", "[package]") {
+  auto package = two_files();
+  package.library_dirs = {"applications/A", "applications/A/c"};
+  CHECK_FALSE(protocol::package_problem(package).has_value());
+  const std::vector<std::pair<std::vector<std::string>, const char *>> refused = {
+      {{"/usr/lib"}, "an absolute path"},
+      {{"applications/../etc"}, "every part of a path"},
+      {{"applications/B"}, "no file of the package is in it"},
+      {{"applications/A/c/run"}, "no file of the package is in it"}, // a file, not a folder
+      {{"applications/A/c", "applications/A"}, "not sorted"},
+      {{"applications/A", "applications/A"}, "there twice"},
+  };
+  for (const auto &[dirs, why] : refused) {
+    package.library_dirs = dirs;
+    const auto problem = protocol::package_problem(package);
+    INFO(dirs.front());
+    REQUIRE(problem.has_value());
+    CHECK_THAT(*problem, Contains(why));
+  }
+  package.library_dirs.assign(protocol::kMaxLibraryDirs + 1, "applications/A");
+  CHECK_THAT(protocol::package_problem(package).value_or(""), Contains("library folders"));
 }
