@@ -12,8 +12,38 @@
 #include "common/process_priority.hpp"
 #include "common/termination_signals.hpp"
 #include "dds/participant.hpp"
+#include "node/daemon_log.hpp"
 #include "node/device_manager.hpp"
+#include "profile/descriptor.hpp"
+#include "profile/xml_document.hpp"
 #include "service/systemd.hpp"
+
+namespace {
+
+// The node's name, from its DCD alone (its devices' profiles are read as the node starts).
+rsca::Expected<std::string> node_name_of(const std::string &dcd) {
+  auto document = rsca::profile::read_xml_profile(dcd);
+  if (!document)
+    return tl::unexpected(document.error());
+  auto configuration = rsca::profile::read_dcd(*document);
+  if (!configuration)
+    return tl::unexpected(configuration.error());
+  return configuration->name;
+}
+
+// The daemon's own log file as well, named by its node (node/daemon_log.hpp): set up before any
+// other thread logs. A DCD that cannot be read is left to the node's start to report.
+void log_to_file(const std::string &dcd, const std::string &log_dir, std::uint64_t max_bytes) {
+  const auto name = node_name_of(dcd);
+  if (!name)
+    return;
+  if (auto ok =
+          rsca::node::log_also_to_file(rsca::node::daemon_log_file(log_dir, *name), max_bytes);
+      !ok)
+    spdlog::warn("this node's log is not kept in a file: {}", ok.error().to_string());
+}
+
+} // namespace
 
 int main(int argc, char **argv) {
   const int nice = rsca::run_above_applications(); // before any thread exists
@@ -34,13 +64,14 @@ int main(int argc, char **argv) {
   app.add_option("--exec-path", exec_path,
                  "Folders where component executables named without a path are looked for "
                  "(default: this program's folder and where an install puts rsca's components)");
-  app.add_option("--log-dir", log_dir, "Component logs go here")
+  app.add_option("--log-dir", log_dir,
+                 "Component logs go here, and this daemon's own (rsca-noded.NODE.log)")
       ->capture_default_str()
       ->take_last();
   std::uint64_t log_max_kib = options.log_max_bytes >> 10U;
   app.add_option("--log-max-kib", log_max_kib,
-                 "A component's log past this many KiB is rotated, one older file kept (LOG.1); "
-                 "0: never")
+                 "A component's log past this many KiB is rotated, one older file kept (LOG.1), "
+                 "as is this daemon's own (rsca-noded.NODE.1.log); 0: never")
       ->capture_default_str();
   std::string control_socket;
   app.add_option("--control-socket", control_socket,
@@ -72,6 +103,7 @@ int main(int argc, char **argv) {
   rsca::service::log_to_journal_if_connected("rsca-noded"); // before any thread logs
   spdlog::set_level(spdlog::level::from_str(level));
   spdlog::set_pattern("%Y-%m-%dT%H:%M:%S.%e %^%l%$ noded: %v");
+  log_to_file(dcd, log_dir, log_max_kib << 10U); // after the pattern: the file has its own
   spdlog::info("running at nice {} (components at {})", nice, rsca::application_nice());
 
   options.dcd = dcd;

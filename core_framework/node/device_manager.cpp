@@ -14,6 +14,7 @@
 #include "common/install_layout.hpp"
 #include "common/periodic.hpp"
 #include "control/operation.hpp"
+#include "node/daemon_log.hpp"
 #include "node/device_libraries.hpp"
 #include "node/process_logs.hpp"
 #include "process/proc_figures.hpp"
@@ -372,6 +373,9 @@ void DeviceManager::Impl::serve() {
   control::serve<op::Top>(*endpoint, [this](const auto &, const auto &) { return top(); });
   control::serve<op::Logs>(*endpoint, [this](const auto &request, const auto &) {
     return read_log(options.log_dir, request, running());
+  });
+  control::serve<op::DaemonLogs>(*endpoint, [this](const auto &request, const auto &) {
+    return read_daemon_log(options.log_dir, dcd->name, request);
   });
 }
 

@@ -69,10 +69,6 @@ std::string bytes_of(const fs::path &file, Span span) {
   return bytes;
 }
 
-fs::path previous_of(const fs::path &log) {
-  return fs::path(log.string() + ".1");
-}
-
 // What a read takes before it is cut to whole lines: bytes that end at `end` in the log and
 // start at `start` in it (nothing: they begin in LOG.1), and whether they start inside the text
 // (a tail's, whose first line is partial).
@@ -84,10 +80,10 @@ struct Piece {
 };
 
 // The last `max` bytes, reaching into LOG.1 when the log holds fewer.
-Piece tail_of(const fs::path &log, std::uint64_t size, std::uint64_t max) {
+Piece tail_of(const LogFiles &files, std::uint64_t size, std::uint64_t max) {
+  const auto &[log, previous] = files;
   if (size >= max)
     return {bytes_of(log, {size - max, size}), size - max, size, size > max};
-  const auto previous = previous_of(log);
   const auto before = size_of(previous);
   const auto wanted = std::min(before, max - size);
   if (wanted == 0)
@@ -98,13 +94,13 @@ Piece tail_of(const fs::path &log, std::uint64_t size, std::uint64_t max) {
 
 // From `offset` on: in the log; past its end (it was rotated since), the rest of LOG.1 from there
 // and then the log from its start, at most half of `max` each when both are longer.
-Piece from_offset(const fs::path &log, std::uint64_t size, std::uint64_t offset,
+Piece from_offset(const LogFiles &files, std::uint64_t size, std::uint64_t offset,
                   std::uint64_t max) {
+  const auto &[log, previous] = files;
   if (offset <= size) {
     const auto end = std::min(size, offset + max);
     return {bytes_of(log, {offset, end}), offset, end, false};
   }
-  const auto previous = previous_of(log);
   const auto before = size_of(previous);
   if (offset >= before) { // truncated, not rotated: nothing of LOG.1 is new
     const auto end = std::min(size, max);
@@ -117,6 +113,10 @@ Piece from_offset(const fs::path &log, std::uint64_t size, std::uint64_t offset,
 }
 
 } // namespace
+
+fs::path previous_of(const fs::path &log) {
+  return fs::path(log.string() + ".1");
+}
 
 Expected<bool> rotate_if_over(const fs::path &log, std::uint64_t max_bytes) {
   if (max_bytes == 0 || size_of(log) <= max_bytes)
@@ -173,21 +173,28 @@ CallResult<op::LogsReply> read_log(const fs::path &log_dir, const op::LogsReques
   const auto what = op::process_label(request.application, request.component);
   if (file.empty())
     return protocol::call_error(Status::NotFound, fmt::format("no log of {} here", what));
+  return read_piece({file, previous_of(file)}, log_dir, request.offset, request.max_bytes, what);
+}
+
+CallResult<op::LogsReply> read_piece(const LogFiles &files, const fs::path &log_dir,
+                                     std::optional<std::uint64_t> offset,
+                                     std::optional<std::uint64_t> max_bytes,
+                                     const std::string &what) {
+  const fs::path &file = files.log;
   std::error_code ec;
   if (!fs::is_regular_file(file, ec))
     return protocol::call_error(Status::Failed, fmt::format("the log of {} cannot be read", what));
-  const auto max = std::clamp<std::uint64_t>(
-      request.max_bytes.value_or(op::LogsRequest::kDefaultBytes), 1, op::LogsRequest::kMaxBytes);
+  const auto max = std::clamp<std::uint64_t>(max_bytes.value_or(op::LogsRequest::kDefaultBytes), 1,
+                                             op::LogsRequest::kMaxBytes);
   const auto size = size_of(file);
-  const Piece piece =
-      request.offset ? from_offset(file, size, *request.offset, max) : tail_of(file, size, max);
+  const Piece piece = offset ? from_offset(files, size, *offset, max) : tail_of(files, size, max);
   const Span lines = whole_lines(piece.bytes, piece.from_inside);
   const auto text = std::string_view(piece.bytes).substr(lines.from, lines.to - lines.from);
   // Offsets are the log's own: the next read goes on after the last whole line returned.
   const std::uint64_t cut = piece.bytes.size() - lines.to;
   const std::uint64_t next = piece.end - std::min(piece.end, cut);
-  const std::uint64_t offset = piece.start ? *piece.start + lines.from : 0;
-  return op::LogsReply{file.lexically_relative(log_dir).string(), std::min(offset, next), next,
+  const std::uint64_t start = piece.start ? *piece.start + lines.from : 0;
+  return op::LogsReply{file.lexically_relative(log_dir).string(), std::min(start, next), next,
                        utf8_or_replaced(text)};
 }
 

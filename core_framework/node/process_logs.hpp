@@ -11,6 +11,7 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -28,6 +29,24 @@ namespace rsca::node {
 control::CallResult<protocol::node::LogsReply>
 read_log(const std::filesystem::path &log_dir, const protocol::node::LogsRequest &request,
          const std::vector<protocol::node::ProcessRecord> &running);
+
+// A log and the older file its rotation keeps: LOG.1 for a process's (previous_of), the name
+// spdlog's rotating sink gives for the node daemon's own (node/daemon_log.hpp).
+struct LogFiles {
+  std::filesystem::path log;
+  std::filesystem::path previous;
+};
+
+std::filesystem::path previous_of(const std::filesystem::path &log);
+
+// The piece of `files` from `offset` (absent: their tail) of at most `max_bytes` (clamped to
+// LogsRequest's bounds), whole lines only, read across a rotation as read_log says. `what` names
+// the log in errors; the reply names it relative to `log_dir`.
+control::CallResult<protocol::node::LogsReply> read_piece(const LogFiles &files,
+                                                          const std::filesystem::path &log_dir,
+                                                          std::optional<std::uint64_t> offset,
+                                                          std::optional<std::uint64_t> max_bytes,
+                                                          const std::string &what);
 
 // Copies `log` to `log`.1 and empties it when it holds more than `max_bytes`; whether it did.
 Expected<bool> rotate_if_over(const std::filesystem::path &log, std::uint64_t max_bytes);

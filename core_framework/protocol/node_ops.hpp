@@ -293,8 +293,27 @@ struct LogsRequest {
   }
 };
 
+// The node daemon's own log (node/daemon_log.hpp): where to read from and how much, as in
+// LogsRequest; the node makes the path.
+struct DaemonLogsRequest {
+  std::optional<std::uint64_t> offset;
+  std::optional<std::uint64_t> max_bytes; // 1 to LogsRequest::kMaxBytes; absent: kDefaultBytes
+  static constexpr auto fields() {
+    using R = DaemonLogsRequest;
+    return std::tuple{optional("offset", &R::offset), optional("max_bytes", &R::max_bytes)};
+  }
+  // Any offset is one: past the log's end, the log was rotated since (node/process_logs.hpp).
+  std::optional<DecodeError> check() const {
+    if (max_bytes && (*max_bytes == 0 || *max_bytes > LogsRequest::kMaxBytes))
+      return DecodeError{"max_bytes", fmt::format("not 1 to {}", LogsRequest::kMaxBytes)};
+    return std::nullopt;
+  }
+};
+
+// A piece of a log, node.logs's or node.daemon_logs's.
 struct LogsReply {
-  std::string log;          // the log's name in the node's log folder: APPLICATION/COMPONENT.log
+  // The log's name in the node's log folder: APPLICATION/COMPONENT.log, or the daemon's own.
+  std::string log;
   std::uint64_t offset = 0; // where `text` starts in the log
   std::uint64_t next = 0;   // where the next read goes on
   std::string text;         // invalid UTF-8 replaced, so that it travels as JSON text
@@ -335,6 +354,11 @@ struct Top {
 struct Logs {
   static constexpr std::string_view name = "node.logs";
   using Request = LogsRequest;
+  using Reply = LogsReply;
+};
+struct DaemonLogs {
+  static constexpr std::string_view name = "node.daemon_logs";
+  using Request = DaemonLogsRequest;
   using Reply = LogsReply;
 };
 

@@ -260,12 +260,13 @@ public:
     restart_domaind();
   }
 
-  // Starts one more node daemon (index: nodes so far + 1) and waits until the domain knows it.
-  void start_node(const fs::path &dcd) {
+  // Starts one more node daemon (index: nodes so far + 1), with `more_args` of its options
+  // (--log-max-kib 16), and waits until the domain knows it.
+  void start_node(const fs::path &dcd, const std::vector<std::string> &more_args = {}) {
     auto before = call("domain.nodes");
     REQUIRE(before.has_value());
     const std::size_t known = before->at("nodes").size();
-    launch_node(dcd);
+    launch_node(dcd, more_args);
     REQUIRE(wait_for([&] {
       auto r = call("domain.nodes");
       return r && r->at("nodes").size() > known;
@@ -302,17 +303,22 @@ public:
   const ChildProcess::Environment &env() const { return env_; }
 
 private:
-  void launch_node(const fs::path &dcd) {
-    nodes_.push_back(start_node_process(dcd, static_cast<int>(nodes_.size()) + 1));
+  void launch_node(const fs::path &dcd, const std::vector<std::string> &more_args = {}) {
+    nodes_.push_back(start_node_process(dcd, static_cast<int>(nodes_.size()) + 1, more_args));
   }
 
-  std::unique_ptr<ChildProcess> start_node_process(const fs::path &dcd, int index) {
-    return std::make_unique<ChildProcess>(
-        (kBin / "rsca-noded").string(),
-        std::vector<std::string>{"--dcd", dcd.string(), "--log-dir", (run_ / "logs").string(),
-                                 "--exec-path", kBin.string(), "--control-socket",
-                                 (run_ / fmt::format("node{}.sock", index)).string()},
-        env_);
+  std::unique_ptr<ChildProcess> start_node_process(const fs::path &dcd, int index,
+                                                   const std::vector<std::string> &more_args = {}) {
+    std::vector<std::string> args{"--dcd",
+                                  dcd.string(),
+                                  "--log-dir",
+                                  (run_ / "logs").string(),
+                                  "--exec-path",
+                                  kBin.string(),
+                                  "--control-socket",
+                                  (run_ / fmt::format("node{}.sock", index)).string()};
+    args.insert(args.end(), more_args.begin(), more_args.end());
+    return std::make_unique<ChildProcess>((kBin / "rsca-noded").string(), args, env_);
   }
 
 public:

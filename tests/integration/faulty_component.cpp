@@ -53,6 +53,10 @@ class Faulty final : public Component {
 public:
   explicit Faulty(const Context &context) : Component(context) {
     property("fault", fault_);
+    // "chatter": a configure of N logs N numbered lines at once, each ~200 bytes, so that a test
+    // fills a log past a small rotation bound when it chooses (the rotation test's).
+    property("chatter", chatter_,
+             [this](const std::uint32_t &, const std::uint32_t &lines) { chatter(lines); });
     property("level", level_, [](const std::uint32_t &, const std::uint32_t &) {
       if (g_fault == "hang_at_configure")
         std::this_thread::sleep_for(std::chrono::hours(1)); // the fault itself: never answer
@@ -62,6 +66,12 @@ public:
   }
 
 private:
+  void chatter(std::uint32_t lines) {
+    const std::string padding(160, '.');
+    for (std::uint32_t i = 0; i < lines; ++i)
+      log().info("chatter {:06} {}", ++chattered_, padding);
+  }
+
   Result start() override {
     if (g_fault == "crash_at_start")
       std::abort();
@@ -72,6 +82,8 @@ private:
 
   std::string fault_ = "none";
   std::uint32_t level_ = 1;
+  std::uint32_t chatter_ = 0;
+  std::uint64_t chattered_ = 0; // lines logged so far, numbering the next
   std::uint64_t received_ = 0;
 };
 

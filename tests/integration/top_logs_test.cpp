@@ -38,6 +38,21 @@ void check_sane(const Json &row) {
   CHECK(row.at("cpu_percent").get<double>() >= 0);
 }
 
+// `rsca logs TARGET --since` keeps `line`, logged as the target started, while it is recent, and
+// leaves it out once the second it was logged in is over.
+void check_since(TestDomain &domain, const std::string &target, const std::string &line) {
+  auto [rc, out] = domain.cli({"logs", target, "--since", "3600s"});
+  INFO(out);
+  CHECK(rc == 0);
+  CHECK(out.find(line) != std::string::npos);
+  std::string recent;
+  CHECK(TestDomain::wait_for([&] {
+    recent = domain.cli({"logs", target, "--since", "0s"}).second;
+    return recent.find(line) == std::string::npos;
+  }));
+  INFO(recent);
+}
+
 } // namespace
 
 TEST_CASE("rsca top lists the daemons and every component process with the pid app.show gives",
@@ -132,27 +147,19 @@ TEST_CASE("rsca logs of a component or an application that does not exist is not
   auto [arc, aout] = domain.cli({"logs", "NoSuchApp"});
   INFO(aout);
   CHECK(arc == 3);
-  auto [nrc, nout] = domain.cli({"logs", "node1"});
-  INFO(nout);
-  CHECK(nrc == 3);
-  CHECK(nout.find("is a node") != std::string::npos);
+  CHECK(aout.find("no application or node NoSuchApp") != std::string::npos);
 }
 
 TEST_CASE("rsca logs --since leaves out older lines", "[integration][logs]") {
   TestDomain domain(1);
   domain.launch_shipped("ProducerConsumer");
-  auto [rc, out] = domain.cli({"logs", "ProducerConsumer/Producer_1", "--since", "3600s"});
-  INFO(out);
-  CHECK(rc == 0);
-  CHECK(out.find("serving at") != std::string::npos);
-  // The lines logged at launch are older than "now" once the second they were logged in is over.
-  std::string recent;
-  CHECK(TestDomain::wait_for([&] {
-    recent = domain.cli({"logs", "ProducerConsumer/Producer_1", "--since", "0s"}).second;
-    return recent.find("serving at") == std::string::npos;
-  }));
-  INFO(recent);
+  check_since(domain, "ProducerConsumer/Producer_1", "serving at");
   CHECK(domain.cli({"logs", "ProducerConsumer/Producer_1", "--since", "soon"}).first == 2);
+}
+
+TEST_CASE("rsca logs NODE --since leaves out the node's older lines", "[integration][logs]") {
+  TestDomain domain(1);
+  check_since(domain, "node1", "node node1 announced");
 }
 
 TEST_CASE("rsca logs -f goes on printing what the component logs", "[integration][logs]") {

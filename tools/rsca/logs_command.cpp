@@ -1,7 +1,10 @@
-// rsca logs APP[/COMP] [-n LINES] [--since T] [-f]: the logs of an application's component
-// processes, read by the nodes that run them (node.logs), so they come from any host. The domain
-// says where each component runs (app.show); each node is asked for the components it runs. -f
-// follows: the nodes are asked again every half second from where their last reply ended.
+// rsca logs APP[/COMP]|NODE [-n LINES] [--since T] [-f]: the logs of an application's component
+// processes, read by the nodes that run them (node.logs), so they come from any host, or a node
+// daemon's own log, read by that node (node.daemon_logs). The domain says where each component
+// runs (app.show) and where each node is (domain.nodes); each node is asked for the components it
+// runs. -f follows: the nodes are asked again every half second from where their last reply
+// ended. A name that is both an application's and a node's is the application's (the one a
+// user launched and is more likely to mean); `node:NAME` names the node.
 #include <algorithm>
 #include <chrono>
 #include <ctime>
@@ -28,7 +31,7 @@ namespace node_ops = protocol::node;
 using control::Json;
 
 struct LogsOptions {
-  std::string target; // APP or APP/COMP
+  std::string target; // APP, APP/COMP, NODE or node:NODE
   std::size_t lines = 100;
   std::string since; // a duration ("300s"): only the lines logged since then
   bool follow = false;
@@ -36,16 +39,22 @@ struct LogsOptions {
 
 constexpr std::chrono::milliseconds kFollowPace{500};
 
-// One component's log, and where reading it goes on.
+constexpr std::string_view kNodePrefix = "node:";
+
+// One log, and where reading it goes on: a component's, or a node daemon's own.
 struct Source {
   std::string node_address;
+  std::string node; // a node daemon's own log: its node's name; empty: a component's log
+  // A component's; its offset and max_bytes are where and how much to read a daemon's log too.
   node_ops::LogsRequest request;
   bool keeping = false; // --since: whether the last line read was kept
+  const std::string &label() const { return node.empty() ? request.component : node; }
 };
 
 // A component's log lines start with the component runtime's local time, "[YYYY-MM-DD
-// HH:MM:SS.mmm]", which orders them as text: --since compares that with the time it names. A
-// line without it (a program's own output) goes with the line before it.
+// HH:MM:SS.mmm]", as a node daemon's do (node/daemon_log.hpp), which orders them as text: --since
+// compares that with the time it names. A line without it (a program's own output) goes with the
+// line before it.
 std::string local_stamp(std::chrono::system_clock::time_point at) {
   const std::time_t t = std::chrono::system_clock::to_time_t(at);
   std::tm local{};
@@ -85,44 +94,63 @@ std::vector<std::string> lines_of(const std::string &text) {
   return lines;
 }
 
-bool is_node(const domain_ops::NodesReply &nodes, const std::string &name) {
-  return std::any_of(nodes.nodes.begin(), nodes.nodes.end(),
-                     [&](const auto &n) { return n.name == name; });
+// The node named `name`'s own log; none (with rc) when the domain has no such node. `explicitly`:
+// named as a node (node:NAME), not a name no application has.
+std::vector<Source> node_source(const domain_ops::NodesReply &nodes, const std::string &name,
+                                bool explicitly, const GlobalOptions &global, int &rc) {
+  for (const auto &n : nodes.nodes)
+    if (n.name == name)
+      return {{n.address,
+               n.name,
+               {{}, {}, std::nullopt, std::nullopt, node_ops::LogsRequest::kMaxBytes}}};
+  rc = report_failure(global, "logs",
+                      {control::Status::NotFound,
+                       explicitly ? fmt::format("no node {} in the domain", name)
+                                  : fmt::format("no application or node {} in the domain", name)});
+  return {};
 }
 
-// The components the target names, each with its node's address. rc: the exit code when it fails.
+// The components of the application shown (all, or `component`), each with its node's address.
+std::vector<Source> component_sources(const app_ops::Show::Reply &shown,
+                                      const domain_ops::NodesReply &nodes,
+                                      const std::string &component) {
+  std::vector<Source> sources;
+  for (const auto &c : shown.components) {
+    if (!component.empty() && c.id != component)
+      continue;
+    for (const auto &n : nodes.nodes)
+      if (n.name == c.node)
+        sources.push_back(
+            {n.address,
+             {},
+             {shown.name, c.id, c.pid, std::nullopt, node_ops::LogsRequest::kMaxBytes}});
+  }
+  return sources;
+}
+
+// The logs the target names, each with its node's address. rc: the exit code when it fails.
 std::vector<Source> sources_of(const DomainClient &client, const LogsOptions &options,
                                const GlobalOptions &global, int &rc) {
   const std::chrono::milliseconds timeout(global.timeout_ms);
-  const auto slash = options.target.find('/');
-  const std::string app = options.target.substr(0, slash);
-  const std::string component =
-      slash == std::string::npos ? std::string() : options.target.substr(slash + 1);
   auto nodes = client.call<domain_ops::Nodes>({}, timeout);
   if (!nodes) {
     rc = report_failure(global, "logs", nodes.error());
     return {};
   }
+  if (options.target.rfind(kNodePrefix, 0) == 0)
+    return node_source(*nodes, options.target.substr(kNodePrefix.size()), true, global, rc);
+  const auto slash = options.target.find('/');
+  const std::string app = options.target.substr(0, slash);
+  const std::string component =
+      slash == std::string::npos ? std::string() : options.target.substr(slash + 1);
   auto shown = client.call<app_ops::Show>({app}, timeout);
+  if (!shown && shown.error().status == control::Status::NotFound && slash == std::string::npos)
+    return node_source(*nodes, app, false, global, rc); // no application of that name: a node's
   if (!shown) {
-    if (slash == std::string::npos && is_node(*nodes, app))
-      shown.error().message = fmt::format(
-          "{} is a node: a node daemon's own log is not served (yet); it is its standard error "
-          "(the journal under systemd, the run folder's log with `rsca domain up`)",
-          app);
     rc = report_failure(global, "logs", shown.error());
     return {};
   }
-  std::vector<Source> sources;
-  for (const auto &c : shown->components) {
-    if (!component.empty() && c.id != component)
-      continue;
-    for (const auto &n : nodes->nodes)
-      if (n.name == c.node)
-        sources.push_back(
-            {n.address,
-             {shown->name, c.id, c.pid, std::nullopt, node_ops::LogsRequest::kMaxBytes}});
-  }
+  auto sources = component_sources(*shown, *nodes, component);
   if (sources.empty())
     rc = report_failure(global, "logs",
                         {control::Status::NotFound,
@@ -133,15 +161,16 @@ std::vector<Source> sources_of(const DomainClient &client, const LogsOptions &op
 }
 
 // Prints a reply's lines (the last `keep` of them when not all), prefixed with the component when
-// the logs of several are shown.
+// the logs of several are shown; in JSON, each names its node or its component.
 void print_lines(const Source &source, const std::vector<std::string> &lines, std::size_t keep,
                  bool prefix, const GlobalOptions &global) {
   const std::size_t first = lines.size() > keep ? lines.size() - keep : 0;
   for (std::size_t i = first; i < lines.size(); ++i) {
     if (global.json)
-      fmt::print("{}\n", Json{{"application", source.request.application},
-                              {"component", source.request.component},
-                              {"line", lines[i]}}
+      fmt::print("{}\n", (source.node.empty() ? Json{{"application", source.request.application},
+                                                     {"component", source.request.component},
+                                                     {"line", lines[i]}}
+                                              : Json{{"node", source.node}, {"line", lines[i]}})
                              .dump());
     else if (prefix)
       fmt::print("{} | {}\n", source.request.component, lines[i]);
@@ -151,19 +180,28 @@ void print_lines(const Source &source, const std::vector<std::string> &lines, st
   std::fflush(stdout);
 }
 
+// Asks the node of `source` for its next piece.
+std::future<control::CallResult<Json>> ask(const DomainClient &client, const Source &source,
+                                           std::chrono::milliseconds timeout) {
+  if (source.node.empty())
+    return client.call_async_at<node_ops::Logs>(source.node_address, source.request, timeout);
+  return client.call_async_at<node_ops::DaemonLogs>(
+      source.node_address, {source.request.offset, source.request.max_bytes}, timeout);
+}
+
 // Reads each source once, from where it stands; the exit code of the first failure.
 int read_once(const DomainClient &client, std::vector<Source> &sources, std::size_t keep,
               const std::string &stamp, const GlobalOptions &global) {
   std::vector<std::future<control::CallResult<Json>>> pending;
   for (const auto &s : sources)
-    pending.push_back(client.call_async_at<node_ops::Logs>(
-        s.node_address, s.request, std::chrono::milliseconds(global.timeout_ms)));
+    pending.push_back(ask(client, s, std::chrono::milliseconds(global.timeout_ms)));
   int rc = kOk;
   for (std::size_t i = 0; i < sources.size(); ++i) {
+    // node.logs's reply is node.daemon_logs's too.
     auto reply = control::reply_of<node_ops::Logs>(pending[i].get());
     if (!reply) {
-      const int failed = report_failure(
-          global, fmt::format("logs {}", sources[i].request.component), reply.error());
+      const int failed =
+          report_failure(global, fmt::format("logs {}", sources[i].label()), reply.error());
       rc = rc == kOk ? failed : rc;
       continue;
     }
@@ -210,9 +248,12 @@ int logs(const LogsOptions &options, const GlobalOptions &global) {
 void add_logs_command(CLI::App &app, const GlobalOptions &global, int &exit_code) {
   auto *cmd = app.add_subcommand(
       "logs", "The logs of a running application's components (APP) or of one (APP/COMP), read "
-              "by the nodes that run them");
+              "by the nodes that run them, or a node daemon's own log (NODE)");
   auto options = std::make_shared<LogsOptions>();
-  cmd->add_option("target", options->target, "APP or APP/COMPONENT")->required();
+  cmd->add_option("target", options->target,
+                  "APP, APP/COMPONENT or NODE; a name that is both an application's and a "
+                  "node's is the application's: node:NODE names the node")
+      ->required();
   cmd->add_option("-n,--lines", options->lines, "the last LINES lines of each log")
       ->capture_default_str();
   cmd->add_option("--since", options->since,
