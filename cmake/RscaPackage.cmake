@@ -28,4 +28,16 @@ set(CPACK_DEBIAN_DEV_PACKAGE_DEPENDS
 set(CPACK_COMPONENT_DEV_DESCRIPTION
     "rsca's component SDK: headers, find_package(rsca) with rsca_add_component, pkg-config")
 
+# The maintainer scripts (cmake/debian/): systemd reloads its units when the package installs,
+# upgrades or goes, and the daemons stop before their programs are removed; no unit is enabled
+# (README, "Install"). Each package has its copyright file where Debian looks for it.
+set(rsca_debian ${CMAKE_CURRENT_LIST_DIR}/debian)
+set(CPACK_DEBIAN_RUNTIME_PACKAGE_CONTROL_EXTRA
+    "${rsca_debian}/postinst;${rsca_debian}/prerm;${rsca_debian}/postrm")
+set(CPACK_DEBIAN_RUNTIME_PACKAGE_CONTROL_STRICT_PERMISSION ON) # scripts 0755, as dpkg wants
+install(FILES ${rsca_debian}/copyright DESTINATION ${CMAKE_INSTALL_DATAROOTDIR}/doc/rsca
+        COMPONENT runtime)
+install(FILES ${rsca_debian}/copyright DESTINATION ${CMAKE_INSTALL_DATAROOTDIR}/doc/rsca-dev
+        COMPONENT dev)
+
 include(CPack)

@@ -327,13 +327,25 @@ CallResult<ResolvedEnd> DomainManager::Impl::resolve_device_end(const PortRef &r
                              fmt::format("{} is not a {} port", ref.to_string(), wanted));
 }
 
+namespace {
+
+domain_ops::NodeSummary summary_of(const NodeDirectory::Node &node) {
+  const auto &a = node.announcement;
+  return {a.node, node.address, a.pid, a.devices.size(), a.failed_devices};
+}
+
+} // namespace
+
+// A lost node is listed apart, not left out: it still holds its devices' reservations and its
+// components, and may come back; `rsca ls nodes` and `rsca top` show it as lost.
 CallResult<domain_ops::NodesReply> DomainManager::Impl::list_nodes() {
   domain_ops::NodesReply reply;
   for (const auto &node : nodes.snapshot())
-    reply.nodes.push_back({node.announcement.node, node.address, node.announcement.pid,
-                           node.announcement.devices.size()});
+    reply.nodes.push_back(summary_of(node));
   for (const auto &r : nodes.refused_nodes())
     reply.refused.push_back({excerpt(r.address), r.why});
+  for (const auto &node : nodes.lost_nodes())
+    reply.lost.push_back(summary_of(node));
   return reply;
 }
 

@@ -87,13 +87,26 @@ std::optional<protocol::node::DeviceRecord> NodeDirectory::device(const std::str
   return *device;
 }
 
-std::vector<NodeDirectory::Node> NodeDirectory::snapshot() const {
-  std::lock_guard lock(mutex_);
-  std::vector<Node> out;
-  out.reserve(nodes_.size());
-  for (const auto &[name, node] : nodes_)
+namespace {
+
+std::vector<NodeDirectory::Node> nodes_of(const std::map<std::string, NodeDirectory::Node> &map) {
+  std::vector<NodeDirectory::Node> out;
+  out.reserve(map.size());
+  for (const auto &[name, node] : map)
     out.push_back(node);
   return out;
+}
+
+} // namespace
+
+std::vector<NodeDirectory::Node> NodeDirectory::snapshot() const {
+  std::lock_guard lock(mutex_);
+  return nodes_of(nodes_);
+}
+
+std::vector<NodeDirectory::Node> NodeDirectory::lost_nodes() const {
+  std::lock_guard lock(mutex_);
+  return nodes_of(lost_);
 }
 
 // Called with mutex_ held.

@@ -46,6 +46,8 @@ public:
   // The device of that id ("NODE:LABEL").
   std::optional<protocol::node::DeviceRecord> device(const std::string &id) const;
   std::vector<Node> snapshot() const;
+  // The nodes lost and not back, as they last announced themselves.
+  std::vector<Node> lost_nodes() const;
   std::vector<Refused> refused_nodes() const;
 
 private:

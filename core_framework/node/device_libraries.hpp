@@ -14,6 +14,14 @@
 
 namespace rsca::node {
 
+// Why a device has no factory: the file and the symbol involved, apart, for the node's
+// announcement (protocol/node_ops.hpp, FailedDevice), and the whole reason, naming both.
+struct LoadFailure {
+  std::string file;   // the library tried; empty when the SPD names none
+  std::string symbol; // the symbol looked up; empty when the library was not opened
+  std::string reason;
+};
+
 class DeviceLibraries {
 public:
   // The library as the SPD names it: absolute, or relative to the SPD's folder; one that is not
@@ -26,15 +34,15 @@ public:
   // implementation names, loaded into `registry` the first time. Fails with why, naming the file
   // and the symbol: the SPD names no library, the library cannot be loaded, exports no
   // kDeviceFactoriesSymbol, or registers no device of the SPD's name.
-  tl::expected<const DeviceFactory *, std::string>
+  tl::expected<const DeviceFactory *, LoadFailure>
   factory_of(const profile::ResolvedSoftPkg &softpkg, DeviceRegistry &registry);
 
 private:
-  std::optional<std::string> load(const std::filesystem::path &library, DeviceRegistry &registry);
+  std::optional<LoadFailure> load(const std::filesystem::path &library, DeviceRegistry &registry);
 
   std::vector<std::filesystem::path> folders_;
-  // Each library tried, by resolved path: empty when loaded, else why it could not be.
-  std::map<std::filesystem::path, std::string> tried_;
+  // Each library tried, by resolved path: nothing when loaded, else why it could not be.
+  std::map<std::filesystem::path, std::optional<LoadFailure>> tried_;
 };
 
 } // namespace rsca::node

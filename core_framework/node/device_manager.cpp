@@ -12,6 +12,7 @@
 
 #include "common/host_name.hpp"
 #include "common/install_layout.hpp"
+#include "common/names.hpp"
 #include "common/periodic.hpp"
 #include "control/operation.hpp"
 #include "node/daemon_log.hpp"
@@ -75,6 +76,13 @@ op::ProcessFigures figures_of(pid_t pid, const process::Figures &f) {
   return {pid, f.cpu_percent, f.rss_bytes, f.threads};
 }
 
+// `text` cut to what the announcement's contract takes (protocol/node_ops.hpp, FailedDevice): a
+// field over its bound would have the domain refuse the whole announcement. excerpt() may write
+// each byte as 4 and adds its length: a quarter, less that, fits.
+std::string bounded(const std::string &text, std::size_t max) {
+  return text.size() <= max ? text : excerpt(text, max / 4 - 32);
+}
+
 } // namespace
 
 struct DeviceManager::Impl {
@@ -104,12 +112,14 @@ struct DeviceManager::Impl {
   DeviceRegistry registry;
   DeviceLibraries libraries{{}};
   std::vector<RunningDevice> devices;
+  std::vector<op::FailedDevice> failed; // the DCD's devices not started, announced with the rest
   std::atomic<bool> stopping{false};
   std::mutex endpoint_mutex;        // the endpoint's end against a process exit reported meanwhile
   process::CpuSampler sampler;      // node.top's: its last reading of each process
   std::optional<Periodic> rotation; // of its processes' logs, by size
 
   Expected<void> start_devices();
+  void not_started(op::FailedDevice failure);
   op::NodeAnnouncement announcement() const;
   void serve();
   ExecutableDevice *executable_device(const std::string &id) const;
@@ -174,13 +184,15 @@ Expected<void> DeviceManager::Impl::start_devices() {
     const std::string label = ci.usage_name.empty() ? ci.id : ci.usage_name;
     const std::string id = fmt::format("{}:{}", dcd->name, label);
     if (!placed.softpkg->unavailable.empty()) {
-      spdlog::warn("device {} not started: {}", id, to_string(placed.softpkg->unavailable.front()));
+      not_started({id, label, placed.softpkg->spd->name, "", "",
+                   to_string(placed.softpkg->unavailable.front())});
       continue;
     }
     auto factory = libraries.factory_of(*placed.softpkg, registry);
     if (!factory) {
-      spdlog::warn("device {} ({}) not started: {}", id, placed.softpkg->spd->name,
-                   factory.error());
+      auto &why = factory.error();
+      not_started({id, label, placed.softpkg->spd->name, std::move(why.file), std::move(why.symbol),
+                   std::move(why.reason)});
       continue;
     }
     DeviceContext context{id,
@@ -211,8 +223,21 @@ Expected<void> DeviceManager::Impl::start_devices() {
   return {};
 }
 
+void DeviceManager::Impl::not_started(op::FailedDevice failure) {
+  spdlog::warn("device {} ({}) not started: {}", failure.id, failure.softpkg, failure.reason);
+  if (failed.size() >= op::NodeAnnouncement::kMaxFailedDevices)
+    return; // the log has them all
+  using F = op::FailedDevice;
+  failed.push_back({bounded(failure.id, 2 * F::kMaxName), bounded(failure.label, F::kMaxName),
+                    bounded(failure.softpkg, F::kMaxName), bounded(failure.file, F::kMaxPath),
+                    bounded(failure.symbol, F::kMaxName), bounded(failure.reason, F::kMaxReason)});
+}
+
 op::NodeAnnouncement DeviceManager::Impl::announcement() const {
-  op::NodeAnnouncement out{dcd->name, static_cast<std::int64_t>(getpid()), host_name(), {}, true};
+  op::NodeAnnouncement out{dcd->name, static_cast<std::int64_t>(getpid()), host_name(), {}, true,
+                           {}};
+  if (!failed.empty())
+    out.failed_devices = failed;
   for (const auto &d : devices) {
     op::DeviceRecord record{d.id,
                             d.label,

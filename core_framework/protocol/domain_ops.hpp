@@ -141,10 +141,13 @@ struct NodeSummary {
   std::string address;
   std::int64_t pid = 0;
   std::uint64_t devices = 0;
+  // The devices of its DCD it did not start, as it announced them; absent when none.
+  std::optional<std::vector<node::FailedDevice>> failed_devices;
   static constexpr auto fields() {
     using R = NodeSummary;
     return std::tuple{required("name", &R::name), required("address", &R::address),
-                      required("pid", &R::pid), required("devices", &R::devices)};
+                      required("pid", &R::pid), required("devices", &R::devices),
+                      optional("failed_devices", &R::failed_devices)};
   }
 };
 
@@ -159,11 +162,15 @@ struct RefusedNode {
 };
 
 struct NodesReply {
-  std::vector<NodeSummary> nodes;
+  std::vector<NodeSummary> nodes; // the nodes that are there: they answer calls
   std::vector<RefusedNode> refused;
+  // Nodes whose DDS lease ran out, as they last announced themselves: the domain keeps their
+  // devices' reservations until they are back (domain/domain_nodes.cpp), and calls none of them.
+  std::vector<NodeSummary> lost;
   static constexpr auto fields() {
     return std::tuple{required("nodes", &NodesReply::nodes),
-                      optional("refused", &NodesReply::refused)};
+                      optional("refused", &NodesReply::refused),
+                      optional("lost", &NodesReply::lost)};
   }
 };
 

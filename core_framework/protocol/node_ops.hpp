@@ -143,8 +143,41 @@ struct DeviceRecord {
   }
 };
 
+// A device of the node's DCD that the node did not start (node/device_libraries.hpp: its library
+// cannot be loaded, exports no symbol, registers no device of its name; or its SPD names a file
+// missing). The node runs without it and says so, so that users see it beside the node.
+struct FailedDevice {
+  static constexpr std::size_t kMaxName = 256;
+  static constexpr std::size_t kMaxPath = 4096; // PATH_MAX
+  static constexpr std::size_t kMaxReason = 2 * kMaxPath;
+  std::string id;    // NODE:LABEL, as a device it started would have
+  std::string label; // the DCD's usage name, else its instantiation id
+  std::string softpkg;
+  std::string file;   // the library tried (or the file missing); empty when none is named
+  std::string symbol; // the symbol looked up in it; empty when it was not looked up
+  std::string reason; // names the file and the symbol
+  static constexpr auto fields() {
+    using R = FailedDevice;
+    return std::tuple{required("id", &R::id),           required("label", &R::label),
+                      required("softpkg", &R::softpkg), optional("file", &R::file),
+                      optional("symbol", &R::symbol),   required("reason", &R::reason)};
+  }
+  std::optional<DecodeError> check() const {
+    if (id.size() > 2 * kMaxName || label.size() > kMaxName || softpkg.size() > kMaxName ||
+        symbol.size() > kMaxName)
+      return DecodeError{"id", "a name too long"};
+    if (file.size() > kMaxPath)
+      return DecodeError{"file", "a path too long"};
+    if (reason.size() > kMaxReason)
+      return DecodeError{"reason", "too long"};
+    return std::nullopt;
+  }
+};
+
 // What a node announces (announcement kind "node").
 struct NodeAnnouncement {
+  // More than a DCD places (a robot's node has tens of devices).
+  static constexpr std::size_t kMaxFailedDevices = 256;
   std::string node;
   std::int64_t pid = 0;
   std::string host;
@@ -153,11 +186,22 @@ struct NodeAnnouncement {
   // calls their components through the node. Absent: a node that does not, whose processes
   // serve their own addresses.
   std::optional<bool> relays_processes;
+  // Absent when every device started: a domain of an earlier version, which refuses a field it
+  // does not know, still takes the announcement of a node with nothing to report.
+  std::optional<std::vector<FailedDevice>> failed_devices;
   static constexpr auto fields() {
     using R = NodeAnnouncement;
-    return std::tuple{required("node", &R::node), required("pid", &R::pid),
-                      required("host", &R::host), required("devices", &R::devices),
-                      optional("relays_processes", &R::relays_processes)};
+    return std::tuple{required("node", &R::node),
+                      required("pid", &R::pid),
+                      required("host", &R::host),
+                      required("devices", &R::devices),
+                      optional("relays_processes", &R::relays_processes),
+                      optional("failed_devices", &R::failed_devices)};
+  }
+  std::optional<DecodeError> check() const {
+    if (failed_devices && failed_devices->size() > kMaxFailedDevices)
+      return DecodeError{"failed_devices", fmt::format("more than {}", kMaxFailedDevices)};
+    return std::nullopt;
   }
 };
 

@@ -49,6 +49,49 @@ done
 lacks "$dev" "^./usr/bin/"
 dpkg-deb -f "$dev" Depends | grep "^rsca (= " >/dev/null || fail "rsca-dev does not depend on rsca"
 
+has "$runtime" ./usr/share/doc/rsca/copyright
+has "$dev" ./usr/share/doc/rsca-dev/copyright
+
+# The maintainer scripts (cmake/debian/): in rsca's control area, executable, POSIX sh that
+# parses, `set -e`, and none enables a unit (the operator chooses which node runs; README).
+control="$work/control"
+dpkg-deb -e "$runtime" "$control"
+for script in postinst prerm postrm; do
+  f="$control/$script"
+  [ -x "$f" ] || fail "rsca's control area lacks an executable $script"
+  [ "$(head -n 1 "$f")" = "#!/bin/sh" ] || fail "$script is not a #!/bin/sh script"
+  sh -n "$f" || fail "$script does not parse as sh"
+  grep -qx 'set -e' "$f" || fail "$script does not set -e"
+  sed '/^[[:space:]]*#/d' "$f" >"$work/$script.code" # its comments may name what it does not do
+  ! grep -Eq '(systemctl|deb-systemd-helper|deb-systemd-invoke)[^#]* (enable|start|restart)( |$)' \
+    "$work/$script.code" || fail "$script enables, starts or restarts a unit"
+done
+# Run as dpkg runs them, with systemd's tools stubbed (they record their calls): where systemd
+# does not run (a chroot, this container) they succeed and call nothing; where it runs they
+# reload it and stop the daemons on removal. postrm purge is not run: it removes the host's
+# links to rsca's units.
+stubs="$work/stubs"
+calls="$work/systemd.calls"
+mkdir -p "$stubs"
+for tool in systemctl deb-systemd-invoke deb-systemd-helper; do
+  printf '#!/bin/sh\necho "%s $*" >>"%s"\n' "$tool" "$calls" >"$stubs/$tool"
+  chmod +x "$stubs/$tool"
+done
+for run in "postinst configure" "prerm upgrade 0.1.0" "postinst configure 0.1.0" \
+           "prerm remove" "postrm remove"; do
+  # shellcheck disable=SC2086 # a script's name, then its arguments
+  set -- $run
+  PATH="$stubs:$PATH" sh "$control/$1" "${@:2}" >"$work/script.log" 2>&1 ||
+    { cat "$work/script.log"; fail "$run exits with $?"; }
+done
+if [ -d /run/systemd/system ]; then
+  grep -q 'systemctl --system daemon-reload' "$calls" || fail "no daemon-reload under systemd"
+  grep -q 'stop rsca-domaind.service' "$calls" || fail "prerm remove does not stop rsca-domaind"
+elif [ -s "$calls" ]; then
+  cat "$calls"
+  fail "the maintainer scripts call systemd's tools where systemd does not run"
+fi
+
 # Depends: every library outside the package that an ELF file of it links directly.
 root="$work/root"
 dpkg-deb -x "$runtime" "$root"
@@ -100,6 +143,17 @@ for unit in "$root"/lib/systemd/system/rsca-*.service; do
   exec_start="$(sed -n 's/^ExecStart=\([^ ]*\).*/\1/p' "$unit")"
   [ -n "$exec_start" ] && [ -x "$root$exec_start" ] ||
     fail "$(basename "$unit") starts \"$exec_start\", which the package does not hold"
+done
+
+# Each package's copyright file is in Debian's machine-readable format.
+dpkg-deb -x "$dev" "$work/dev-root"
+for doc in "$root/usr/share/doc/rsca/copyright" "$work/dev-root/usr/share/doc/rsca-dev/copyright"; do
+  [ "$(head -n 1 "$doc")" = \
+    "Format: https://www.debian.org/doc/packaging-manuals/copyright-format/1.0/" ] ||
+    fail "$doc is not in the machine-readable copyright format"
+  for field in '^Files: \*$' '^Copyright: ' '^License: '; do
+    grep -q "$field" "$doc" || fail "$doc lacks a line $field"
+  done
 done
 
 # Unpacked anywhere, the CLI finds its schemas' reader and its profiles.

@@ -30,6 +30,43 @@ Json row_of(const Json &top, const std::string &node, const std::string &what) {
   return nullptr;
 }
 
+// How `rsca top` lists node `node` when it has no figures of it; null when it does not.
+Json unreachable_row(const Json &top, const std::string &node) {
+  for (const auto &row : top.at("unreachable"))
+    if (row.at("node") == node)
+      return row;
+  return nullptr;
+}
+
+// The line of `text` that starts with `prefix`; empty when none does.
+std::string line_starting(const std::string &text, const std::string &prefix) {
+  std::istringstream lines(text);
+  for (std::string line; std::getline(lines, line);)
+    if (line.rfind(prefix, 0) == 0)
+      return line;
+  return {};
+}
+
+// Node daemon `index` frozen (SIGSTOP), as a hung node is: it answers no call and, past its DDS
+// lease, the domain loses it. Resumed however the test ends, so that the domain can stop it.
+class FrozenNode {
+public:
+  FrozenNode(TestDomain &domain, int index) : pid_(domain.node_pid(index)) {
+    REQUIRE(::kill(pid_, SIGSTOP) == 0);
+  }
+  ~FrozenNode() { resume(); }
+  FrozenNode(const FrozenNode &) = delete;
+  FrozenNode &operator=(const FrozenNode &) = delete;
+  void resume() {
+    if (pid_ > 0)
+      ::kill(pid_, SIGCONT);
+    pid_ = 0;
+  }
+
+private:
+  pid_t pid_;
+};
+
 void check_sane(const Json &row) {
   INFO(row.dump());
   CHECK(row.at("pid").get<long>() > 0);
@@ -84,6 +121,54 @@ TEST_CASE("rsca top lists the daemons and every component process with the pid a
   auto [rc, out] = domain.cli({"top", "NoSuchApp"});
   INFO(out);
   CHECK(rc == 3);
+}
+
+TEST_CASE("rsca top lists a node that does not answer as unreachable, and still once the domain "
+          "lost it, with the other rows",
+          "[integration][top]") {
+  TestDomain domain(2);
+  const Json app = domain.launch_shipped("ProducerConsumer", {"--strategy", "spread"});
+  // What node1 runs, and the domain daemon, are shown whatever node2 does; node2 has no row.
+  auto check_others = [&](const Json &top) {
+    INFO(top.dump(2));
+    CHECK(row_of(top, "domain", "rsca-domaind").is_object());
+    CHECK(row_of(top, "node1", "rsca-noded").is_object());
+    for (const auto &row : top.at("processes"))
+      CHECK(row.at("node") != "node2");
+    for (const auto &c : app.at("components"))
+      if (c.at("node") == "node1")
+        CHECK(
+            row_of(top, "node1", "ProducerConsumer/" + c.at("id").get<std::string>()).is_object());
+    const Json node2 = unreachable_row(top, "node2");
+    REQUIRE(node2.is_object());
+    CHECK_FALSE(node2.at("error").get<std::string>().empty());
+    CHECK(unreachable_row(top, "node1").is_null());
+    return node2;
+  };
+  FrozenNode frozen(domain, 2);
+  // Within its lease the domain still lists it: it is asked, and does not answer in time.
+  // (Should the lease run out first, it is listed as lost instead: unreachable all the same.)
+  check_others(top_json(domain, {"--timeout-ms", "1000"}));
+  // Past its lease the domain loses it, and keeps its devices and components: it is listed as
+  // lost, not left out.
+  REQUIRE(TestDomain::wait_for([&] {
+    auto nodes = domain.call("domain.nodes");
+    return nodes && nodes->at("nodes").size() == 1 && nodes->at("lost").size() == 1;
+  }));
+  const Json lost = check_others(top_json(domain));
+  CHECK(lost.at("lost") == true);
+  auto [rc, listed] = domain.cli({"ls", "nodes"});
+  INFO(listed);
+  CHECK(rc == 0);
+  CHECK_THAT(line_starting(listed, "node2 "), Catch::Contains(" lost "));
+  // Back (the same run): asked and shown again, nothing unreachable.
+  frozen.resume();
+  Json back;
+  CHECK(TestDomain::wait_for([&] {
+    back = top_json(domain);
+    return back.at("unreachable").empty() && row_of(back, "node2", "rsca-noded").is_object();
+  }));
+  INFO(back.dump(2));
 }
 
 TEST_CASE("rsca top shows a component that burns a CPU as busy", "[integration][top]") {

@@ -25,7 +25,7 @@ struct Node {
 
   // The factory of a device package `name` whose one implementation is `library` of code type
   // `type`.
-  tl::expected<const DeviceFactory *, std::string>
+  tl::expected<const DeviceFactory *, rsca::node::LoadFailure>
   factory_of(const std::string &name, const std::string &library,
              CodeType type = CodeType::SharedLibrary) {
     auto spd = std::make_shared<rsca::profile::SoftPkg>();
@@ -47,9 +47,12 @@ TEST_CASE("a device library that is not there fails naming the file", "[node][de
   Node node;
   auto factory = node.factory_of("Gone", "librsca-no-such-device.so");
   REQUIRE_FALSE(factory.has_value());
-  CHECK_THAT(factory.error(), Catch::Contains("cannot load"));
-  CHECK_THAT(factory.error(),
-             Catch::Contains((node.spds.path() / "librsca-no-such-device.so").string()));
+  const auto &failure = factory.error();
+  CHECK_THAT(failure.reason, Catch::Contains("cannot load"));
+  const std::string file = (node.spds.path() / "librsca-no-such-device.so").string();
+  CHECK_THAT(failure.reason, Catch::Contains(file));
+  CHECK(failure.file == file);
+  CHECK(failure.symbol.empty()); // never looked up: the file did not load
 }
 
 TEST_CASE("a library without the device symbol fails naming the file and the symbol",
@@ -58,8 +61,11 @@ TEST_CASE("a library without the device symbol fails naming the file and the sym
   // The XML reader module: a library rsca loads, found by name in rsca's library folder.
   auto factory = node.factory_of("Reader", "librsca_xml_reader.so");
   REQUIRE_FALSE(factory.has_value());
-  CHECK_THAT(factory.error(), Catch::Contains((kLibraries / "librsca_xml_reader.so").string()));
-  CHECK_THAT(factory.error(), Catch::Contains(rsca::node::kDeviceFactoriesSymbol));
+  const auto &failure = factory.error();
+  CHECK_THAT(failure.reason, Catch::Contains((kLibraries / "librsca_xml_reader.so").string()));
+  CHECK_THAT(failure.reason, Catch::Contains(rsca::node::kDeviceFactoriesSymbol));
+  CHECK(failure.file == (kLibraries / "librsca_xml_reader.so").string());
+  CHECK(failure.symbol == rsca::node::kDeviceFactoriesSymbol);
 }
 
 TEST_CASE("a device library's devices are found by their SPD's name, the library entered once",
@@ -82,13 +88,16 @@ TEST_CASE("a device library's devices are found by their SPD's name, the library
 
   auto other = node.factory_of("Other", library);
   REQUIRE_FALSE(other.has_value());
-  CHECK_THAT(other.error(), Catch::Contains("registers no device named Other"));
-  CHECK_THAT(other.error(), Catch::Contains(library));
+  CHECK_THAT(other.error().reason, Catch::Contains("registers no device named Other"));
+  CHECK_THAT(other.error().reason, Catch::Contains(library));
+  CHECK(other.error().file == (kLibraries / library).string());
+  CHECK(other.error().symbol == rsca::node::kDeviceFactoriesSymbol);
 }
 
 TEST_CASE("a device whose SPD names no shared library has no implementation", "[node][devices]") {
   Node node;
   auto factory = node.factory_of("GPP", "bin/rsca-gpp", CodeType::Executable);
   REQUIRE_FALSE(factory.has_value());
-  CHECK_THAT(factory.error(), Catch::Contains("names no SharedLibrary implementation"));
+  CHECK_THAT(factory.error().reason, Catch::Contains("names no SharedLibrary implementation"));
+  CHECK(factory.error().file.empty());
 }

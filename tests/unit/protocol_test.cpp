@@ -407,8 +407,9 @@ TEST_CASE("protocol: a listed connection keeps a null end state null, and its st
 TEST_CASE("protocol: domain replies round-trip, and an install names its broken file",
           "[protocol]") {
   namespace dom = protocol::domain;
-  const auto nodes = round_trip(dom::NodesReply{{{"node1", "rsca/node/node1", 77, 3}},
-                                                {{"rsca/node/rogue", "missing field \"host\""}}});
+  const auto nodes = round_trip(dom::NodesReply{{{"node1", "rsca/node/node1", 77, 3, std::nullopt}},
+                                                {{"rsca/node/rogue", "missing field \"host\""}},
+                                                {}});
   REQUIRE(nodes.nodes.size() == 1);
   REQUIRE(nodes.refused.size() == 1);
   CHECK(nodes.refused[0].why == "missing field \"host\"");

@@ -42,10 +42,20 @@ void print_installed(const domain_ops::InstalledReply &r) {
     fmt::print("{:<24} {:<10} {}\n", a.name, a.components, a.sad);
 }
 
+// A node's row, then a line per device of its DCD it did not start, with why.
+void print_node(const domain_ops::NodeSummary &n, std::string_view state) {
+  fmt::print("{:<16} {:<8} {:<8} {:<8} {}\n", n.name, n.pid, n.devices, state, n.address);
+  for (const auto &f : n.failed_devices.value_or(std::vector<protocol::node::FailedDevice>{}))
+    fmt::print("  not started: {} ({}): {}\n", f.id, f.softpkg, f.reason);
+}
+
 void print_nodes(const domain_ops::NodesReply &r) {
-  fmt::print("{:<16} {:<8} {:<8} {}\n", "NODE", "PID", "DEVICES", "ADDRESS");
+  fmt::print("{:<16} {:<8} {:<8} {:<8} {}\n", "NODE", "PID", "DEVICES", "STATE", "ADDRESS");
   for (const auto &n : r.nodes)
-    fmt::print("{:<16} {:<8} {:<8} {}\n", n.name, n.pid, n.devices, n.address);
+    print_node(n, "up");
+  // Its lease ran out: it holds its devices and components until it is back.
+  for (const auto &n : r.lost)
+    print_node(n, "lost");
   for (const auto &refused : r.refused)
     fmt::print("refused: the endpoint at {} announced itself as a node in a form this domain does "
                "not take: {}\n",

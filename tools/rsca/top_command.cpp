@@ -1,6 +1,8 @@
 // rsca top [APP]: CPU, resident memory and threads of the daemons and of every process the nodes
 // run, each node asked for its own (node.top) and the domain daemon for itself (domain.top), all at
 // once. A node that does not answer is listed as unreachable; the others are shown all the same.
+// So is a node the domain has lost (its DDS lease ran out): it is not asked, and not left out
+// either, since its devices and components are still the domain's.
 #include <future>
 #include <optional>
 #include <string>
@@ -35,6 +37,7 @@ struct Row {
 struct Unreachable {
   std::string node;
   std::string error;
+  bool lost = false; // the domain lost it: not asked
 };
 
 struct Table {
@@ -47,7 +50,7 @@ using Pending = std::future<control::CallResult<Json>>;
 void add_node(Table &table, const std::string &node, Pending &pending, const std::string &app) {
   auto reply = control::reply_of<node_ops::Top>(pending.get());
   if (!reply) {
-    table.unreachable.push_back({node, reply.error().message});
+    table.unreachable.push_back({node, reply.error().message, false});
     return;
   }
   if (app.empty())
@@ -62,7 +65,7 @@ void add_node(Table &table, const std::string &node, Pending &pending, const std
 void add_domain(Table &table, Pending &pending) {
   auto reply = control::reply_of<domain_ops::Top>(pending.get());
   if (!reply) {
-    table.unreachable.push_back({"domain", reply.error().message});
+    table.unreachable.push_back({"domain", reply.error().message, false});
     return;
   }
   table.rows.push_back({reply->host, "domain", "rsca-domaind", "", "", reply->daemon});
@@ -83,7 +86,7 @@ Json json_of(const Table &table) {
   }
   Json unreachable = Json::array();
   for (const auto &u : table.unreachable)
-    unreachable.push_back({{"node", u.node}, {"error", u.error}});
+    unreachable.push_back({{"node", u.node}, {"error", u.error}, {"lost", u.lost}});
   return {{"processes", std::move(processes)}, {"unreachable", std::move(unreachable)}};
 }
 
@@ -128,6 +131,9 @@ int top(const std::string &app, const GlobalOptions &global) {
     add_domain(table, *domain);
   for (std::size_t i = 0; i < pending.size(); ++i)
     add_node(table, nodes->nodes[i].name, pending[i], app);
+  for (const auto &n : nodes->lost)
+    table.unreachable.push_back(
+        {n.name, "lost: its DDS lease ran out; the domain keeps it until it is back", true});
   if (global.json)
     print_json(json_of(table));
   else
