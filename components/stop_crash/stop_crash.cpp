@@ -14,8 +14,11 @@ class StopCrash final : public Component {
 public:
   explicit StopCrash(const Context &context)
       : Component(context), commands_(uses_port<rsca::port::Command>("command_out")) {
-    provides_port<rsca::port::Samples>("range_in",
-                                       [this](const rsca::port::Samples &s) { on_range(s); });
+    // on_range is short and never waits (atomics, one write to a keep-last port): it runs on
+    // DDS's receive thread when it can, and the command leaves a thread wake-up sooner.
+    provides_port<rsca::port::Samples>(
+        "range_in", [this](const rsca::port::Samples &s) { on_range(s); },
+        rsca::component::Delivery::Listener);
     property("threshold", threshold_);
     property("speed", speed_);
     property("stopped", stopped_);

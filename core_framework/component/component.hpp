@@ -135,10 +135,14 @@ protected:
   UsesPort<T> &uses_port(std::string name) {
     return add_port(std::make_unique<UsesPort<T>>(std::move(name)));
   }
-  // A provides port of the SCD; `on_sample` runs on the receive thread while started.
+  // A provides port of the SCD; `on_sample` runs on the receive thread while started. With
+  // Delivery::Listener (component/ports.hpp) the author promises `on_sample` is short and never
+  // blocks, and it then runs on DDS's receive thread when it can, a thread wake-up sooner.
   template <typename T>
-  ProvidesPort<T> &provides_port(std::string name, typename ProvidesPort<T>::Callback on_sample) {
-    return add_port(std::make_unique<ProvidesPort<T>>(std::move(name), std::move(on_sample)));
+  ProvidesPort<T> &provides_port(std::string name, typename ProvidesPort<T>::Callback on_sample,
+                                 Delivery delivery = Delivery::ReceiveThread) {
+    return add_port(
+        std::make_unique<ProvidesPort<T>>(std::move(name), std::move(on_sample), delivery));
   }
 
   // A uses port of a CF control interface (its SCD repid IDL:CF/Resource:1.0 or one it

@@ -231,7 +231,7 @@ CallResult<protocol::Empty> Host::op_start(const Empty &, const Context &) {
     if (auto ok = c().start(); !ok)
       return tl::unexpected(ok.error());
   }
-  delivering_ = true;
+  loop_->set_delivering(true);
   start_service();
   set_state(State::Started);
   return Empty{};

@@ -136,7 +136,9 @@ Expected<void> Host::open(std::shared_ptr<ParticipantSource> participants,
   participants_ = std::move(participants);
   on_released_ = std::move(on_released);
   address_ = c().context().control_address;
-  auto loop = ReceiveLoop::start([this] { poll_ports(); });
+  // The property lock is the one a callback may take (component.hpp): a callback delivered on a
+  // DDS listener's thread runs only while it is free, so that it never waits there for it.
+  auto loop = ReceiveLoop::start([this] { poll_ports(); }, &c().properties_mutex_);
   if (!loop)
     return tl::unexpected(loop.error());
   loop_ = std::move(*loop);
@@ -169,8 +171,15 @@ void Host::close() {
     endpoint_->stop_serving(address_); // waits for running handlers
   }
   stop_service();
-  if (loop_)
+  if (loop_) {
     loop_->stop();
+    // No callback on a DDS listener's thread either (Delivery::Listener) from here on: the
+    // component's own members go before its ports, which are what would stop the listeners.
+    loop_->set_delivering(false);
+    if (component_)
+      for (const auto &port : c().ports_)
+        port->quiesce();
+  }
   // Only once the receive thread has stopped: it reports connection problems through the
   // endpoint (ThreadSanitizer saw it read endpoint_ while close cleared it, then call through
   // null: a consumer crashed as it exited).
@@ -239,7 +248,7 @@ ResourceUsesPort *Host::find_resource_port(const std::string &name) const {
 }
 
 void Host::poll_ports() {
-  const bool deliver = delivering_.load();
+  const bool deliver = loop_->delivering();
   for (const auto &port : c().ports_)
     if (port->direction() == profile::PortDirection::Provides)
       port->take_all(deliver);
@@ -355,7 +364,8 @@ void Host::service_loop() {
 // the stop hook runs.
 void Host::stop_component() {
   stop_service();
-  delivering_ = false;
+  if (loop_)
+    loop_->set_delivering(false);
   for (const auto &port : c().ports_)
     port->quiesce();
 }

@@ -115,7 +115,6 @@ private:
   std::function<void()> on_released_;
 
   std::mutex lifecycle_; // one lifecycle operation at a time
-  std::atomic<bool> delivering_{false};
   std::map<std::pair<std::string, std::string>, std::uint32_t> unreported_problems_;
   std::chrono::steady_clock::time_point last_problem_report_{};
   static constexpr std::chrono::milliseconds kProblemCheck{100};

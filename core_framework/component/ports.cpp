@@ -8,76 +8,20 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "component/data_connection.hpp"
 #include "component/filter_fields.hpp"
-#include "component/liveliness_ticker.hpp"
-#include "component/local_topics.hpp"
 #include "component/port_record.hpp"
 #include "component/port_wire.hpp"
-#include "component/receive_loop.hpp"
 #include "shm/process_arena.hpp"
-#include "shm/ring.hpp"
 
 namespace rsca::component {
-
-namespace detail {
-
-// One connection of a port: its topic and its writer or reader, or its in-host topic. The reader
-// leaves the receive loop (or its inbox the topic) first, then members are destroyed in reverse
-// order: the reader or writer, then the topic.
-struct DataConnection {
-  std::string topic_name;
-  dds::Entity topic;
-  dds::Entity entity; // the writer (uses) or reader (provides)
-  ReceiveLoop *loop = nullptr;
-  std::atomic<std::uint64_t> samples{0};
-  std::optional<ContentFilter> filter; // provides only: what is delivered
-  std::atomic<std::uint64_t> filtered{0};
-
-  // In-host: the topic, a reader's inbox, and the deadline, which each end checks itself as DDS
-  // would (requested by the reader, offered by the writer).
-  std::shared_ptr<LocalTopic> local;
-  std::shared_ptr<LocalInbox> inbox;
-  std::chrono::nanoseconds deadline{0};
-  // The last write (uses) or arrival (provides), steady clock ns; 0: none yet.
-  std::atomic<std::int64_t> last_sample_ns{0};
-  std::atomic<std::uint32_t> deadline_missed{0};
-  std::uint32_t deadline_periods_reported = 0; // provides: of the current gap (receive thread)
-  bool watched = false; // a reader with a deadline or a liveliness lease: problems to look for
-
-  // Same-host: the ring's writer or reader; the deadline as in-host. Lost writers already
-  // reported (provides, receive thread).
-  std::optional<shm::RingWriter> ring_writer;
-  std::optional<shm::RingReader> ring_reader;
-  std::uint32_t writers_lost_reported = 0;
-  std::chrono::nanoseconds lease{0}; // a reader's liveliness lease (0: none)
-  // The ring's alive_ns when lost liveliness was last reported (receive thread): a gap is
-  // reported once, however it was seen.
-  std::int64_t lost_at_alive_ns = -1;
-  bool ticking = false; // the writer's liveliness is asserted by the ticker
-  bool relayed = false; // the node relays the ring to and from other hosts
-
-  ~DataConnection() {
-    if (ticking)
-      LivelinessTicker::instance().remove(&*ring_writer);
-    if (loop != nullptr && entity)
-      loop->detach(entity.get());
-    if (local && inbox)
-      local->remove_reader(inbox.get());
-    else if (local)
-      local->remove_writer();
-  }
-
-  bool in_host() const { return local != nullptr; }
-  bool same_host() const { return ring_writer || ring_reader; }
-  // Its ends count deadlines themselves, as DDS would (no DDS entity does it for them).
-  bool own_deadline() const { return in_host() || same_host(); }
-};
-
-} // namespace detail
 
 namespace {
 
 using detail::DataConnection;
+using detail::deadline_misses;
+using detail::note_local_write;
+using detail::steady_ns;
 
 constexpr std::uint32_t kTakeBatch = 32;
 
@@ -91,10 +35,30 @@ open_writer(dds_entity_t participant, std::unique_ptr<DataConnection> c, const d
   return c;
 }
 
+// The data-available listener of a reader whose port delivers on the listener's thread: Cyclone's
+// receive thread for a remote writer, the writer's own thread for one in this process.
+void on_data_here(dds_entity_t, void *connection) {
+  auto *c = static_cast<DataConnection *>(connection);
+  c->listened_by->take_here(*c);
+}
+
+// Its own listener, with the connection as the argument (Cyclone copies the listener: it need
+// not outlive the call). Detached as the loop's listener is (~DataConnection).
+Expected<void> listen_here(DataConnection &c) {
+  std::unique_ptr<dds_listener_t, decltype(&dds_delete_listener)> listener(dds_create_listener(&c),
+                                                                           &dds_delete_listener);
+  dds_lset_data_available(listener.get(), &on_data_here);
+  if (dds_return_t rc = dds_set_listener(c.entity.get(), listener.get()); rc < 0)
+    return tl::unexpected(dds::dds_error(rc, "setting a reader's listener"));
+  c.loop->wake(); // what arrived before the listener was set
+  return {};
+}
+
+// `listened_by`: the port, when its callback may run on the listener's thread.
 Expected<std::unique_ptr<DataConnection>> open_reader(dds_entity_t participant,
                                                       detail::ReceiveLoop *loop,
                                                       std::unique_ptr<DataConnection> c,
-                                                      const dds_qos_t *qos) {
+                                                      const dds_qos_t *qos, PortBase *listened_by) {
   if (loop == nullptr)
     return make_error({"port", 0, 0}, "port", "no receive loop for a provides port");
   auto reader = dds::checked(dds_create_reader(participant, c->topic.get(), qos, nullptr),
@@ -102,12 +66,14 @@ Expected<std::unique_ptr<DataConnection>> open_reader(dds_entity_t participant,
   if (!reader)
     return tl::unexpected(reader.error());
   c->entity = std::move(*reader);
-  if (auto attached = loop->attach(c->entity.get()); !attached)
+  c->loop = loop;
+  c->listened_by = listened_by;
+  auto attached = listened_by ? listen_here(*c) : loop->attach(c->entity.get());
+  if (!attached)
     return tl::unexpected(attached.error());
   // Deadline misses and lost liveliness are looked for by the loop's owner now and then
   // (take_problems), not waited for: a status check at every sample contends with Cyclone's
   // receive thread for the reader's locks.
-  c->loop = loop;
   return c;
 }
 
@@ -163,90 +129,11 @@ std::int32_t matched_count(const DataConnection &c, profile::PortDirection direc
              : 0;
 }
 
-std::int64_t steady_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(
-             std::chrono::steady_clock::now().time_since_epoch())
-      .count();
-}
-
-// Whole deadline periods from `since_ns` to `now_ns`.
-std::uint32_t periods_between(std::int64_t since_ns, std::int64_t now_ns,
-                              std::chrono::nanoseconds deadline) {
-  if (since_ns == 0 || deadline.count() <= 0 || now_ns <= since_ns)
-    return 0;
-  return static_cast<std::uint32_t>((now_ns - since_ns) / deadline.count());
-}
-
-// An in-host writer's offered deadline: the periods each gap between writes spanned.
-void note_local_write(DataConnection &c) {
-  if (c.deadline.count() <= 0)
-    return;
-  const std::int64_t now = steady_ns();
-  const std::int64_t before = c.last_sample_ns.exchange(now, std::memory_order_relaxed);
-  if (auto missed = periods_between(before, now, c.deadline); missed > 0)
-    c.deadline_missed.fetch_add(missed, std::memory_order_relaxed);
-}
-
-// An in-host reader's requested deadline, counted as DDS counts it (once a sample has arrived,
-// each period without one): the periods of the current gap not reported yet.
-std::uint32_t local_deadline_misses(DataConnection &c) {
-  const auto periods =
-      periods_between(c.last_sample_ns.load(std::memory_order_relaxed), steady_ns(), c.deadline);
-  if (periods <= c.deadline_periods_reported)
-    return 0;
-  const std::uint32_t missed = periods - c.deadline_periods_reported;
-  c.deadline_periods_reported = periods;
-  c.deadline_missed.fetch_add(missed, std::memory_order_relaxed);
-  return missed;
-}
-
-// A same-host reader's lost liveliness not reported yet: writers whose process ended while
-// connected (the node counts them in the ring, and so does its relay for writers on other hosts
-// that DDS saw lose theirs), or a lease that passed since a writer was last alive. Once per gap,
-// as DDS counts a writer going from alive to not alive: a gap is the ring's last sign of life,
-// reported once whichever way it was seen.
-std::uint32_t lost_writers(DataConnection &c) {
-  if (!c.ring_reader)
-    return 0;
-  const std::uint32_t lost = c.ring_reader->writers_lost();
-  const std::uint32_t change = lost - c.writers_lost_reported;
-  c.writers_lost_reported = lost;
-  const std::int64_t alive = c.ring_reader->alive_ns();
-  if (change > 0) {
-    c.lost_at_alive_ns = alive;
-    return change;
-  }
-  if (c.lease.count() <= 0 || alive == 0 || alive == c.lost_at_alive_ns)
-    return 0;
-  // A writer on another host is alive while its node's relay says so (DDS liveliness).
-  const bool expired = steady_ns() - alive > c.lease.count() && c.ring_reader->remote_alive() == 0;
-  if (!expired)
-    return 0;
-  c.lost_at_alive_ns = alive;
-  return 1;
-}
-
-// How often the writer (uses) or the reader's writers (provides) missed the connection's deadline.
-std::uint32_t deadline_misses(const DataConnection &c, profile::PortDirection direction) {
-  if (c.own_deadline() && direction == profile::PortDirection::Uses) // and the current gap
-    return c.deadline_missed.load(std::memory_order_relaxed) +
-           periods_between(c.last_sample_ns.load(std::memory_order_relaxed), steady_ns(),
-                           c.deadline);
-  if (c.own_deadline())
-    return c.deadline_missed.load(std::memory_order_relaxed);
-  const dds_entity_t entity = c.entity.get();
-  if (direction == profile::PortDirection::Uses) {
-    dds_offered_deadline_missed_status_t status{};
-    return dds_get_offered_deadline_missed_status(entity, &status) == 0 ? status.total_count : 0;
-  }
-  dds_requested_deadline_missed_status_t status{};
-  return dds_get_requested_deadline_missed_status(entity, &status) == 0 ? status.total_count : 0;
-}
-
 } // namespace
 
-PortBase::PortBase(std::string name, profile::PortDirection direction, port::PortType type)
-    : name_(std::move(name)), direction_(direction), type_(type) {}
+PortBase::PortBase(std::string name, profile::PortDirection direction, port::PortType type,
+                   Delivery delivery)
+    : name_(std::move(name)), direction_(direction), type_(type), delivery_(delivery) {}
 
 PortBase::~PortBase() {
   disconnect_all();
@@ -286,7 +173,8 @@ Expected<void> PortBase::connect(dds_entity_t participant, detail::ReceiveLoop *
   c->topic = std::move(*created);
   auto opened = direction_ == profile::PortDirection::Uses
                     ? open_writer(participant, std::move(c), qos)
-                    : open_reader(participant, loop, std::move(c), qos);
+                    : open_reader(participant, loop, std::move(c), qos,
+                                  delivery_ == Delivery::Listener ? this : nullptr);
   if (!opened)
     return tl::unexpected(opened.error());
   std::unique_lock lock(mutex_);
@@ -375,38 +263,6 @@ std::optional<std::int32_t> PortBase::matched(const std::string &connection) con
   return matched_count(*it->second, direction_);
 }
 
-std::vector<ConnectionProblem> PortBase::take_problems() {
-  std::vector<ConnectionProblem> out;
-  if (direction_ != profile::PortDirection::Provides)
-    return out;
-  std::shared_lock lock(mutex_);
-  constexpr std::uint32_t kProblems =
-      DDS_REQUESTED_DEADLINE_MISSED_STATUS | DDS_LIVELINESS_CHANGED_STATUS;
-  for (const auto &[id, c] : connections_) {
-    if (c->own_deadline()) {
-      if (auto missed = local_deadline_misses(*c); missed > 0)
-        out.push_back({id, "deadline missed", missed});
-      if (auto lost = lost_writers(*c); lost > 0)
-        out.push_back({id, "liveliness lost", lost});
-      continue;
-    }
-    std::uint32_t changed = 0;
-    if (dds_get_status_changes(c->entity.get(), &changed) != 0 || (changed & kProblems) == 0)
-      continue;
-    dds_requested_deadline_missed_status_t deadline{};
-    if (dds_get_requested_deadline_missed_status(c->entity.get(), &deadline) == 0 &&
-        deadline.total_count_change > 0)
-      out.push_back(
-          {id, "deadline missed", static_cast<std::uint32_t>(deadline.total_count_change)});
-    dds_liveliness_changed_status_t liveliness{};
-    if (dds_get_liveliness_changed_status(c->entity.get(), &liveliness) == 0 &&
-        liveliness.not_alive_count_change > 0)
-      out.push_back(
-          {id, "liveliness lost", static_cast<std::uint32_t>(liveliness.not_alive_count_change)});
-  }
-  return out;
-}
-
 bool PortBase::watched() const {
   std::shared_lock lock(mutex_);
   return std::any_of(connections_.begin(), connections_.end(),
@@ -414,6 +270,10 @@ bool PortBase::watched() const {
 }
 
 void PortBase::take_all(bool) {}
+
+void PortBase::take_here(DataConnection &c) {
+  c.loop->wake();
+}
 
 void PortBase::quiesce() {
   std::unique_lock lock(mutex_);
@@ -478,6 +338,16 @@ void ProvidesPort<T>::take_all(bool deliver) {
     else
       take_dds(*c, deliver);
   }
+}
+
+// Not waiting for the port's lock: a (dis)connect holds it, and a disconnect waits, in
+// dds_set_listener, for this very call to end.
+template <typename T>
+void ProvidesPort<T>::take_here(DataConnection &c) {
+  std::shared_lock lock(mutex_, std::try_to_lock);
+  if (lock && c.loop->run_here([this, &c] { take_dds(c, true); }))
+    return;
+  c.loop->wake();
 }
 
 template <typename T>

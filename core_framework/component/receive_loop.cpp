@@ -30,14 +30,15 @@ std::chrono::microseconds spin_time() {
 
 } // namespace
 
-Expected<std::unique_ptr<ReceiveLoop>> ReceiveLoop::start(std::function<void()> poll) {
-  std::unique_ptr<ReceiveLoop> loop(new ReceiveLoop(std::move(poll)));
+Expected<std::unique_ptr<ReceiveLoop>> ReceiveLoop::start(std::function<void()> poll,
+                                                          std::recursive_mutex *owner_lock) {
+  std::unique_ptr<ReceiveLoop> loop(new ReceiveLoop(std::move(poll), owner_lock));
   loop->thread_ = std::thread([raw = loop.get()] { raw->run(); });
   return loop;
 }
 
-ReceiveLoop::ReceiveLoop(std::function<void()> poll)
-    : listener_(dds_create_listener(this)), poll_(std::move(poll)) {
+ReceiveLoop::ReceiveLoop(std::function<void()> poll, std::recursive_mutex *owner_lock)
+    : listener_(dds_create_listener(this)), poll_(std::move(poll)), owner_lock_(owner_lock) {
   dds_lset_data_available(listener_, &ReceiveLoop::on_data_available);
   if (auto *arena = shm::ProcessArena::inherited())
     if (auto *bell = arena->allocate_doorbell()) {
@@ -78,6 +79,11 @@ void ReceiveLoop::detach(dds_entity_t reader) {
 
 void ReceiveLoop::on_data_available(dds_entity_t, void *loop) {
   static_cast<const ReceiveLoop *>(loop)->wake();
+}
+
+bool &ReceiveLoop::delivering_on_this_thread() {
+  thread_local bool delivering = false;
+  return delivering;
 }
 
 void ReceiveLoop::wake() const {
@@ -124,7 +130,11 @@ void ReceiveLoop::run() {
     }
     if (stopping_.load())
       return;
+    std::lock_guard one_at_a_time(delivery_); // a listener's delivery under way ends first
+    bool &marked = delivering_on_this_thread();
+    marked = true;
     poll_();
+    marked = false;
   }
 }
 

@@ -1,0 +1,89 @@
+// Private to the component runtime: one connection of a data port (component/ports.hpp), and
+// how its ends count the QoS problems DDS would count for them (port_problems.cpp).
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "common/content_filter.hpp"
+#include "component/liveliness_ticker.hpp"
+#include "component/local_topics.hpp"
+#include "component/ports.hpp"
+#include "component/receive_loop.hpp"
+#include "dds/entity.hpp"
+#include "shm/ring.hpp"
+
+namespace rsca::component {
+
+namespace detail {
+
+// One connection of a port: its topic and its writer or reader, or its in-host topic. The reader
+// leaves the receive loop (or its inbox the topic) first, then members are destroyed in reverse
+// order: the reader or writer, then the topic.
+struct DataConnection {
+  std::string topic_name;
+  dds::Entity topic;
+  dds::Entity entity; // the writer (uses) or reader (provides)
+  ReceiveLoop *loop = nullptr;
+  // A reader whose DDS listener delivers on its own thread (Delivery::Listener): its port.
+  PortBase *listened_by = nullptr;
+  std::atomic<std::uint64_t> samples{0};
+  std::optional<ContentFilter> filter; // provides only: what is delivered
+  std::atomic<std::uint64_t> filtered{0};
+
+  // In-host: the topic, a reader's inbox, and the deadline, which each end checks itself as DDS
+  // would (requested by the reader, offered by the writer).
+  std::shared_ptr<LocalTopic> local;
+  std::shared_ptr<LocalInbox> inbox;
+  std::chrono::nanoseconds deadline{0};
+  // The last write (uses) or arrival (provides), steady clock ns; 0: none yet.
+  std::atomic<std::int64_t> last_sample_ns{0};
+  std::atomic<std::uint32_t> deadline_missed{0};
+  std::uint32_t deadline_periods_reported = 0; // provides: of the current gap (receive thread)
+  bool watched = false; // a reader with a deadline or a liveliness lease: problems to look for
+
+  // Same-host: the ring's writer or reader; the deadline as in-host. Lost writers already
+  // reported (provides, receive thread).
+  std::optional<shm::RingWriter> ring_writer;
+  std::optional<shm::RingReader> ring_reader;
+  std::uint32_t writers_lost_reported = 0;
+  std::chrono::nanoseconds lease{0}; // a reader's liveliness lease (0: none)
+  // The ring's alive_ns when lost liveliness was last reported (receive thread): a gap is
+  // reported once, however it was seen.
+  std::int64_t lost_at_alive_ns = -1;
+  bool ticking = false; // the writer's liveliness is asserted by the ticker
+  bool relayed = false; // the node relays the ring to and from other hosts
+
+  ~DataConnection() {
+    if (ticking)
+      LivelinessTicker::instance().remove(&*ring_writer);
+    if (loop != nullptr && entity)
+      loop->detach(entity.get());
+    if (local && inbox)
+      local->remove_reader(inbox.get());
+    else if (local)
+      local->remove_writer();
+  }
+
+  bool in_host() const { return local != nullptr; }
+  bool same_host() const { return ring_writer || ring_reader; }
+  // Its ends count deadlines themselves, as DDS would (no DDS entity does it for them).
+  bool own_deadline() const { return in_host() || same_host(); }
+};
+
+} // namespace detail
+
+namespace detail {
+
+std::int64_t steady_ns();
+// An in-host or same-host writer's offered deadline: the periods each gap between writes spanned.
+void note_local_write(DataConnection &c);
+// How often the writer (uses) or the reader's writers (provides) missed the connection's deadline.
+std::uint32_t deadline_misses(const DataConnection &c, profile::PortDirection direction);
+
+} // namespace detail
+} // namespace rsca::component
