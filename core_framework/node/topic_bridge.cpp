@@ -2,8 +2,12 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
+#include <cstdlib>
 #include <optional>
 #include <vector>
+
+#include <pthread.h>
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -19,6 +23,26 @@ namespace {
 // The most matched endpoints a relay counts at once (a topic's readers or writers on other
 // hosts, each a node or a process of its own).
 constexpr std::size_t kMostMatched = 1024;
+
+// How long the relay's thread looks for more of the host's records after it relayed some, before
+// it sleeps: RSCA_RELAY_SPIN_US, 0 (never spins) by default. Meant to save the wake of the
+// sending node's relay that makes a round trip between hosts 1.46x raw DDS's; in a ping-pong the
+// next record comes a round trip later (~70-110 us here), so only a spin longer than that can
+// help. Measured on the shared 2-core VM (docs/measurements.md, "The relay thread that spins"),
+// 200 us did not lower the p50 and in one series of three quadrupled it, while the two relays
+// took ~1 CPU each during the exchange: spinning threads take the CPU from the ones that must
+// run next when the host is busy. Off until a quiet host shows it pays.
+std::chrono::microseconds relay_spin_time() {
+  static const std::chrono::microseconds spin = [] {
+    const char *text = std::getenv("RSCA_RELAY_SPIN_US");
+    if (text == nullptr || *text == '\0')
+      return std::chrono::microseconds{0};
+    char *end = nullptr;
+    const long value = std::strtol(text, &end, 10);
+    return std::chrono::microseconds{*end == '\0' && value >= 0 ? value : 0};
+  }();
+  return spin;
+}
 
 struct ListenerDeleter {
   void operator()(dds_listener_t *l) const { dds_delete_listener(l); }
@@ -78,7 +102,7 @@ struct TopicBridge::Relay {
   std::int32_t readers_counted = 0, writers_counted = 0, alive_counted = 0;
 
   bool idle() const { return !writer && !reader; }
-  void pump();
+  std::size_t pump(); // the records relayed out
   void apply_counts();
   void uncount();
 };
@@ -116,9 +140,10 @@ void on_data_available(dds_entity_t reader, void *arg) {
 
 } // namespace
 
-void TopicBridge::Relay::pump() {
+std::size_t TopicBridge::Relay::pump() {
+  std::size_t relayed = 0;
   if (writer && ring_reader) {
-    out_convert->to_dds(*ring_reader, writer.get());
+    relayed = out_convert->to_dds(*ring_reader, writer.get());
     if (lease_ns > 0) {
       const std::int64_t alive = owner.host_alive_ns(); // not what came from other hosts
       if (alive != alive_seen) {
@@ -128,6 +153,7 @@ void TopicBridge::Relay::pump() {
     }
   }
   apply_counts();
+  return relayed;
 }
 
 // The peers on other hosts, as DDS matched them, into the ring's counts (the node's own reader
@@ -168,6 +194,8 @@ TopicBridge::start(std::shared_ptr<dds::Participant> participant, const shm::Are
     return make_error({"node", 0, 0}, "relay", "no doorbell in the host's arena for the relay");
   std::unique_ptr<TopicBridge> bridge(new TopicBridge(std::move(participant), arena, doorbell));
   bridge->thread_ = std::thread([b = bridge.get()] { b->run(); });
+  // Named, so that its CPU (it spins after data) can be told from the node's other threads.
+  pthread_setname_np(bridge->thread_.native_handle(), "rsca-relay");
   return bridge;
 }
 
@@ -198,12 +226,13 @@ int TopicBridge::sleep_ms() const {
 }
 
 void TopicBridge::run() {
-  auto *bell = arena_.object<shm::Doorbell>(doorbell_);
+  shm::SpinWait wait(*arena_.object<shm::Doorbell>(doorbell_), /*shared=*/true, relay_spin_time());
   int timeout_ms = 1000;
+  bool relayed = false; // the last round relayed records out: the thread spins before it sleeps
   std::vector<std::shared_ptr<Relay>> relays;
   for (;;) {
-    shm::sleep(*bell, timeout_ms, /*shared=*/true);
-    shm::take(*bell);
+    wait.wait(relayed, timeout_ms);
+    relayed = false;
     relays.clear();
     {
       std::lock_guard lock(mutex_);
@@ -215,8 +244,8 @@ void TopicBridge::run() {
     }
     for (auto &relay : relays) { // each on its own lock: a close waits for its relay only
       std::lock_guard lock(relay->lock);
-      if (!relay->closed)
-        relay->pump();
+      if (!relay->closed && relay->pump() > 0)
+        relayed = true;
     }
   }
 }

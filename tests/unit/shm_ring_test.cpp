@@ -2,8 +2,12 @@
 // its writers, readers, depths and overruns, its doorbells, and a ring between two processes.
 #include <catch2/catch.hpp>
 
+#include <atomic>
+#include <chrono>
 #include <cstring>
+#include <functional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <sys/wait.h>
@@ -50,6 +54,49 @@ struct RingFixture {
   shm::RingReader reader(shm::RingOwner &owner, std::uint64_t at, std::uint32_t depth = 0) {
     const auto slot = owner.claim_reader().value();
     return shm::RingReader::open(arena, at, slot, bell_at, depth).value();
+  }
+};
+
+// Waits for a condition another thread makes true; false only if it never comes (a hang guard,
+// not a measure of speed).
+bool eventually(const std::function<bool()> &condition) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (!condition()) {
+    if (std::chrono::steady_clock::now() > deadline)
+      return false;
+    std::this_thread::yield();
+  }
+  return true;
+}
+
+// The node's relay thread, reduced to its wait (node/topic_bridge.cpp): it waits on the bell with
+// a SpinWait, spinning after a round that took records, and takes what the ring has.
+struct RelayThread {
+  RingFixture &f;
+  shm::RingReader reader;
+  shm::SpinWait wait;
+  std::vector<std::uint64_t> got; // the thread's until it is joined
+  std::atomic<std::size_t> delivered{0};
+  std::atomic<bool> stopping{false};
+  std::thread thread;
+
+  RelayThread(RingFixture &fixture, shm::RingReader ring_reader, std::chrono::microseconds spin)
+      : f(fixture), reader(std::move(ring_reader)), wait(*f.bell, /*shared=*/true, spin) {
+    thread = std::thread([this] {
+      bool took = false;
+      while (!stopping.load()) {
+        wait.wait(took, 1000);
+        const auto numbers = take_numbers(reader);
+        got.insert(got.end(), numbers.begin(), numbers.end());
+        delivered.store(got.size());
+        took = !numbers.empty();
+      }
+    });
+  }
+  void stop() {
+    stopping = true;
+    shm::ring(*f.bell, shm::kWakeData, /*shared=*/true);
+    thread.join();
   }
 };
 
@@ -277,4 +324,58 @@ TEST_CASE("shm: port values round-trip as ring records, a short record is refuse
   CHECK(cback.name == "go");
   CHECK(cback.args == c.args);
   CHECK(cback.text == "now");
+}
+
+TEST_CASE("relay: a spinning wait takes the records written while it spins, in order, and never "
+          "sleeps between them",
+          "[shm][relay]") {
+  RingFixture f;
+  auto [owner, at] = f.make();
+  auto writer = shm::RingWriter::open(f.arena, at).value();
+  // A spin far longer than the test: each record is written after the last was taken, so the
+  // thread is spinning when it comes; only the wait for the first may sleep.
+  RelayThread relay(f, f.reader(owner, at), std::chrono::seconds(60));
+  constexpr std::uint64_t kRecords = 200;
+  for (std::uint64_t i = 0; i < kRecords; ++i) {
+    REQUIRE(write_number(writer, i));
+    REQUIRE(eventually([&] { return relay.delivered.load() == i + 1; }));
+  }
+  CHECK(relay.wait.sleeps() <= 1);
+  relay.stop();
+  REQUIRE(relay.got.size() == kRecords);
+  for (std::uint64_t i = 0; i < kRecords; ++i)
+    CHECK(relay.got[i] == i);
+  CHECK(relay.reader.dropped() == 0);
+}
+
+TEST_CASE("relay: a spinning wait goes back to sleep when no record comes, and a ring wakes it",
+          "[shm][relay]") {
+  RingFixture f;
+  auto [owner, at] = f.make();
+  auto writer = shm::RingWriter::open(f.arena, at).value();
+  RelayThread relay(f, f.reader(owner, at), std::chrono::microseconds(200));
+  // Asleep before any data: it never spins then.
+  REQUIRE(eventually([&] { return f.bell->sleeping.load() == 1; }));
+  CHECK(relay.wait.caught() == 0);
+  for (std::uint64_t round = 1; round <= 3; ++round) {
+    const auto slept = relay.wait.sleeps();
+    REQUIRE(write_number(writer, round));
+    REQUIRE(eventually([&] { return relay.delivered.load() == round; }));
+    // The spin after the record ends and the thread sleeps again on the futex.
+    REQUIRE(
+        eventually([&] { return relay.wait.sleeps() > slept && f.bell->sleeping.load() == 1; }));
+  }
+  relay.stop();
+  CHECK(relay.got == std::vector<std::uint64_t>{1, 2, 3});
+}
+
+TEST_CASE("relay: a wait with no spin sleeps after data too", "[shm][relay]") {
+  shm::Doorbell bell;
+  shm::SpinWait wait(bell, /*shared=*/false, std::chrono::microseconds(0));
+  shm::ring(bell, shm::kWakeNearData, /*shared=*/false);
+  CHECK(wait.wait(true, 1000) == shm::kWakeNearData); // rung before: no sleep
+  CHECK(wait.sleeps() == 0);
+  CHECK(wait.wait(true, 0) == 0); // nothing rang: it slept (a timeout of 0) without spinning
+  CHECK(wait.sleeps() == 1);
+  CHECK(wait.caught() == 0);
 }
