@@ -3,8 +3,8 @@
 #include <sched.h>
 
 #include <chrono>
-#include <cstdlib>
 
+#include "common/env_duration.hpp"
 #include "shm/process_arena.hpp"
 
 namespace rsca::component::detail {
@@ -17,14 +17,8 @@ constexpr int kWakeIntervalMs = 100;
 // How long the thread looks for more data before it sleeps: RSCA_RECEIVE_SPIN_US, 50 by default;
 // 0 never spins (for a robot that counts every milliwatt more than every microsecond).
 std::chrono::microseconds spin_time() {
-  static const std::chrono::microseconds spin = [] {
-    const char *text = std::getenv("RSCA_RECEIVE_SPIN_US");
-    if (text == nullptr || *text == '\0')
-      return std::chrono::microseconds{50};
-    char *end = nullptr;
-    const long value = std::strtol(text, &end, 10);
-    return std::chrono::microseconds{*end == '\0' && value >= 0 ? value : 50};
-  }();
+  static const std::chrono::microseconds spin =
+      microseconds_from_env("RSCA_RECEIVE_SPIN_US", std::chrono::microseconds{50});
   return spin;
 }
 

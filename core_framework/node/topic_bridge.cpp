@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
-#include <cstdlib>
 #include <optional>
 #include <vector>
 
@@ -12,6 +11,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "common/env_duration.hpp"
 #include "component/port_types.hpp"
 #include "component/record_relay.hpp"
 #include "dds/port_qos.hpp"
@@ -33,14 +33,8 @@ constexpr std::size_t kMostMatched = 1024;
 // took ~1 CPU each during the exchange: spinning threads take the CPU from the ones that must
 // run next when the host is busy. Off until a quiet host shows it pays.
 std::chrono::microseconds relay_spin_time() {
-  static const std::chrono::microseconds spin = [] {
-    const char *text = std::getenv("RSCA_RELAY_SPIN_US");
-    if (text == nullptr || *text == '\0')
-      return std::chrono::microseconds{0};
-    char *end = nullptr;
-    const long value = std::strtol(text, &end, 10);
-    return std::chrono::microseconds{*end == '\0' && value >= 0 ? value : 0};
-  }();
+  static const std::chrono::microseconds spin =
+      microseconds_from_env("RSCA_RELAY_SPIN_US", std::chrono::microseconds{0});
   return spin;
 }
 

@@ -4,8 +4,12 @@
 
 #include <chrono>
 #include <cstdint>
+#include <cstdlib>
 #include <string>
 #include <string_view>
+#include <utility>
+
+#include "common/env_duration.hpp"
 
 using namespace rsca;
 using namespace std::chrono_literals;
@@ -184,4 +188,19 @@ TEST_CASE("numbers outside the documented grammar are rejected", "[units]") {
   CHECK_FALSE(parse_duration("5.ms").has_value());
   CHECK_FALSE(parse_duration("-0ms").has_value());
   CHECK_FALSE(parse_size_bytes(".5KiB").has_value());
+}
+
+TEST_CASE("a duration from the environment: a whole number of microseconds, else the fallback",
+          "[units]") {
+  using std::chrono::microseconds;
+  const char *name = "RSCA_TEST_ENV_DURATION_US";
+  ::unsetenv(name);
+  CHECK(rsca::microseconds_from_env(name, microseconds{50}) == microseconds{50});
+  for (const auto &[text, expected] : {std::pair{"", 50}, std::pair{"200", 200}, std::pair{"0", 0},
+                                       std::pair{"-3", 50}, std::pair{"12us", 50}}) {
+    ::setenv(name, text, 1);
+    INFO(text);
+    CHECK(rsca::microseconds_from_env(name, microseconds{50}) == microseconds{expected});
+  }
+  ::unsetenv(name);
 }
