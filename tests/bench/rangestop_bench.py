@@ -9,6 +9,9 @@ run three ways, in real time, each over 20 runs (--quick: 1):
 - tcp: two processes over loopback TCP with TCP_NODELAY (tests/bench/rangestop/rangestop_tcp.cpp):
   the robot (world, sensor, drive) sends each reading with its timestamp, the controller answers
   with a command carrying it back. Delay: from the reading's timestamp to the command's arrival.
+- dds (not the paper's; a baseline of what rsca is built on): raw Cyclone DDS ping-pong between
+  the controller's and the robot's host with RangeStop's QoS, one round trip a sensor period
+  (run_dds). Delay: the round trip, a reading there and a command back.
 - rsca: a real local domain (rsca-domaind, rsca-noded for node1, a GPP, and rsca-noded for the
   robot's DCD), RangeStop launched: StopCrash in a process of its own on node1, the IRSensor and
   the DriveSystem devices in the robot's node daemon, connected over Cyclone DDS. Delay: what the
@@ -32,7 +35,8 @@ Delay percentiles are taken as the DriveSystem takes them (sorted[n/2], sorted[n
 With --hosts (root; tools/hosts), as the paper ran it, across two network hosts: the robot (its
 node daemon for rsca, the robot process for tcp) on one, the controller (node1 running StopCrash,
 the controller process) on the other, the domain daemon on a third; DDS and TCP over the hosts'
-network interfaces. It prints `ratio rsca/tcp delay p50 = R` (issue 21's target: at most 1.2).
+network interfaces. It prints `ratio rsca/tcp delay p50 = R` (issue 21's target: at most 1.2),
+and with the dds way `ratio rsca/dds delay p50 = R`.
 
 Every process started is stopped at the end, also on failure.
 """
@@ -46,11 +50,15 @@ import subprocess
 import sys
 import time
 
-from local_domain import Domain, NetHosts, Processes, on_host, skipped_without_hosts
+from local_domain import Domain, NetHosts, Processes, dds_env, on_host, skipped_without_hosts
+from port_bench_helpers import read_u64
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
-WAYS = ("inprocess", "tcp", "rsca")
+WAYS = ("inprocess", "tcp", "dds", "rsca")
+# The dds way's round trips a run: about the readings of one run of the others (the drive toward
+# the threshold at 0.3 m/s, 20 ms a reading).
+DDS_ROUND_TRIPS_A_RUN = 250
 LAUNCH_ATTEMPTS = 3
 # After the drive toward the threshold at full speed: the start (~0.1 s), the braking (~0.15 s),
 # and the rest of the margin for a late start on a busy host.
@@ -147,6 +155,40 @@ def run_tcp(args, runs, logs):
                                f"see {logs}/tcp-robot.log")
         controller.wait(timeout=10)  # it leaves when the robot hangs up
     return baseline_result(*parse_lines(out, exe))
+
+
+def run_dds(args, runs, logs):
+    """Raw Cyclone DDS between the controller's host and the robot's, with RangeStop's QoS
+    (reliable, keep last 1) and its pace: `rsca-bench-raw echo` where the controller runs, and
+    `rsca-bench-raw ping` where the robot runs, a ping every sensor period, each answered before
+    the next (--interval-us). A round trip is what the other ways' delay is: a reading to the
+    controller and a command back, two hops, with DDS's own threads woken from idle as a
+    periodic loop wakes them. Not a baseline rsca could beat by design (rsca carries its data on
+    Cyclone DDS), but it tells what of rsca's delay is DDS's."""
+    exe = os.path.join(args.bin, "rsca-bench-raw")
+    hosts = args.net_hosts
+    env = dds_env()
+    if hosts:
+        env["RSCA_DDS_INTERFACE"] = "eth0"
+    qos = json.dumps({"reliability": "reliable", "history": "keeplast", "depth": 1})
+    topics = [f"rsca_bench_rangestop_{name}_{os.getpid()}" for name in ("reading", "command")]
+    output = os.path.join(logs, "dds-rtt.bin")
+    count = DDS_ROUND_TRIPS_A_RUN * runs
+    with Processes() as procs:
+        procs.start(on_host(hosts and hosts[CONTROLLER_HOST],
+                            [exe, "echo", "--in", topics[0], "--out", topics[1], "--qos", qos]),
+                    env, os.path.join(logs, "dds-echo.log"))
+        ping = procs.start(
+            on_host(hosts and hosts[ROBOT_HOST],
+                    [exe, "ping", "--out", topics[0], "--in", topics[1], "--qos", qos,
+                     "--count", str(count), "--warmup", "20",
+                     "--interval-us", str(args.period_ms * 1000), "--output", output]),
+            env, os.path.join(logs, "dds-ping.log"))
+        ping.communicate(timeout=60 + count * args.period_ms / 1000 * 2)
+        if ping.returncode != 0:
+            raise RuntimeError(f"{exe} ping failed ({ping.returncode}), see {logs}/dds-ping.log")
+    delays = [ns / 1e3 for ns in read_u64(output)]
+    return {"delay_us": delay_summary(delays), "round_trips": len(delays)}
 
 
 class RobotDomain(Domain):
@@ -313,7 +355,7 @@ def experiment(args, parser):
                "host": {"cpus": os.cpu_count(), "machine": platform.machine(),
                         "loadavg_before": os.getloadavg()},
                "ways": {}}
-    run = {"inprocess": run_inprocess, "tcp": run_tcp, "rsca": run_rsca}
+    run = {"inprocess": run_inprocess, "tcp": run_tcp, "dds": run_dds, "rsca": run_rsca}
     for w in ways:
         print(f"{w}: {runs} runs in real time...", file=sys.stderr, flush=True)
         t = time.monotonic()
@@ -338,7 +380,12 @@ def experiment(args, parser):
     print("| --- | --- | --- | --- | --- | --- | --- | --- | --- |")
     for w in ways:
         r = results["ways"][w]
-        d, s = r["delay_us"], r["stop_distance_m"]
+        d = r["delay_us"]
+        if "stop_distance_m" not in r:  # dds: round trips, no robot
+            print(f"| {w} (round trip) | {r['round_trips']} | {d['mean']:.1f} | {d['p50']:.1f} | "
+                  f"{d['p99']:.1f} | | | | |")
+            continue
+        s = r["stop_distance_m"]
         print(f"| {w} | {len(r['runs'])} | {d['mean']:.1f} | {d['p50']:.1f} | {d['p99']:.1f} | "
               f"{s['mean']:.4f} | {s['sd']:.4f} | {s['min']:.4f} | {s['max']:.4f} |")
     if "prediction" in results:
@@ -356,6 +403,14 @@ def experiment(args, parser):
             json.dump(results, f, indent=2)
         where = "across hosts " if args.net_hosts else ""
         print(f"\nratio {where}rsca/tcp delay p50 = {ratio:.2f}")
+    if "rsca" in results["ways"] and "dds" in results["ways"]:
+        ratio = (results["ways"]["rsca"]["delay_us"]["p50"] /
+                 results["ways"]["dds"]["delay_us"]["p50"])
+        results["ratio_rsca_dds_p50"] = ratio
+        with open(args.out, "w") as f:
+            json.dump(results, f, indent=2)
+        where = "across hosts " if args.net_hosts else ""
+        print(f"ratio {where}rsca/dds delay p50 = {ratio:.2f}")
     if "rsca" in results["ways"]:
         print(f"rsca delay over {results['ways']['rsca']['delay_us']['samples']} commands "
               f"(all runs, DriveSystem); drive safety stops: "

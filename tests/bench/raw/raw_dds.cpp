@@ -183,9 +183,20 @@ void write_results(const std::string &path, const std::vector<std::uint64_t> &va
 
 // ---- ping-pong ---------------------------------------------------------------------------------
 
+// Sleeps until the monotonic time `at_ns` (ns); at once if it has passed.
+void pause_until(std::uint64_t at_ns) {
+  const std::uint64_t now = mono_ns();
+  if (at_ns <= now)
+    return;
+  const std::uint64_t ns = at_ns - now;
+  const timespec pause{static_cast<time_t>(ns / 1'000'000'000u),
+                       static_cast<long>(ns % 1'000'000'000u)};
+  nanosleep(&pause, nullptr);
+}
+
 int ping(const std::string &out_topic, const std::string &in_topic, const std::string &qos,
          Wake wake, std::uint64_t count, std::uint64_t warmup, std::uint64_t timeout_ms,
-         const std::string &output) {
+         std::uint64_t interval_us, const std::string &output) {
   Dds dds(qos);
   const dds_entity_t writer = dds.writer(dds.topic(&rsca_port_SampleSeq_desc, out_topic));
   Receiver in(dds, dds.reader(dds.topic(&rsca_port_SampleSeq_desc, in_topic)), wake);
@@ -228,6 +239,7 @@ int ping(const std::string &out_topic, const std::string &in_topic, const std::s
         rtts.push_back(now - sent_at);
       if (completed < target) {
         ++sample.sequence;
+        pause_until(sent_at + interval_us * 1000u);
         send(mono_ns());
       }
     } else if (mono_ns() - sent_at > timeout_ns) {
@@ -529,6 +541,10 @@ int main(int argc, char **argv) {
   ping_cmd->add_option("--count", count, "Round trips measured");
   ping_cmd->add_option("--warmup", warmup, "Round trips first, not measured");
   ping_cmd->add_option("--timeout-ms", timeout_ms, "Send a ping again after");
+  std::uint64_t interval_us = 0;
+  ping_cmd->add_option("--interval-us", interval_us,
+                       "Pings start at most this often (0: each at once after the last echo), "
+                       "as a periodic sensor's readings do");
   ping_cmd->add_option("--output", output, "File of the round-trip times")->required();
   const std::map<std::string, Wake> wakes{{"waitset", Wake::waitset}, {"listener", Wake::listener}};
   Wake wake = Wake::waitset;
@@ -580,7 +596,7 @@ int main(int argc, char **argv) {
   sigaction(SIGINT, &action, nullptr);
 
   if (*ping_cmd)
-    return ping(out_topic, in_topic, qos, wake, count, warmup, timeout_ms, output);
+    return ping(out_topic, in_topic, qos, wake, count, warmup, timeout_ms, interval_us, output);
   if (*echo_cmd)
     return echo(in_topic, out_topic, qos, wake);
   if (*pub_cmd)
