@@ -8,6 +8,7 @@
 
 #include "common/content_filter.hpp"
 #include "component/host.hpp"
+#include "component/tcp_stream.hpp"
 #include "control/operation.hpp"
 #include "dds/port_qos.hpp"
 
@@ -125,11 +126,14 @@ CallResult<protocol::Empty> Host::connect_resource_port(ResourceUsesPort &port,
   return Empty{};
 }
 
-CallResult<protocol::Empty> Host::op_connect(const op::ConnectRequest &r, const Context &) {
+CallResult<op::ConnectReply> Host::op_connect(const op::ConnectRequest &r, const Context &) {
   if (auto ok = check_named({{"connection", &r.connection}, {"port", &r.port}}); !ok)
     return tl::unexpected(ok.error());
-  if (auto *resource = find_resource_port(r.port))
-    return connect_resource_port(*resource, r);
+  if (auto *resource = find_resource_port(r.port)) {
+    if (auto ok = connect_resource_port(*resource, r); !ok)
+      return tl::unexpected(ok.error());
+    return op::ConnectReply{};
+  }
   const std::string topic = r.topic.value_or("");
   if (auto ok = check_named({{"topic", &topic}, {"repid", &r.repid}}); !ok)
     return tl::unexpected(ok.error());
@@ -163,6 +167,13 @@ CallResult<protocol::Empty> Host::op_connect(const op::ConnectRequest &r, const 
   if (c().state() == State::Released)
     return released();
   const bool local = r.local.value_or(false); // the other end is in this process
+  if (const auto typed = dds::connection_qos_from_json(r.qos.value_or(Json::object()));
+      !local && typed && typed->transport == profile::Transport::Tcp) {
+    if (filter)
+      return control::call_error(Status::BadRequest,
+                                 "a TCP stream carries no content filter (an event channel's)");
+    return connect_tcp(*port, r, qos->get());
+  }
   if (r.shared_memory.value_or(false) && !r.ring)
     return control::call_error(Status::BadRequest,
                                "a same-host connection needs the ring its node makes; was the "
@@ -187,7 +198,34 @@ CallResult<protocol::Empty> Host::op_connect(const op::ConnectRequest &r, const 
   log().info("port {}: connection {} on {}topic \"{}\"{}", r.port, r.connection,
              local ? "in-host " : (ring ? (ring->relayed ? "relayed " : "same-host ") : ""), topic,
              filter_text.empty() ? "" : fmt::format(" with filter \"{}\"", filter_text));
-  return Empty{};
+  return op::ConnectReply{};
+}
+
+// transport="tcp": the reader listens and answers where; the writer connects there. Called with
+// the lifecycle lock held.
+CallResult<op::ConnectReply> Host::connect_tcp(PortBase &port, const op::ConnectRequest &r,
+                                               const dds_qos_t *qos) {
+  // How long a writer's connect may take: the reader listens already (it was connected first).
+  constexpr std::chrono::milliseconds kConnectTimeout{2000};
+  const std::string token = r.tcp_token.value_or("");
+  if (!detail::valid_token(token))
+    return control::call_error(Status::BadRequest,
+                               "a TCP connection needs tcp_token, 8 to 64 hex digits");
+  const bool uses = port.direction() == profile::PortDirection::Uses;
+  const std::string peer = r.tcp_peer.value_or("");
+  if (uses && (peer.empty() || peer.size() > 64))
+    return control::call_error(
+        Status::BadRequest, "a TCP connection's writer needs tcp_peer, its reader's address:port");
+  auto endpoint = port.connect_tcp(loop_.get(), r.connection, qos, peer, token, kConnectTimeout);
+  if (!endpoint)
+    return control::call_error(Status::Failed, endpoint.error().to_string());
+  watch_connections();
+  log().info("port {}: connection {} on a TCP stream {} {}", r.port, r.connection,
+             uses ? "to" : "listening at", uses ? peer : *endpoint);
+  op::ConnectReply reply;
+  if (!uses)
+    reply.tcp_endpoint = *endpoint;
+  return reply;
 }
 
 CallResult<protocol::Empty> Host::op_disconnect(const op::DisconnectRequest &r, const Context &) {

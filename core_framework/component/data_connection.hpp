@@ -14,6 +14,7 @@
 #include "component/local_topics.hpp"
 #include "component/ports.hpp"
 #include "component/receive_loop.hpp"
+#include "component/tcp_stream.hpp"
 #include "dds/entity.hpp"
 #include "shm/ring.hpp"
 
@@ -44,6 +45,7 @@ struct DataConnection {
   std::atomic<std::int64_t> last_sample_ns{0};
   std::atomic<std::uint32_t> deadline_missed{0};
   std::uint32_t deadline_periods_reported = 0; // provides: of the current gap (receive thread)
+  std::int64_t deadline_gap_ns = 0; // provides: the last_sample_ns that gap began at (same)
   bool watched = false; // a reader with a deadline or a liveliness lease: problems to look for
 
   // Same-host: the ring's writer or reader; the deadline as in-host. Lost writers already
@@ -58,11 +60,18 @@ struct DataConnection {
   bool ticking = false; // the writer's liveliness is asserted by the ticker
   bool relayed = false; // the node relays the ring to and from other hosts
 
+  // A TCP stream (transport="tcp"): the writer's end, or the reader's, whose thread fills
+  // `inbox` or delivers on itself (Delivery::Listener). Last: destroyed first, so its thread has
+  // stopped before what it uses goes.
+  std::unique_ptr<TcpSender> tcp_out;
+  std::unique_ptr<TcpReceiver> tcp_in;
+
   ~DataConnection() {
     if (ticking)
       LivelinessTicker::instance().remove(&*ring_writer);
     if (loop != nullptr && entity)
       loop->detach(entity.get());
+    tcp_in.reset(); // its thread stops before the inbox it fills goes
     if (local && inbox)
       local->remove_reader(inbox.get());
     else if (local)
@@ -71,8 +80,9 @@ struct DataConnection {
 
   bool in_host() const { return local != nullptr; }
   bool same_host() const { return ring_writer || ring_reader; }
+  bool tcp() const { return tcp_out || tcp_in; }
   // Its ends count deadlines themselves, as DDS would (no DDS entity does it for them).
-  bool own_deadline() const { return in_host() || same_host(); }
+  bool own_deadline() const { return in_host() || same_host() || tcp(); }
 };
 
 } // namespace detail

@@ -94,7 +94,10 @@ private:
   CallResult<Empty> op_configure(const protocol::component::ConfigureRequest &r, const Context &);
   CallResult<protocol::component::QueryReply> op_query(const protocol::component::QueryRequest &r,
                                                        const Context &);
-  CallResult<Empty> op_connect(const protocol::component::ConnectRequest &r, const Context &);
+  CallResult<protocol::component::ConnectReply>
+  op_connect(const protocol::component::ConnectRequest &r, const Context &);
+  CallResult<protocol::component::ConnectReply>
+  connect_tcp(PortBase &port, const protocol::component::ConnectRequest &r, const dds_qos_t *qos);
   CallResult<Empty> op_disconnect(const protocol::component::DisconnectRequest &r, const Context &);
   CallResult<Empty> op_start(const Empty &, const Context &);
   CallResult<Empty> op_stop(const Empty &, const Context &);

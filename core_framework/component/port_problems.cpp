@@ -20,8 +20,13 @@ std::uint32_t periods_between(std::int64_t since_ns, std::int64_t now_ns,
 // An in-host reader's requested deadline, counted as DDS counts it (once a sample has arrived,
 // each period without one): the periods of the current gap not reported yet.
 std::uint32_t local_deadline_misses(DataConnection &c) {
-  const auto periods =
-      periods_between(c.last_sample_ns.load(std::memory_order_relaxed), steady_ns(), c.deadline);
+  // A sample since the last look began a new gap (one a TCP stream's thread delivered too).
+  const std::int64_t last = c.last_sample_ns.load(std::memory_order_relaxed);
+  if (last != c.deadline_gap_ns) {
+    c.deadline_gap_ns = last;
+    c.deadline_periods_reported = 0;
+  }
+  const auto periods = periods_between(last, steady_ns(), c.deadline);
   if (periods <= c.deadline_periods_reported)
     return 0;
   const std::uint32_t missed = periods - c.deadline_periods_reported;

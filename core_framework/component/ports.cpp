@@ -110,6 +110,10 @@ bool has_problems_to_watch(const dds_qos_t *qos) {
 }
 
 std::int32_t matched_count(const DataConnection &c, profile::PortDirection direction) {
+  if (c.tcp_out)
+    return c.tcp_out->readers();
+  if (c.tcp_in)
+    return c.tcp_in->writers();
   if (c.ring_writer)
     return c.ring_writer->readers();
   if (c.ring_reader)
@@ -275,6 +279,42 @@ void PortBase::take_here(DataConnection &c) {
   c.loop->wake();
 }
 
+void PortBase::take_frame(DataConnection &, const std::byte *, std::size_t) {}
+
+Expected<std::string> PortBase::connect_tcp(detail::ReceiveLoop *loop,
+                                            const std::string &connection, const dds_qos_t *qos,
+                                            const std::string &peer, const std::string &token,
+                                            std::chrono::milliseconds timeout) {
+  auto c = std::make_unique<DataConnection>();
+  c->topic_name = "tcp:" + connection;
+  c->deadline = requested_deadline(qos);
+  std::string endpoint;
+  if (direction_ == profile::PortDirection::Uses) {
+    auto sender = detail::TcpSender::connect(peer, token, timeout);
+    if (!sender)
+      return make_error({"port", 0, 0}, "port", sender.error());
+    c->tcp_out = std::move(*sender);
+  } else {
+    if (loop == nullptr)
+      return make_error({"port", 0, 0}, "port", "no receive loop for a provides port");
+    c->loop = loop;
+    c->watched = has_problems_to_watch(qos);
+    c->inbox = std::make_shared<detail::LocalInbox>(*loop, history_depth(qos));
+    auto receiver = detail::TcpReceiver::listen(
+        detail::listen_address(), token,
+        [this, conn = c.get()](const std::byte *data, std::size_t bytes) {
+          take_frame(*conn, data, bytes);
+        });
+    if (!receiver)
+      return make_error({"port", 0, 0}, "port", receiver.error());
+    endpoint = (*receiver)->endpoint();
+    c->tcp_in = std::move(*receiver);
+  }
+  std::unique_lock lock(mutex_);
+  connections_[connection] = std::move(c); // an earlier one of that id goes
+  return endpoint;
+}
+
 void PortBase::quiesce() {
   std::unique_lock lock(mutex_);
 }
@@ -295,6 +335,15 @@ WriteResult PortBase::write_all(const T &value) {
       if (!shared)
         shared = std::make_shared<const T>(value);
       c->local->publish(shared);
+    } else if (c->tcp_out) {
+      auto ok = c->tcp_out->send(port::record::size_of(value), [&value](std::byte *at) {
+        port::record::Writer w(at);
+        port::record::write(value, w);
+      });
+      if (!ok) {
+        failed(id, ok.error());
+        continue;
+      }
     } else if (c->ring_writer) {
       auto ok = c->ring_writer->write(port::record::size_of(value), [&value](std::byte *at) {
         port::record::Writer w(at);
@@ -331,7 +380,7 @@ template <typename T>
 void ProvidesPort<T>::take_all(bool deliver) {
   std::shared_lock lock(mutex_);
   for (const auto &[id, c] : connections_) {
-    if (c->in_host())
+    if (c->in_host() || c->tcp_in)
       take_local(*c, deliver);
     else if (c->ring_reader)
       take_same_host(*c, deliver);
@@ -348,6 +397,26 @@ void ProvidesPort<T>::take_here(DataConnection &c) {
   if (lock && c.loop->run_here([this, &c] { take_dds(c, true); }))
     return;
   c.loop->wake();
+}
+
+// A frame that is not a whole record of T is dropped: what the network sends is not trusted.
+template <typename T>
+void ProvidesPort<T>::take_frame(DataConnection &c, const std::byte *data, std::size_t bytes) {
+  auto value = std::make_shared<T>();
+  port::record::Reader r(data, bytes);
+  if (!port::record::read(r, *value))
+    return;
+  if (delivery() == Delivery::Listener) {
+    std::shared_lock lock(mutex_, std::try_to_lock);
+    if (lock && c.loop->run_here([this, &c, &value] {
+          c.last_sample_ns.store(steady_ns(), std::memory_order_relaxed);
+          c.samples.fetch_add(1, std::memory_order_relaxed);
+          if (callback_)
+            this->deliver(c, *value);
+        }))
+      return;
+  }
+  c.inbox->push(std::move(value));
 }
 
 template <typename T>

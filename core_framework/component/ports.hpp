@@ -103,6 +103,12 @@ public:
                          const std::string &connection, const std::string &topic,
                          const dds_qos_t *qos, std::optional<ContentFilter> filter = std::nullopt,
                          bool local = false, std::optional<RingRef> ring = std::nullopt);
+  // A connection on a TCP stream (transport="tcp"): a provides port listens and returns the
+  // endpoint its writer connects to; a uses port connects to `peer` within `timeout` and returns
+  // "". Both ends know `token`.
+  Expected<std::string> connect_tcp(detail::ReceiveLoop *loop, const std::string &connection,
+                                    const dds_qos_t *qos, const std::string &peer,
+                                    const std::string &token, std::chrono::milliseconds timeout);
   bool disconnect(const std::string &connection);
   void disconnect_all();
   std::vector<ConnectionStatus> status() const;
@@ -119,6 +125,10 @@ public:
   // On a DDS listener's thread (Delivery::Listener): takes and delivers what the connection
   // received when ReceiveLoop::run_here can, else wakes the receive loop. Never blocks.
   virtual void take_here(detail::DataConnection &c);
+  // On a TCP stream's thread: one frame (a record) of connection `c`, delivered there when the
+  // port asked for Delivery::Listener and ReceiveLoop::run_here can, else queued for the receive
+  // loop. Never waits for the port's lock.
+  virtual void take_frame(detail::DataConnection &c, const std::byte *data, std::size_t bytes);
   // Returns once no callback of this port is running (one that starts later sees the caller's
   // earlier writes, e.g. a cleared delivery flag).
   void quiesce();
@@ -169,6 +179,7 @@ public:
         callback_(std::move(callback)) {}
   void take_all(bool deliver) override;
   void take_here(detail::DataConnection &c) override;
+  void take_frame(detail::DataConnection &c, const std::byte *data, std::size_t bytes) override;
 
 private:
   void take_dds(detail::DataConnection &c, bool deliver);

@@ -182,15 +182,15 @@ CallResult<ConnectionEnd> ApplicationFactory::Launch::device_end(ConnectionInsta
 }
 
 // Where an end's data goes: through the ring of the node that relays for its process (`node`
-// not empty), or on DDS from its owner itself (a device, a QoS asking for direct DDS).
+// not empty), or from its owner itself (a device; a QoS asking for direct DDS or a TCP stream).
 std::string ApplicationFactory::Launch::relaying_node_of(const ConnectionInstance &ci,
                                                          const ConnectionEnd &end) const {
   const auto *component = end.component.empty() ? nullptr : component_of(end.component);
   if (component == nullptr)
     return {};
   const auto qos = dds::connection_qos_from_json(ci.qos);
-  if (qos && qos->transport == profile::Transport::Direct)
-    return {};
+  if (qos && qos->transport != profile::Transport::Node)
+    return {}; // DDS from its own process, or a TCP stream
   return component->relaying_node();
 }
 

@@ -1,6 +1,7 @@
 #include "domain/wiring.hpp"
 
 #include <map>
+#include <random>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -16,10 +17,20 @@ using namespace detail;
 
 namespace {
 
-// The connection's QoS asks each process to carry it on DDS itself (transport="direct").
-bool asks_direct_dds(const Wire &wire) {
+// The connection's QoS asks for a transport other than the nodes': DDS from each process itself
+// (transport="direct") or a TCP stream between the two processes (transport="tcp").
+profile::Transport transport_of(const Wire &wire) {
   const auto qos = dds::connection_qos_from_json(wire.qos);
-  return qos && qos->transport == profile::Transport::Direct;
+  return qos ? *qos->transport : profile::Transport::Node;
+}
+
+// A TCP stream's token (profile "tcp"): 128 random bits, as hex, that only its two ends learn.
+std::string new_token() {
+  std::random_device random;
+  std::string token;
+  for (int i = 0; i < 4; ++i)
+    token += fmt::format("{:08x}", random());
+  return token;
 }
 
 protocol::component::ConnectRequest connect_request(const Wire &wire, const WireEnd &end,
@@ -40,7 +51,7 @@ protocol::component::ConnectRequest connect_request(const Wire &wire, const Wire
   const bool reader = std::string_view(direction) == "provides";
   request.filter = reader ? wire.filter : "";
   request.local = wire.in_one_host();
-  if (wire.through_node(end) && !asks_direct_dds(wire)) {
+  if (wire.through_node(end) && transport_of(wire) == profile::Transport::Node) {
     request.shared_memory = true;
     request.relay = !wire.on_one_node(); // ends on other hosts, or an event channel's
   }
@@ -62,26 +73,61 @@ CallResult<void> connect_all(control::Caller &caller, const std::vector<Call> &c
 
 CallResult<WiringTimes> Wiring::connect(const std::vector<Wire> &wires,
                                         std::vector<WireEnd> &made) {
-  std::vector<Call> readers, writers;
-  std::vector<const WireEnd *> reader_ends, writer_ends;
   using Connect = protocol::component::Connect;
-  for (const auto &w : wires) {
+  // A TCP stream's two ends share a token; its writer connects where its reader listens, which
+  // the reader's connect answers: readers first, then writers.
+  std::vector<std::string> tokens(wires.size());
+  std::vector<Call> readers;
+  std::vector<const WireEnd *> reader_ends;
+  std::vector<std::size_t> reader_wire;
+  for (std::size_t i = 0; i < wires.size(); ++i) {
+    const Wire &w = wires[i];
+    const bool tcp = transport_of(w) == profile::Transport::Tcp && !w.in_one_host();
+    if (tcp)
+      tokens[i] = new_token();
     if (w.provides && !w.to_interface()) {
-      readers.push_back(call_of<Connect>(
-          w.provides->address, connect_request(w, *w.provides, "provides"), w.provides->what));
+      auto request = connect_request(w, *w.provides, "provides");
+      if (tcp)
+        request.tcp_token = tokens[i];
+      readers.push_back(call_of<Connect>(w.provides->address, request, w.provides->what));
       reader_ends.push_back(&*w.provides);
-    }
-    if (w.uses) {
-      writers.push_back(
-          call_of<Connect>(w.uses->address, connect_request(w, *w.uses, "uses"), w.uses->what));
-      writer_ends.push_back(&*w.uses);
+      reader_wire.push_back(i);
     }
   }
   WiringTimes times;
   auto began = Clock::now();
-  if (auto ok = connect_all(caller_, readers, reader_ends, timeout_, made); !ok)
+  const auto replies = call_each_of(caller_, readers, timeout_);
+  std::vector<std::string> endpoints(wires.size());
+  for (std::size_t k = 0; k < replies.size(); ++k) {
+    if (!replies[k])
+      continue;
+    made.push_back(*reader_ends[k]);
+    auto reply = protocol::decode<protocol::component::ConnectReply>(*replies[k]);
+    if (reply && reply->tcp_endpoint)
+      endpoints[reader_wire[k]] = *reply->tcp_endpoint;
+  }
+  if (auto ok = first_failure(readers, replies); !ok)
     return tl::unexpected(ok.error());
   times.readers_ms = ms_since(began);
+
+  std::vector<Call> writers;
+  std::vector<const WireEnd *> writer_ends;
+  for (std::size_t i = 0; i < wires.size(); ++i) {
+    const Wire &w = wires[i];
+    if (!w.uses)
+      continue;
+    auto request = connect_request(w, *w.uses, "uses");
+    if (!tokens[i].empty()) {
+      if (endpoints[i].empty())
+        return control::call_error(
+            Status::Failed,
+            fmt::format("{}: its reader gave no TCP endpoint to connect to", w.uses->what));
+      request.tcp_peer = endpoints[i];
+      request.tcp_token = tokens[i];
+    }
+    writers.push_back(call_of<Connect>(w.uses->address, request, w.uses->what));
+    writer_ends.push_back(&*w.uses);
+  }
   began = Clock::now();
   if (auto ok = connect_all(caller_, writers, writer_ends, timeout_, made); !ok)
     return tl::unexpected(ok.error());

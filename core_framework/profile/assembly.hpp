@@ -143,7 +143,7 @@ enum class Liveliness : std::uint8_t { Automatic, ManualByParticipant, ManualByT
 enum class Ownership : std::uint8_t { Shared, Exclusive };
 // How a connection between processes travels: through their nodes (shared memory on one host),
 // or on DDS from the components' own participants (a high-rate stream between hosts).
-enum class Transport : std::uint8_t { Node, Direct };
+enum class Transport : std::uint8_t { Node, Direct, Tcp };
 
 std::string_view to_string(Reliability v);
 std::string_view to_string(Durability v);

@@ -85,7 +85,8 @@ FieldResult set_qos_attribute(ConnectionQos &qos, std::string_view name, std::st
   if (name == "strength")
     return set_integer<std::int32_t>(qos.strength, text, kInt32Min);
   if (name == "transport")
-    return set_enum(qos.transport, text, std::array{Transport::Node, Transport::Direct});
+    return set_enum(qos.transport, text,
+                    std::array{Transport::Node, Transport::Direct, Transport::Tcp});
   return tl::unexpected(std::string("not a QoS attribute"));
 }
 
@@ -94,6 +95,9 @@ std::optional<std::string> qos_inconsistency(const ConnectionQos &qos) {
     return "depth applies only to history=\"keeplast\", not to keepall";
   if (qos.strength && qos.ownership != Ownership::Exclusive)
     return "strength applies only to ownership=\"exclusive\"";
+  // A TCP stream tells a closed connection, not a writer that stopped asserting itself.
+  if (qos.transport == Transport::Tcp && qos.lease && !qos.lease->infinite())
+    return "transport=\"tcp\" carries no liveliness lease: use transport=\"node\" or \"direct\"";
   return std::nullopt;
 }
 

@@ -230,7 +230,15 @@ std::string_view to_string(Liveliness v) {
   return names[static_cast<std::size_t>(v)];
 }
 std::string_view to_string(Transport v) {
-  return v == Transport::Direct ? "direct" : "node";
+  switch (v) {
+  case Transport::Direct:
+    return "direct";
+  case Transport::Tcp:
+    return "tcp";
+  case Transport::Node:
+    break;
+  }
+  return "node";
 }
 
 std::string_view to_string(Ownership v) {

@@ -466,6 +466,12 @@ void check_assembly_references(ReadContext &ctx, const std::vector<ComponentFile
       ctx.report({c.where, "connection",
                   fmt::format("{} joins two event channels; one end must be a component port",
                               connection_label(c))});
+    if (c.qos && c.qos->transport == Transport::Tcp &&
+        (c.subscribes_to_channel() || c.publishes_to_channel()))
+      ctx.report({c.qos->where, "qos",
+                  fmt::format("{}: transport=\"tcp\" is a stream between one uses port and one "
+                              "provides port, not an event channel",
+                              connection_label(c))});
   }
 }
 

@@ -43,6 +43,11 @@ struct ConnectRequest {
   // reaches by relaying the ring to and from DDS (node/topic_bridge.hpp). The process sees a ring.
   std::optional<bool> relay;
   std::optional<Ring> ring;
+  // transport="tcp" (profile/assembly.hpp): the writer connects to the reader's `tcp_peer`
+  // ("address:port", what the reader's connect replied) and first sends `tcp_token`, which the
+  // reader checks: a stream from anyone else on the network is closed unread.
+  std::optional<std::string> tcp_peer;
+  std::optional<std::string> tcp_token;
   static constexpr auto fields() {
     using R = ConnectRequest;
     return std::tuple{required("connection", &R::connection),
@@ -57,7 +62,17 @@ struct ConnectRequest {
                       optional("via", &R::via),
                       optional("shared_memory", &R::shared_memory),
                       optional("relay", &R::relay),
-                      optional("ring", &R::ring)};
+                      optional("ring", &R::ring),
+                      optional("tcp_peer", &R::tcp_peer),
+                      optional("tcp_token", &R::tcp_token)};
+  }
+};
+
+// A provides port's connection over TCP answers where its writer connects ("address:port").
+struct ConnectReply {
+  std::optional<std::string> tcp_endpoint;
+  static constexpr auto fields() {
+    return std::tuple{optional("tcp_endpoint", &ConnectReply::tcp_endpoint)};
   }
 };
 
@@ -213,7 +228,7 @@ struct Query {
 struct Connect {
   static constexpr std::string_view name = "component.connect";
   using Request = ConnectRequest;
-  using Reply = Empty;
+  using Reply = ConnectReply;
 };
 struct Disconnect {
   static constexpr std::string_view name = "component.disconnect";

@@ -16,6 +16,7 @@
 #include <fmt/format.h>
 
 #include "control/endpoint.hpp"
+#include "eventually.hpp"
 #include "protocol/codec.hpp"
 #include "test_domain.hpp"
 #include "writers_into.hpp"
@@ -26,6 +27,8 @@ using control::Endpoint;
 using control::Json;
 using control::Status;
 using rsca::test::writers_into;
+
+using rsca::test::eventually;
 
 namespace {
 
@@ -59,16 +62,6 @@ private:
 };
 
 // Polls `done` until it holds or 5 s have passed.
-bool eventually(const std::function<bool()> &done) {
-  const auto deadline = std::chrono::steady_clock::now() + 5s;
-  while (!done()) {
-    if (std::chrono::steady_clock::now() > deadline)
-      return false;
-    std::this_thread::sleep_for(10ms); // pacing the poll of a condition
-  }
-  return true;
-}
-
 control::CallResult<Json> fast(const Json &, const control::RequestContext &) {
   return Json{{"ok", true}};
 }

@@ -14,11 +14,14 @@
 #include <unistd.h>
 
 #include "component/port_record.hpp"
+#include "eventually.hpp"
 #include "shm/arena.hpp"
 #include "shm/doorbell.hpp"
 #include "shm/ring.hpp"
 
 using namespace rsca;
+
+using rsca::test::eventually;
 
 namespace {
 
@@ -56,18 +59,6 @@ struct RingFixture {
     return shm::RingReader::open(arena, at, slot, bell_at, depth).value();
   }
 };
-
-// Waits for a condition another thread makes true; false only if it never comes (a hang guard,
-// not a measure of speed).
-bool eventually(const std::function<bool()> &condition) {
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
-  while (!condition()) {
-    if (std::chrono::steady_clock::now() > deadline)
-      return false;
-    std::this_thread::yield();
-  }
-  return true;
-}
 
 // The node's relay thread, reduced to its wait (node/topic_bridge.cpp): it waits on the bell with
 // a SpinWait, spinning after a round that took records, and takes what the ring has.

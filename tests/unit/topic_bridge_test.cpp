@@ -17,6 +17,7 @@
 
 #include "component/port_record.hpp"
 #include "component/port_types.hpp"
+#include "eventually.hpp"
 #include "node/topic_bridge.hpp"
 #include "shm/arena.hpp"
 #include "shm/doorbell.hpp"
@@ -25,19 +26,9 @@
 
 using namespace rsca;
 
-namespace {
+using rsca::test::eventually;
 
-// Waits for a condition the bridges' threads or DDS make true; false only if it never comes (a
-// hang guard, not a measure of speed).
-bool eventually(const std::function<bool()> &condition) {
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
-  while (!condition()) {
-    if (std::chrono::steady_clock::now() > deadline)
-      return false;
-    std::this_thread::sleep_for(std::chrono::milliseconds(1)); // polling a condition
-  }
-  return true;
-}
+namespace {
 
 // One host's data: its arena, a doorbell for its bridge and one for its reader, the topic's ring.
 struct Host {
