@@ -171,6 +171,47 @@ TEST_CASE("a connection that asks for direct DDS takes it on one node too",
   domain.require_clean(pids);
 }
 
+TEST_CASE("a connection that asks for a TCP stream takes it between the two processes, on two "
+          "nodes, with no DDS socket and no ring",
+          "[integration][node-agent][tcp]") {
+  TestDomain domain(2);
+  domain.install("TcpPair");
+  auto [rc, out] = domain.cli({"launch", "TcpPair", "--strategy", "spread"});
+  INFO(out);
+  REQUIRE(rc == 0);
+  auto app = domain.call("app.show", Json{{"app", "TcpPair"}});
+  REQUIRE(app.has_value());
+  const auto pids = pids_of(*app);
+  REQUIRE(pids.size() == 2);
+  REQUIRE(component_named(*app, "Producer_1").at("node") !=
+          component_named(*app, "Consumer_1").at("node"));
+  // Samples flow over the stream; each end counts the other while it is connected.
+  const Json samples = flowing_connection(domain, "TcpPair");
+  INFO(samples.dump());
+  for (const char *end : {"uses_state", "provides_state"}) {
+    CHECK_FALSE(samples.at(end).value("same_host", true));
+    CHECK_FALSE(samples.at(end).value("relayed", true));
+    CHECK(samples.at(end).value("matched", 0) == 1);
+  }
+  for (long pid : pids)
+    CHECK(udp_sockets_of(pid) == 0); // no DDS participant of its own
+  for (int node : {1, 2}) {
+    auto status = domain.call_node(node, "node.status");
+    REQUIRE(status.has_value());
+    CHECK(status->at("shared_memory").at("rings") == 0);
+    CHECK(status->at("shared_memory").at("relays") == 0);
+  }
+  // The reader sees its writer go: the producer's process killed, its consumer counts none.
+  const long producer = pid_of(*app, "Producer_1");
+  REQUIRE(::kill(static_cast<pid_t>(producer), SIGKILL) == 0);
+  CHECK(TestDomain::wait_for([&] {
+    auto list = domain.call("connection.list", Json{{"app", "TcpPair"}});
+    return list && list->at("connections").at(0).at("provides_state").value("matched", -1) == 0;
+  }));
+  REQUIRE(domain.call("app.release", Json{{"app", "TcpPair"}}).has_value());
+  domain.require_clean(pids);
+}
+
 TEST_CASE("the CLI reaches the domain through a node's control socket, with no DDS of its own",
           "[integration][node-agent]") {
   TestDomain domain(2);

@@ -41,6 +41,36 @@ TEST_CASE("qos strength without exclusive ownership is an error", "[extensions][
   }
 }
 
+TEST_CASE("a TCP stream with a liveliness lease, or to an event channel, is an error",
+          "[extensions][errors][qos]") {
+  // A stream tells a closed connection, not a writer that stopped asserting itself.
+  const std::string leased = sad_text(
+      "", port_connection("c", R"(<qos transport="tcp" liveliness="automatic" lease="300ms"/>)"));
+  const Diagnostic d = sad_error(leased);
+  CHECK(d.rule == "qos");
+  CHECK(d.where.line == line_of(leased, "<qos transport=\"tcp\""));
+  CHECK_THAT(d.message, Contains("tcp") && Contains("lease"));
+  // A stream joins one uses port and one provides port: a channel has many members.
+  const std::string channel = sad_text("", R"(    <connectinterface id="pub">
+      <usesport>
+        <usesidentifier>range_out</usesidentifier>
+        <componentinstantiationref refid="Lidar_1"/>
+      </usesport>
+      <findby>
+        <domainfinder type="eventchannel" name="RangeEvents"/>
+      </findby>
+      <qos transport="tcp"/>
+    </connectinterface>)");
+  const Diagnostic c = sad_error(channel);
+  CHECK(c.rule == "qos");
+  CHECK(c.where.line == line_of(channel, "<qos transport=\"tcp\""));
+  CHECK_THAT(c.message, Contains("tcp") && Contains("event channel"));
+  // Without either, a TCP stream reads.
+  CHECK(sad_of(sad_text("", port_connection("c", R"(<qos transport="tcp"/>)")))
+            .connections.at(0)
+            .qos->transport == Transport::Tcp);
+}
+
 TEST_CASE("executiontime longer than the deadline is an error", "[extensions][errors][timing]") {
   const std::string text =
       sad_text(R"(<timing period="20ms" deadline="5ms" executiontime="6ms"/>)", "");
