@@ -7,4 +7,8 @@ namespace rsca {
 // before the component asked to die with it) exits at once.
 inline constexpr const char *kNodePidVariable = "RSCA_NODE_PID";
 
+// Set to "0" when the node leaves a periodic component free to run on any of its CPUs (its GPP's
+// pin_admitted_cpu is false); otherwise the process pins itself to the CPU timing admission chose.
+inline constexpr const char *kPinAdmittedVariable = "RSCA_PIN_ADMITTED_CPU";
+
 } // namespace rsca

@@ -9,6 +9,7 @@
 #include <cstring>
 #include <functional>
 #include <map>
+#include <string_view>
 
 #include <fmt/format.h>
 #include <poll.h>
@@ -38,6 +39,12 @@ void pin_to_cpu(unsigned cpu, spdlog::logger &log) {
   CPU_SET(cpu, &set);
   if (sched_setaffinity(0, sizeof(set), &set) != 0)
     log.warn("cannot run on cpu {} as admitted: {}", cpu, std::strerror(errno));
+}
+
+// Its node left it free to run on any CPU (common/exec_environment.hpp).
+bool pinning_left_free() {
+  const char *pin = std::getenv(kPinAdmittedVariable);
+  return pin != nullptr && std::string_view(pin) == "0";
 }
 
 } // namespace
@@ -74,7 +81,7 @@ int run_host(const ExecParams &params, const ExitEvents &events, const Factory &
                   logger,
                   params.schedule,
                   params.dds == protocol::kJoinDds};
-  if (params.schedule)
+  if (params.schedule && !pinning_left_free())
     pin_to_cpu(params.schedule->cpu, *logger);
   std::unique_ptr<Component> component;
   try {

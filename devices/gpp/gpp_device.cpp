@@ -48,12 +48,19 @@ GppDevice::GppDevice(node::DeviceContext context)
       {"processor_name", override_of(context_, "processor_name").value_or(host.processor_name)},
       {"hostname", host.hostname},
       {"scheduling_policy",
-       override_of(context_, "scheduling_policy").value_or(Json("fixed-priority"))}};
+       override_of(context_, "scheduling_policy").value_or(Json("fixed-priority"))},
+      {"pin_admitted_cpu", override_of(context_, "pin_admitted_cpu").value_or(Json(true))}};
   capacity_ = {{"cpu_capacity",
                 override_of(context_, "cpu_capacity").value_or(Json(host.cpu_cores * 100.0))},
                {"mem_capacity", override_of(context_, "mem_capacity")
                                     .value_or(Json(static_cast<double>(host.memory_total_bytes) /
                                                    (1024.0 * 1024.0)))}};
+}
+
+bool GppDevice::pins_admitted_cpu() const {
+  const Json &pin = properties_.at("pin_admitted_cpu");
+  return pin.is_boolean() ? pin.get<bool>()
+                          : !(pin.is_string() && pin.get<std::string>() == "false");
 }
 
 Expected<std::unique_ptr<node::LogicalDevice>>
@@ -137,6 +144,8 @@ GppDevice::execute(const protocol::node::ExecuteRequest &r,
   request.env = context_.dds.component_environment();
   // The component dies with this node: it checks that its parent is still this process.
   request.env.emplace_back(kNodePidVariable, std::to_string(::getpid()));
+  if (!pins_admitted_cpu())
+    request.env.emplace_back(kPinAdmittedVariable, "0");
   if (package && r.package && !r.package->library_dirs.empty())
     request.env.emplace_back("LD_LIBRARY_PATH",
                              library_path(package->root(), r.package->library_dirs));

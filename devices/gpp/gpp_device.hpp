@@ -18,6 +18,8 @@ public:
 
   std::string kind() const override { return "gpp"; }
   node::Json properties() const override { return properties_; }
+  // Its pin_admitted_cpu property (GPP.prf.xml): periodic components pinned to their CPU.
+  bool pins_admitted_cpu() const;
   node::Json capacity() const override { return capacity_; }
   node::CallResult<protocol::node::ExecuteReply>
   execute(const protocol::node::ExecuteRequest &request,

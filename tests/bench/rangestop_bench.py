@@ -33,7 +33,9 @@ robot should rest no nearer than threshold - tolerance, give or take the noise (
 Delay percentiles are taken as the DriveSystem takes them (sorted[n/2], sorted[n*99/100]).
 
 With --hosts (root; tools/hosts), as the paper ran it, across two network hosts: the robot (its
-node daemon for rsca, the robot process for tcp) on one, the controller (node1 running StopCrash,
+node daemon for rsca, the robot process for tcp) on one, the controller (for rsca the node
+`controller`, whose GPP leaves StopCrash free on its CPUs as the TCP controller process is, or with
+--pinned node1, which pins it to the CPU admission chose; running StopCrash,
 the controller process) on the other, the domain daemon on a third; DDS and TCP over the hosts'
 network interfaces. It prints `ratio rsca/tcp delay p50 = R` (issue 21's target: at most 1.2),
 and with the dds way `ratio rsca/dds delay p50 = R`.
@@ -195,12 +197,18 @@ class RobotDomain(Domain):
     """local_domain.Domain with the robot's node as well: `rsca domain up --nodes 1 --node DCD`
     (node1, a GPP, and the robot with its Robot, IRSensor and DriveSystem devices)."""
 
-    def __init__(self, rsca, dcd, sdrroot, hosts=None):
+    def __init__(self, rsca, dcd, sdrroot, hosts=None, pinned=False):
         env = {"RSCA_SDRROOT": sdrroot}
         node_dcds = None
         if hosts:  # started by hand, each daemon on its host (CONTROLLER_HOST, ROBOT_HOST)
             env["RSCA_DDS_INTERFACE"] = "eth0"
-            node_dcds = [("node1", os.path.join(sdrroot, "dev/nodes/node1/DeviceManager.dcd.xml")),
+            # The controller's node leaves StopCrash free on its host's CPUs, as the TCP way's
+            # controller process is (dev/nodes/controller); --pinned: node1, which pins it to the
+            # CPU admission chose.
+            controller = ("node1", "dev/nodes/node1") if pinned else ("controller",
+                                                                       "dev/nodes/controller")
+            node_dcds = [(controller[0],
+                          os.path.join(sdrroot, controller[1], "DeviceManager.dcd.xml")),
                          ("robot", dcd)]
         super().__init__(rsca, nodes=2 if hosts else 1, sdrroot=sdrroot, env=env, hosts=hosts,
                          node_dcds=node_dcds)
@@ -252,7 +260,7 @@ def run_rsca(args, runs, logs):
     # The drive toward the threshold at full speed.
     drive_s = max(0.0, (args.wall_distance - args.threshold) / args.speed)
     results = []
-    with RobotDomain(rsca, dcd, args.sdrroot, hosts=args.net_hosts) as domain:
+    with RobotDomain(rsca, dcd, args.sdrroot, hosts=args.net_hosts, pinned=args.pinned) as domain:
         try:
             domain.cli("configure", "robot:IRSensor_1", f"period_ms={args.period_ms}")
             domain.cli("install", os.path.join(args.sdrroot,
@@ -324,6 +332,9 @@ def main():
     parser.add_argument("--wall-distance", type=float, default=2.0, help=argparse.SUPPRESS)
     parser.add_argument("--hosts", action="store_true",
                         help="robot and controller on two network hosts (root; tools/hosts)")
+    parser.add_argument("--pinned", action="store_true",
+                        help="with --hosts: StopCrash pinned to the CPU admission chose (node1's "
+                             "GPP), not free on its host's CPUs as the TCP way's controller is")
     args = parser.parse_args()
     args.net_hosts = None
     if args.hosts:

@@ -101,6 +101,36 @@ TEST_CASE("ProducerConsumer: install, launch, data flows, configure, query, stop
   domain.require_clean(pids);
 }
 
+TEST_CASE("a GPP that does not pin admitted components leaves a periodic process free on every "
+          "CPU, its schedule still admitted",
+          "[integration][domain]") {
+  TestDomain domain({kTestSdr / "dev/nodes/free1/DeviceManager.dcd.xml"});
+  const Json app = domain.launch_shipped("ProducerConsumer");
+  const auto pids = pids_of(app);
+  std::string every_cpu;
+  {
+    std::ifstream status("/proc/self/status"); // this test may run on every CPU of the host
+    std::string line;
+    while (std::getline(status, line))
+      if (line.rfind("Cpus_allowed_list:", 0) == 0)
+        every_cpu = line.substr(line.find_first_not_of(" \t", 18));
+  }
+  for (const auto &c : app.at("components")) {
+    if (c.at("id") != "Producer_1")
+      continue;
+    REQUIRE(c.contains("schedule")); // admitted as on any GPP
+    std::ifstream status(fmt::format("/proc/{}/status", c.at("pid").get<long>()));
+    std::string line, allowed;
+    while (std::getline(status, line))
+      if (line.rfind("Cpus_allowed_list:", 0) == 0)
+        allowed = line.substr(line.find_first_not_of(" \t", 18));
+    CHECK(allowed == every_cpu);
+  }
+  CHECK(TestDomain::wait_for([&] { return received(domain, "ProducerConsumer") > 20; }));
+  REQUIRE(domain.call("app.release", Json{{"app", "ProducerConsumer"}}).has_value());
+  domain.require_clean(pids);
+}
+
 TEST_CASE("install writes each component's runtime model, and its process starts from it",
           "[integration][domain]") {
   TestDomain domain;
