@@ -75,7 +75,8 @@ TEST_CASE("connection QoS: values the SAD refuses are refused, quoting an excerp
         "\"deadline\" is 100, not a duration such as 100ms, 1.5s or infinite (units ns, us, ms, "
         "s; at most about 292 years)");
   CHECK(qos_error({{"depth", "0"}}) == "\"depth\" is \"0\", not an integer from 1 to 2147483647");
-  CHECK(qos_error({{"transport", "udp"}}) == "\"transport\" is \"udp\", not one of node, direct");
+  CHECK(qos_error({{"transport", "udp"}}) ==
+        "\"transport\" is \"udp\", not one of node, direct, tcp");
   CHECK(qos_error({{"depth", "4x"}}) == "\"depth\" is \"4x\", not an integer from 1 to 2147483647");
   CHECK(qos_error({{"deadline", "100ms"}, {"deadline_ns", 5}}) ==
         "give \"deadline\" or \"deadline_ns\", not both");

@@ -434,7 +434,10 @@ TEST_CASE("PRF: Consumer counters and GPP allocation properties", "[descriptors]
   CHECK(definition<SimpleProperty>(consumer, "log_every").type.type == SimpleType::ULong);
 
   const auto gpp = read<Properties>(kGpp / "GPP.prf.xml");
-  REQUIRE(gpp.properties.size() == 8);
+  REQUIRE(gpp.properties.size() == 9);
+  const auto &pin = definition<SimpleProperty>(gpp, "pin_admitted_cpu");
+  CHECK(pin.type.type == SimpleType::Boolean);
+  CHECK(as<bool>(pin.value));
   const auto &os = definition<SimpleProperty>(gpp, "DCE:4a23ad60-0b25-4121-a630-68803a498f75");
   CHECK(os.name == "os_name");
   CHECK(os.label() == "os_name");
