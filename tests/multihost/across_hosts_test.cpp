@@ -42,13 +42,21 @@ bool samples_flow(HostsDomain &domain, const std::string &app = "ProducerConsume
 
 TEST_CASE("ProducerConsumer spread over two network hosts: launched, matched, its data on the wire",
           "[multihost]") {
+  // Through the nodes (DDS between their relays), or on a TCP stream between the two processes
+  // (transport="tcp": the reader listens on its host's interface, not loopback).
+  const bool tcp = GENERATE(false, true);
+  const std::string app = tcp ? "TcpPair" : "ProducerConsumer";
+  const std::string sad =
+      tcp ? (kSource / "tests/data/integration/dom/waveforms/TcpPair/TcpPair.sad.xml").string()
+          : kProducerConsumer;
+  INFO(app);
   HostsDomain domain(2);
   const int consumer_host = HostsDomain::host_of_node(2);
   const auto received_before = domain.hosts().received_bytes(consumer_host);
 
   // The CLI on the domain's host, over DDS: nothing of it shares a host with a node.
   const auto launched =
-      domain.cli(1, {"launch", kProducerConsumer, "--strategy", "spread"}, HostsDomain::over_dds());
+      domain.cli(1, {"launch", sad, "--strategy", "spread"}, HostsDomain::over_dds());
   INFO(launched.out << launched.err);
   REQUIRE(launched.rc == 0);
   std::set<std::string> nodes;
@@ -60,11 +68,11 @@ TEST_CASE("ProducerConsumer spread over two network hosts: launched, matched, it
   }
   CHECK(nodes == std::set<std::string>{"node1", "node2"});
 
-  REQUIRE(HostsDomain::wait_for([&] { return samples_flow(domain); }));
+  REQUIRE(HostsDomain::wait_for([&] { return samples_flow(domain, app); }));
   // The samples crossed the consumer host's network interface, not a loopback.
   CHECK(domain.hosts().received_bytes(consumer_host) > received_before);
 
-  const auto released = domain.cli(1, {"release", "ProducerConsumer"}, HostsDomain::over_dds());
+  const auto released = domain.cli(1, {"release", app}, HostsDomain::over_dds());
   INFO(released.out << released.err);
   CHECK(released.rc == 0);
   // Nothing left: no application, and the component processes (one pid space for every host)
