@@ -308,6 +308,8 @@ CallResult<op::StatusReply> Host::op_status(const Empty &, const Context &) {
         connection.same_host = true;
       if (s.relayed)
         connection.relayed = true;
+      if (s.tcp)
+        connection.tcp = true;
       status.connections.push_back(std::move(connection));
     }
     reply.ports.push_back(std::move(status));

@@ -255,7 +255,7 @@ std::vector<ConnectionStatus> PortBase::status() const {
   for (const auto &[id, c] : connections_)
     out.push_back({id, c->topic_name, matched_count(*c, direction_), c->samples.load(),
                    c->filtered.load(), deadline_misses(*c, direction_), c->in_host(),
-                   c->same_host(), c->relayed});
+                   c->same_host(), c->relayed, c->tcp()});
   return out;
 }
 

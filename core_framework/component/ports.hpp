@@ -44,6 +44,7 @@ struct ConnectionStatus {
   bool in_host = false;              // both ends in one process: no DDS entities
   bool same_host = false;            // both ends on one host: a ring in shared memory
   bool relayed = false;              // a ring the node relays to and from the ends on other hosts
+  bool tcp = false;                  // a TCP stream between the two ends' processes
 };
 
 // A same-host connection's ring, as the node gave it: where it is in the host's arena, and a

@@ -44,7 +44,8 @@ Json end_state(const StatusOf &status_of, const std::string &address, const std:
                   {"deadline_missed", c.deadline_missed.value_or(0)},
                   {"in_host", c.in_host.value_or(false)},
                   {"same_host", c.same_host.value_or(false)},
-                  {"relayed", c.relayed.value_or(false)}};
+                  {"relayed", c.relayed.value_or(false)},
+                  {"tcp", c.tcp.value_or(false)}};
     }
   }
   return nullptr;

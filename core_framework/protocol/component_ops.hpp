@@ -115,21 +115,18 @@ struct ConnectionStatus {
   std::optional<bool> in_host;
   std::optional<bool> same_host;
   std::optional<bool> relayed;       // same_host, and the node relays it to other hosts
+  std::optional<bool> tcp;           // a TCP stream between the two ends (transport="tcp")
   std::optional<std::string> target; // a control interface's connection: whom it calls
   std::optional<std::uint64_t> calls;
   static constexpr auto fields() {
     using R = ConnectionStatus;
-    return std::tuple{required("connection", &R::connection),
-                      optional("topic", &R::topic),
-                      optional("matched", &R::matched),
-                      optional("samples", &R::samples),
-                      optional("filtered", &R::filtered),
-                      optional("deadline_missed", &R::deadline_missed),
-                      optional("in_host", &R::in_host),
-                      optional("same_host", &R::same_host),
-                      optional("relayed", &R::relayed),
-                      optional("target", &R::target),
-                      optional("calls", &R::calls)};
+    return std::tuple{
+        required("connection", &R::connection), optional("topic", &R::topic),
+        optional("matched", &R::matched),       optional("samples", &R::samples),
+        optional("filtered", &R::filtered),     optional("deadline_missed", &R::deadline_missed),
+        optional("in_host", &R::in_host),       optional("same_host", &R::same_host),
+        optional("relayed", &R::relayed),       optional("tcp", &R::tcp),
+        optional("target", &R::target),         optional("calls", &R::calls)};
   }
 };
 

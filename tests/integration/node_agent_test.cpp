@@ -191,8 +191,13 @@ TEST_CASE("a connection that asks for a TCP stream takes it between the two proc
   for (const char *end : {"uses_state", "provides_state"}) {
     CHECK_FALSE(samples.at(end).value("same_host", true));
     CHECK_FALSE(samples.at(end).value("relayed", true));
+    CHECK(samples.at(end).value("tcp", false));
     CHECK(samples.at(end).value("matched", 0) == 1);
   }
+  // `rsca ls connections` says how it travels.
+  const auto [ls_rc, listed] = domain.cli({"ls", "connections", "TcpPair"});
+  REQUIRE(ls_rc == 0);
+  CHECK(listed.find("(TCP stream)") != std::string::npos);
   for (long pid : pids)
     CHECK(udp_sockets_of(pid) == 0); // no DDS participant of its own
   for (int node : {1, 2}) {

@@ -101,6 +101,7 @@ std::string end_state(const Json &state) {
                      state.value("in_host", false)     ? " (in-host)"
                      : state.value("relayed", false)   ? " (through the nodes)"
                      : state.value("same_host", false) ? " (same-host, shared memory)"
+                     : state.value("tcp", false)       ? " (TCP stream)"
                                                        : "");
 }
 
