@@ -17,6 +17,7 @@
 #else
 #define RSCA_COMPONENT_DETAIL_MAIN(Class)                                                          \
   int main(int argc, char **argv) {                                                                \
+    ::rsca::component::serve_forks_if_asked(argc, argv, ::rsca::process::kForkServerReady);        \
     return ::rsca::component::run<Class>(argc, argv);                                              \
   }
 #endif

@@ -3,5 +3,6 @@
 #include "component/runtime.hpp"
 
 int main(int argc, char **argv) {
+  rsca::component::serve_forks_if_asked(argc, argv, rsca::process::kForkServerReady);
   return rsca::component::run_component_host(argc, argv);
 }

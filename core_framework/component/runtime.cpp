@@ -1,4 +1,5 @@
 #include "component/runtime.hpp"
+#include "process/fork_service.hpp"
 
 #include <sched.h>
 
@@ -121,6 +122,10 @@ int run_host(const ExecParams &params, const ExitEvents &events, const Factory &
 }
 
 } // namespace
+
+void serve_forks_if_asked(int &argc, char **&argv, std::string_view ready) {
+  process::serve_forks_if_asked(argc, argv, ready);
+}
 
 int run_component(int argc, char **argv, const Factory &factory) {
   return detail::run_process<ExecParams>(

@@ -15,12 +15,14 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
 #include <tl/expected.hpp>
 
 #include "component/component.hpp"
+#include "process/fork_request.hpp"
 #include "protocol/exec_params.hpp"
 
 namespace rsca::component {
@@ -54,6 +56,14 @@ using FactoryExport = void (*)(Factory *out);
 // It serves every component at its own control address, exactly as a component process would,
 // and returns once all of them are released, or on SIGTERM or SIGINT.
 int run_component_host(int argc, char **argv);
+
+// What the main of a component executable calls first (component/export.hpp's does): started by
+// its node as a fork server, it serves the node until the node lets it go, and returns only in a
+// process it forked, with that process's arguments (process/fork_service.hpp). Otherwise it
+// returns at once. `ready` is process::kForkServerReady, passed from main so that its bytes are in
+// the executable, where the node looks for them before it starts one as a fork server. Code that
+// main runs before this call runs once, in the fork server; no thread may have started.
+void serve_forks_if_asked(int &argc, char **&argv, std::string_view ready);
 
 template <typename T>
 int run(int argc, char **argv) {

@@ -286,13 +286,17 @@ void kill_and_reap(pid_t pid, Group group) {
 
 } // namespace
 
-Expected<Child> spawn(const Command &command, Group group) {
+Expected<Fd> prepare_to_spawn(const Command &command) {
   for (auto *check : {&check_executable, &check_working_dir, &check_environment}) {
     if (auto checked = (*check)(command); !checked) {
       return tl::unexpected(std::move(checked.error()));
     }
   }
-  auto log = open_log(command);
+  return open_log(command);
+}
+
+Expected<Child> spawn(const Command &command, Group group) {
+  auto log = prepare_to_spawn(command);
   if (!log) {
     return tl::unexpected(std::move(log.error()));
   }

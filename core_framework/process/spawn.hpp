@@ -76,6 +76,11 @@ struct Child {
 // nothing.
 Expected<Child> spawn(const Command &command, Group group);
 
+// What spawn() does before anything starts, for another way to start the command (a fork
+// server: process/fork_server.hpp): the checks, and the log file opened (an empty Fd when the
+// command has none).
+Expected<Fd> prepare_to_spawn(const Command &command);
+
 // A pidfd for `pid` (close-on-exec), which need not be this process's child; empty on failure
 // (errno says why).
 Fd open_pidfd(pid_t pid);

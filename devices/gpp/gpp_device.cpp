@@ -41,7 +41,8 @@ std::optional<Json> override_of(const node::DeviceContext &context, const char *
 
 GppDevice::GppDevice(node::DeviceContext context)
     : context_(std::move(context)),
-      launcher_([this](ProcessId pid, ExitStatus status) { on_exit(pid, status); }) {
+      launcher_([this](ProcessId pid, ExitStatus status) { on_exit(pid, status); },
+                [this](const ExecRequest &request) { return start(request); }) {
   const HostInfo host = read_host_info();
   properties_ = {
       {"os_name", override_of(context_, "os_name").value_or(host.os_name)},
@@ -49,7 +50,8 @@ GppDevice::GppDevice(node::DeviceContext context)
       {"hostname", host.hostname},
       {"scheduling_policy",
        override_of(context_, "scheduling_policy").value_or(Json("fixed-priority"))},
-      {"pin_admitted_cpu", override_of(context_, "pin_admitted_cpu").value_or(Json(true))}};
+      {"pin_admitted_cpu", override_of(context_, "pin_admitted_cpu").value_or(Json(true))},
+      {"fork_server", override_of(context_, "fork_server").value_or(Json(true))}};
   capacity_ = {{"cpu_capacity",
                 override_of(context_, "cpu_capacity").value_or(Json(host.cpu_cores * 100.0))},
                {"mem_capacity", override_of(context_, "mem_capacity")
@@ -57,10 +59,29 @@ GppDevice::GppDevice(node::DeviceContext context)
                                                    (1024.0 * 1024.0)))}};
 }
 
+namespace {
+
+// A boolean property as a DCD may set it: true, or the text "true".
+bool is_true(const Json &value) {
+  return value.is_boolean() ? value.get<bool>()
+                            : !(value.is_string() && value.get<std::string>() == "false");
+}
+
+} // namespace
+
 bool GppDevice::pins_admitted_cpu() const {
-  const Json &pin = properties_.at("pin_admitted_cpu");
-  return pin.is_boolean() ? pin.get<bool>()
-                          : !(pin.is_string() && pin.get<std::string>() == "false");
+  return is_true(properties_.at("pin_admitted_cpu"));
+}
+
+bool GppDevice::uses_fork_servers() const {
+  return is_true(properties_.at("fork_server"));
+}
+
+Expected<process::Child> GppDevice::start(const ExecRequest &request) {
+  if (uses_fork_servers())
+    if (auto forked = fork_servers_.start(request))
+      return std::move(*forked);
+  return process::spawn(request, process::Group::Own);
 }
 
 Expected<std::unique_ptr<node::LogicalDevice>>
@@ -175,6 +196,7 @@ GppDevice::execute(const protocol::node::ExecuteRequest &r,
   }
   // The process starts on its CPUs: it inherits the spawning thread's mask while it is set.
   const std::vector<unsigned> cpus = placement ? placement->cpus : std::vector<unsigned>{};
+  request.cpus = cpus;
   auto pid = spawner_.run([&]() -> node::CallResult<ProcessId> {
     std::optional<ScopedThreadCpus> pinned;
     if (!cpus.empty() && !pinned.emplace(cpus).pinned())

@@ -6,6 +6,7 @@
 
 #include <memory>
 
+#include "fork_servers.hpp"
 #include "node/logical_device.hpp"
 #include "process/spawn_thread.hpp"
 #include "process_launcher.hpp"
@@ -20,6 +21,9 @@ public:
   node::Json properties() const override { return properties_; }
   // Its pin_admitted_cpu property (GPP.prf.xml): periodic components pinned to their CPU.
   bool pins_admitted_cpu() const;
+  // Its fork_server property (GPP.prf.xml): processes forked from fork servers of their
+  // executables.
+  bool uses_fork_servers() const;
   node::Json capacity() const override { return capacity_; }
   node::CallResult<protocol::node::ExecuteReply>
   execute(const protocol::node::ExecuteRequest &request,
@@ -37,6 +41,8 @@ private:
   packaged_executable(const protocol::node::ExecuteRequest &request,
                       const node::PackageLease &package) const;
   void on_exit(ProcessId pid, const ExitStatus &status);
+  // How the launcher starts a process: forked by a fork server when there is one, else spawned.
+  Expected<process::Child> start(const ExecRequest &request);
 
   node::DeviceContext context_;
   node::Json properties_;
@@ -49,6 +55,8 @@ private:
   std::map<ProcessId, std::shared_ptr<const node::PackageLease>> packages_;
   // Every process starts from this thread, which outlives them all (process/spawn_thread.hpp):
   // destroyed after the launcher has stopped them.
+  // Started from spawner_ too, and stopped after it (gpp/fork_servers.hpp).
+  ForkServers fork_servers_;
   process::SpawnThread spawner_;
   ProcessLauncher launcher_; // last: destroyed (terminating children) first
 };

@@ -1,5 +1,6 @@
 // The GPP's process launcher (gpp/process_launcher.hpp): execute() starts a process through
-// process/spawn.hpp in a process group of its own, at the priority the node was started with;
+// process/spawn.hpp (or the starter it was given) in a process group of its own, at the priority
+// the node was started with;
 // the launcher's state, the reaper thread that polls every pidfd and reports exits, and the
 // SIGINT -> SIGTERM -> SIGKILL escalation of terminate(). What is done to a process group when one
 // of its pidfds fires or it is signalled is in process_groups.cpp.
@@ -44,10 +45,7 @@ std::string label_of(const ExecRequest &request) {
   return request.label.empty() ? request.program.filename().string() : request.label;
 }
 
-// Starts the request's process in a process group of its own, at the priority the node daemon was
-// started with: the daemon runs above what it starts.
-Expected<process::Child> spawn_as_application(const ExecRequest &request) {
-  ApplicationPriority as_application;
+Expected<process::Child> spawn_in_own_group(const ExecRequest &request) {
   return process::spawn(request, process::Group::Own);
 }
 
@@ -70,6 +68,7 @@ std::string describe(const ExitStatus &status) {
 
 struct ProcessLauncher::State {
   ExitCallback on_exit;
+  Starter starter;
   mutable std::mutex mutex;
   std::condition_variable changed; // an exit was reported or a group is gone
   std::map<ProcessId, Record> records;
@@ -281,8 +280,10 @@ struct ProcessLauncher::State {
 
 // --- ProcessLauncher -------------------------------------------------------------------------
 
-ProcessLauncher::ProcessLauncher(ExitCallback on_exit) : state_(std::make_unique<State>()) {
+ProcessLauncher::ProcessLauncher(ExitCallback on_exit, Starter starter)
+    : state_(std::make_unique<State>()) {
   state_->on_exit = std::move(on_exit);
+  state_->starter = starter ? std::move(starter) : Starter(spawn_in_own_group);
   if (::prctl(PR_SET_CHILD_SUBREAPER, 1) != 0) {
     spdlog::warn("process launcher: cannot become a child subreaper: {}", errno_text(errno));
   }
@@ -302,7 +303,11 @@ ProcessLauncher::~ProcessLauncher() {
 }
 
 Expected<ProcessId> ProcessLauncher::execute(const ExecRequest &request) {
-  auto child = spawn_as_application(request);
+  auto child = [&] {
+    // The node runs above what it starts: the process starts at the node's starting priority.
+    ApplicationPriority as_application;
+    return state_->starter(request);
+  }();
   if (!child) {
     return tl::unexpected(std::move(child.error()));
   }

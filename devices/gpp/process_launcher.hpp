@@ -35,6 +35,9 @@ using ProcessId = pid_t;
 // name it goes by in logs.
 struct ExecRequest : process::Command {
   std::string label; // names the process in logs; empty: the program's file name
+  // The CPUs it starts on when a fork server starts it (empty: the server's). A spawned process
+  // inherits the spawning thread's mask instead, which the GPP sets (gpp/affinity.hpp).
+  std::vector<unsigned> cpus{};
 };
 
 struct ExitStatus {
@@ -83,8 +86,12 @@ public:
   // must not block, and must not call terminate(), terminate_all() or wait_for_exit(). It may be
   // called while the launcher is being destroyed.
   using ExitCallback = std::function<void(ProcessId, ExitStatus)>;
+  // How execute() starts a process, at the priority the node was started with: process::spawn
+  // in a process group of its own, unless the launcher is given another way (a fork server,
+  // gpp/fork_servers.hpp) that starts it as that would.
+  using Starter = std::function<Expected<process::Child>(const ExecRequest &)>;
 
-  explicit ProcessLauncher(ExitCallback on_exit = {});
+  explicit ProcessLauncher(ExitCallback on_exit = {}, Starter starter = {});
   // Terminates every process still running (escalation with the default options, all processes
   // at once), then stops the reaper.
   ~ProcessLauncher();

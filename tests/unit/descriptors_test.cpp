@@ -434,10 +434,13 @@ TEST_CASE("PRF: Consumer counters and GPP allocation properties", "[descriptors]
   CHECK(definition<SimpleProperty>(consumer, "log_every").type.type == SimpleType::ULong);
 
   const auto gpp = read<Properties>(kGpp / "GPP.prf.xml");
-  REQUIRE(gpp.properties.size() == 9);
+  REQUIRE(gpp.properties.size() == 10);
   const auto &pin = definition<SimpleProperty>(gpp, "pin_admitted_cpu");
   CHECK(pin.type.type == SimpleType::Boolean);
   CHECK(as<bool>(pin.value));
+  const auto &forks = definition<SimpleProperty>(gpp, "fork_server");
+  CHECK(forks.type.type == SimpleType::Boolean);
+  CHECK(as<bool>(forks.value));
   const auto &os = definition<SimpleProperty>(gpp, "DCE:4a23ad60-0b25-4121-a630-68803a498f75");
   CHECK(os.name == "os_name");
   CHECK(os.label() == "os_name");

@@ -1,0 +1,270 @@
+// process/fork_service.hpp: the fork server's loop, the double fork, and what the started process
+// takes from its request before it returns to main.
+#include "process/fork_service.hpp"
+
+#include <algorithm>
+#include <cerrno>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <fcntl.h>
+#include <poll.h>
+#include <sched.h>
+#include <sys/prctl.h>
+#include <sys/socket.h>
+#include <sys/syscall.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "process/fd.hpp"
+#include "process/fork_request.hpp"
+
+namespace rsca::process {
+namespace {
+
+// The fork server's own argument area, [begin, end): where a started process writes its command
+// line when the kernel does not let it point /proc/PID/cmdline elsewhere.
+struct ArgumentArea {
+  char *begin = nullptr;
+  char *end = nullptr;
+};
+
+struct Received {
+  std::string message;
+  std::vector<Fd> fds;
+  bool truncated = false;
+};
+
+// What a started process continues with: its request, its descriptors, and the middle process
+// whose exit re-parents it to the node.
+struct Started {
+  ForkRequest request;
+  std::vector<Fd> fds;
+  pid_t middle = 0;
+};
+
+void send_message(int socket, std::string_view message) {
+  while (::send(socket, message.data(), message.size(), MSG_NOSIGNAL) < 0 && errno == EINTR) {
+  }
+}
+
+// The next request; nullopt once the node has closed its end (or the socket failed).
+std::optional<Received> receive(int socket) {
+  std::string buffer(kForkMessageMax + 1, '\0');
+  alignas(cmsghdr) char control[CMSG_SPACE(sizeof(int) * kForkFdsMax)];
+  iovec io{buffer.data(), buffer.size()};
+  msghdr header{};
+  header.msg_iov = &io;
+  header.msg_iovlen = 1;
+  header.msg_control = control;
+  header.msg_controllen = sizeof control;
+  ssize_t size = 0;
+  do {
+    size = ::recvmsg(socket, &header, MSG_CMSG_CLOEXEC);
+  } while (size < 0 && errno == EINTR);
+  if (size <= 0)
+    return std::nullopt;
+  Received received;
+  for (auto *cmsg = CMSG_FIRSTHDR(&header); cmsg != nullptr; cmsg = CMSG_NXTHDR(&header, cmsg)) {
+    if (cmsg->cmsg_level != SOL_SOCKET || cmsg->cmsg_type != SCM_RIGHTS)
+      continue;
+    const std::size_t count = (cmsg->cmsg_len - CMSG_LEN(0)) / sizeof(int);
+    for (std::size_t i = 0; i < count; ++i) {
+      int fd = -1;
+      std::memcpy(&fd, CMSG_DATA(cmsg) + i * sizeof(int), sizeof fd);
+      received.fds.emplace_back(fd);
+    }
+  }
+  received.truncated = (header.msg_flags & (MSG_TRUNC | MSG_CTRUNC)) != 0 ||
+                       static_cast<std::size_t>(size) > kForkMessageMax;
+  received.message.assign(buffer.data(), static_cast<std::size_t>(size));
+  return received;
+}
+
+// In the middle process: forks the started process, tells the server its pid through `report`
+// (a negative errno when the fork failed), and exits. Returns only in the started process: the
+// middle process's pid.
+pid_t fork_from_middle(int report) {
+  const pid_t middle = ::getpid();
+  const pid_t child = ::fork();
+  if (child == 0)
+    return middle;
+  // Its process group exists before the node learns its pid (it sets it too: either may run
+  // first), so that the node can signal the group at once.
+  if (child > 0)
+    ::setpgid(child, child);
+  const pid_t said = child > 0 ? child : -errno;
+  [[maybe_unused]] const auto written = ::write(report, &said, sizeof said);
+  ::_exit(0);
+}
+
+// Serves requests; returns only in a started process. The server exits when the node has gone.
+Started serve(int socket, std::string_view ready) {
+  send_message(socket, ready);
+  for (;;) {
+    auto received = receive(socket);
+    if (!received)
+      ::_exit(0);
+    auto request = received->truncated
+                       ? tl::unexpected(std::string("message over the size bounds"))
+                       : decode_fork_request(received->message, received->fds.size());
+    if (!request) {
+      send_message(socket, encode(ForkReply{0, "bad request: " + request.error()}));
+      continue;
+    }
+    int pipe_ends[2];
+    if (::pipe2(pipe_ends, O_CLOEXEC) != 0) {
+      send_message(socket, encode(ForkReply{0, std::string("pipe: ") + std::strerror(errno)}));
+      continue;
+    }
+    Fd read_end{pipe_ends[0]};
+    Fd write_end{pipe_ends[1]};
+    const pid_t middle = ::fork();
+    if (middle == 0) {
+      const pid_t parent = fork_from_middle(write_end.get());
+      return Started{std::move(*request), std::move(received->fds), parent};
+    }
+    write_end.reset();
+    pid_t child = middle < 0 ? -errno : 0;
+    if (middle > 0) {
+      if (::read(read_end.get(), &child, sizeof child) != static_cast<ssize_t>(sizeof child))
+        child = -EIO;
+      while (::waitpid(middle, nullptr, 0) < 0 && errno == EINTR) {
+      }
+    }
+    send_message(socket,
+                 encode(child > 0 ? ForkReply{child, {}}
+                                  : ForkReply{0, std::string("fork: ") + std::strerror(-child)}));
+  }
+}
+
+[[noreturn]] void fail(const char *step) {
+  const int error = errno;
+  std::fprintf(stderr, "fork server: cannot start the process: %s: %s\n", step,
+               std::strerror(error));
+  ::_exit(127);
+}
+
+// stdin from /dev/null, stdout and stderr to the log, each inherited descriptor as its number,
+// and no other descriptor (the server's socket among them).
+void take_descriptors(const ForkRequest &request, std::vector<Fd> &fds) {
+  // Each descriptor first goes above every number it may be given as, so giving one its number
+  // cannot close another not given yet.
+  constexpr int kAbove = 1024;
+  std::vector<int> moved;
+  for (auto &fd : fds) {
+    moved.push_back(::fcntl(fd.get(), F_DUPFD, kAbove));
+    if (moved.back() < 0)
+      fail("fcntl");
+  }
+  const int null = ::open("/dev/null", O_RDONLY);
+  if (null < 0 || ::dup2(null, STDIN_FILENO) < 0)
+    fail("/dev/null");
+  std::size_t next = 0;
+  if (request.log) {
+    if (::dup2(moved[0], STDOUT_FILENO) < 0 || ::dup2(moved[0], STDERR_FILENO) < 0)
+      fail("dup2");
+    next = 1;
+  }
+  std::set<int> given;
+  for (const int number : request.fd_numbers) {
+    if (::dup2(moved[next++], number) < 0)
+      fail("dup2");
+    given.insert(number);
+  }
+  const int first_closed = given.empty() ? STDERR_FILENO + 1 : *given.rbegin() + 1;
+  for (int fd = STDERR_FILENO + 1; fd < first_closed; ++fd)
+    if (given.count(fd) == 0)
+      ::close(fd);
+  ::syscall(SYS_close_range, first_closed, ~0U, 0);
+  for (auto &fd : fds) // already closed above: forget them without closing again
+    [[maybe_unused]] const int released = fd.release();
+}
+
+void take_cpus(const std::vector<unsigned> &cpus) {
+  if (cpus.empty())
+    return;
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  for (const unsigned cpu : cpus)
+    CPU_SET(cpu, &set);
+  if (::sched_setaffinity(0, sizeof set, &set) != 0)
+    fail("sched_setaffinity");
+}
+
+// /proc/PID/cmdline says the started process's arguments: pointed at a copy where the kernel lets
+// a process do that (CAP_SYS_RESOURCE), else written over the fork server's own (cut to fit).
+void take_command_line(const std::string &program, const std::vector<std::string> &args,
+                       ArgumentArea area) {
+  static std::string line; // the process's for the rest of its life
+  line = program;
+  line.push_back('\0');
+  for (const auto &arg : args) {
+    line += arg;
+    line.push_back('\0');
+  }
+  const auto begin = reinterpret_cast<unsigned long>(line.data());
+  if (::prctl(PR_SET_MM, PR_SET_MM_ARG_START, begin, 0, 0) == 0 &&
+      ::prctl(PR_SET_MM, PR_SET_MM_ARG_END, begin + line.size(), 0, 0) == 0)
+    return;
+  const auto room = static_cast<std::size_t>(area.end - area.begin);
+  std::memset(area.begin, 0, room);
+  std::memcpy(area.begin, line.data(), std::min(room > 0 ? room - 1 : 0, line.size()));
+}
+
+// Once the middle process has exited, the started process is the node's child (the node is a
+// child subreaper): what it checks before it runs (component/process.cpp's die_with_node).
+void wait_until_adopted(pid_t middle) {
+  if (::getppid() != middle)
+    return;
+  Fd pidfd{static_cast<int>(::syscall(SYS_pidfd_open, middle, 0))};
+  pollfd exited{pidfd.get(), POLLIN, 0};
+  if (pidfd)
+    ::poll(&exited, 1, 5000);
+}
+
+// The started process takes its request; the new argv lives for the rest of its life.
+void become(Started &started, ArgumentArea area, int &argc, char **&argv) {
+  static std::vector<std::string> arguments;
+  static std::vector<char *> pointers;
+  const ForkRequest &request = started.request;
+  const std::string program = request.program.empty() ? argv[0] : request.program;
+  if (::setpgid(0, 0) != 0)
+    fail("setpgid");
+  take_descriptors(request, started.fds);
+  if (!request.working_dir.empty() && ::chdir(request.working_dir.c_str()) != 0)
+    fail("chdir");
+  for (const auto &[name, value] : request.env)
+    ::setenv(name.c_str(), value.c_str(), 1);
+  take_cpus(request.cpus);
+  take_command_line(program, request.args, area);
+  arguments.assign({program});
+  arguments.insert(arguments.end(), request.args.begin(), request.args.end());
+  for (auto &argument : arguments)
+    pointers.push_back(argument.data());
+  pointers.push_back(nullptr);
+  argc = static_cast<int>(arguments.size());
+  argv = pointers.data();
+  wait_until_adopted(started.middle);
+}
+
+} // namespace
+
+void serve_forks_if_asked(int &argc, char **&argv, std::string_view ready) {
+  const char *variable = std::getenv(kForkServerVariable);
+  if (variable == nullptr || argc < 1)
+    return;
+  const int socket = std::atoi(variable);
+  ::unsetenv(kForkServerVariable);    // not for the processes it starts
+  ::prctl(PR_SET_PDEATHSIG, SIGKILL); // cleared in what it forks
+  ArgumentArea area{argv[0], argv[argc - 1] + std::strlen(argv[argc - 1]) + 1};
+  Started started = serve(socket, ready);
+  become(started, area, argc, argv);
+}
+
+} // namespace rsca::process

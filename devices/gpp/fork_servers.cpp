@@ -1,0 +1,127 @@
+// gpp/fork_servers.hpp: which server serves a request, starting one, and letting one go.
+#include "gpp/fork_servers.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <utility>
+#include <vector>
+
+#include <sys/stat.h>
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+namespace rsca::gpp {
+namespace {
+
+using namespace std::chrono_literals;
+
+// How long a server has to serve once started, and to answer a request: far above what either
+// takes (a few milliseconds), for a loaded host and a sanitized build.
+constexpr auto kStartTimeout = 10s;
+constexpr auto kRequestTimeout = 10s;
+// How many executables the node remembers serve forks or not.
+constexpr std::size_t kMaxRemembered = 1024;
+
+bool for_the_loader(const std::string &name) {
+  return name.rfind("LD_", 0) == 0;
+}
+
+// What the server must be started with: the variables its dynamic loader reads, which a fork
+// cannot change.
+std::vector<std::pair<std::string, std::string>> loader_environment(const ExecRequest &request) {
+  std::vector<std::pair<std::string, std::string>> env;
+  for (const auto &variable : request.env)
+    if (for_the_loader(variable.first))
+      env.push_back(variable);
+  return env;
+}
+
+// The executable's file, and what its loader sees; empty when it cannot be read (spawn then says
+// why). The file, not its path: the node's package cache links the same verified, read-only
+// content into every package that has it, so the packages of two applications share a server. A
+// file is rewritten as a new file (a new inode); and the inode of one a server runs cannot be
+// reused while it runs.
+std::string key_of(const ExecRequest &request) {
+  struct stat status {};
+  if (::stat(request.program.c_str(), &status) != 0)
+    return {};
+  std::string key = fmt::format("{}:{}:{}", status.st_dev, status.st_ino, status.st_size);
+  for (const auto &[name, value] : loader_environment(request))
+    key += fmt::format("\n{}={}", name, value);
+  return key;
+}
+
+} // namespace
+
+std::optional<Expected<process::Child>> ForkServers::start(const ExecRequest &request) {
+  const std::lock_guard lock(mutex_);
+  const std::string key = key_of(request);
+  if (key.empty())
+    return std::nullopt;
+  auto *server = server_for(request, key);
+  if (server == nullptr)
+    return std::nullopt;
+  auto child = server->spawn(request, request.cpus, kRequestTimeout);
+  if (child)
+    return child;
+  if (!server->alive()) {
+    spdlog::warn("fork server of {} (pid {}) stopped: {}; the process is executed",
+                 request.program.string(), server->pid(), child.error().to_string());
+    servers_.erase(key);
+    return std::nullopt;
+  }
+  return child;
+}
+
+process::ForkServer *ForkServers::server_for(const ExecRequest &request, const std::string &key) {
+  if (auto found = servers_.find(key); found != servers_.end()) {
+    found->second.last_used = ++uses_;
+    return &found->second.server;
+  }
+  if (serves_.size() >= kMaxRemembered)
+    serves_.clear(); // each is read again when next used
+  auto [serves, first] = serves_.try_emplace(key, false);
+  if (first)
+    serves->second = process::may_serve_forks(request.program);
+  if (!serves->second)
+    return nullptr;
+  auto started =
+      process::ForkServer::start(request.program, loader_environment(request), kStartTimeout);
+  if (!started) {
+    spdlog::warn("{}; its processes are executed", started.error().to_string());
+    serves->second = false;
+    return nullptr;
+  }
+  drop_deleted();
+  make_room();
+  spdlog::info("fork server of {} started (pid {})", request.program.string(), started->pid());
+  auto &entry = servers_.emplace(key, Entry{std::move(*started), ++uses_}).first->second;
+  return &entry.server;
+}
+
+void ForkServers::drop_deleted() {
+  std::erase_if(servers_, [](const auto &entry) {
+    // The server's executable, even when no path names it any more: a package the cache let go.
+    struct stat status {};
+    const auto exe = fmt::format("/proc/{}/exe", entry.second.server.pid());
+    const bool deleted = ::stat(exe.c_str(), &status) != 0 || status.st_nlink == 0;
+    if (deleted)
+      spdlog::info("fork server (pid {}) stopped: its executable is gone",
+                   entry.second.server.pid());
+    return deleted;
+  });
+}
+
+void ForkServers::make_room() {
+  if (servers_.size() < kMaxServers)
+    return;
+  const auto oldest = std::min_element(servers_.begin(), servers_.end(), [](auto &a, auto &b) {
+    return a.second.last_used < b.second.last_used;
+  });
+  spdlog::info("fork server (pid {}) stopped: the least recently used of {}",
+               oldest->second.server.pid(), kMaxServers);
+  servers_.erase(oldest);
+}
+
+} // namespace rsca::gpp
