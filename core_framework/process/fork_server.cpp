@@ -9,6 +9,7 @@
 
 #include <fcntl.h>
 #include <poll.h>
+#include <sched.h>
 #include <signal.h>
 #include <sys/mman.h>
 #include <sys/socket.h>
@@ -42,6 +43,19 @@ std::optional<std::string> receive(const Fd &socket, std::chrono::milliseconds t
     return std::nullopt;
   buffer.resize(static_cast<std::size_t>(size));
   return buffer;
+}
+
+// The CPUs a process this thread spawned would inherit (the GPP sets them for a placement).
+std::vector<unsigned> calling_thread_cpus() {
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  std::vector<unsigned> cpus;
+  if (::sched_getaffinity(0, sizeof set, &set) != 0)
+    return cpus;
+  for (unsigned cpu = 0; cpu < CPU_SETSIZE; ++cpu)
+    if (CPU_ISSET(cpu, &set))
+      cpus.push_back(cpu);
+  return cpus;
 }
 
 bool send_request(const Fd &socket, const std::string &message, const std::vector<int> &fds) {
@@ -137,8 +151,7 @@ void ForkServer::stop() {
   server_.pidfd.reset();
 }
 
-Expected<Child> ForkServer::spawn(const Command &command, const std::vector<unsigned> &cpus,
-                                  std::chrono::milliseconds timeout) {
+Expected<Child> ForkServer::spawn(const Command &command, std::chrono::milliseconds timeout) {
   auto log = prepare_to_spawn(command);
   if (!log)
     return tl::unexpected(std::move(log.error()));
@@ -148,7 +161,7 @@ Expected<Child> ForkServer::spawn(const Command &command, const std::vector<unsi
                       .args = command.args,
                       .env = command.env,
                       .working_dir = command.working_dir.string(),
-                      .cpus = cpus,
+                      .cpus = calling_thread_cpus(),
                       .log = static_cast<bool>(*log),
                       .fd_numbers = {}};
   std::vector<int> fds;

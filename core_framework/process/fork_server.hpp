@@ -44,11 +44,11 @@ public:
 
   // Starts the command's process (command.program, its argv[0], names the server's executable
   // file, by the path it was started with or another link to the same file; its log file and
-  // inherited descriptors as process::spawn gives them) on `cpus` (none: the server's), in a
-  // process group of its own. An error names the step; one that leaves the server unusable
-  // (it died, or did not answer within `timeout`) makes alive() false.
-  Expected<Child> spawn(const Command &command, const std::vector<unsigned> &cpus,
-                        std::chrono::milliseconds timeout);
+  // inherited descriptors as process::spawn gives them) in a process group of its own, on the
+  // calling thread's CPUs, as a spawned process would inherit them. An error names the step; one
+  // that leaves the server unusable (it died, or did not answer within `timeout`) makes alive()
+  // false.
+  Expected<Child> spawn(const Command &command, std::chrono::milliseconds timeout);
 
   bool alive() const { return static_cast<bool>(socket_); }
   pid_t pid() const { return server_.pid; }

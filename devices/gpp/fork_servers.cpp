@@ -6,7 +6,9 @@
 #include <utility>
 #include <vector>
 
+#include <sched.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -62,7 +64,7 @@ std::optional<Expected<process::Child>> ForkServers::start(const ExecRequest &re
   auto *server = server_for(request, key);
   if (server == nullptr)
     return std::nullopt;
-  auto child = server->spawn(request, request.cpus, kRequestTimeout);
+  auto child = server->spawn(request, kRequestTimeout);
   if (child)
     return child;
   if (!server->alive()) {
@@ -93,6 +95,10 @@ process::ForkServer *ForkServers::server_for(const ExecRequest &request, const s
     serves->second = false;
     return nullptr;
   }
+  // Started from a thread that may be on a placement's CPUs: the server itself runs on the node's.
+  cpu_set_t node_cpus;
+  if (::sched_getaffinity(::getpid(), sizeof node_cpus, &node_cpus) == 0)
+    ::sched_setaffinity(started->pid(), sizeof node_cpus, &node_cpus);
   drop_deleted();
   make_room();
   spdlog::info("fork server of {} started (pid {})", request.program.string(), started->pid());

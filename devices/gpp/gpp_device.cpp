@@ -196,7 +196,6 @@ GppDevice::execute(const protocol::node::ExecuteRequest &r,
   }
   // The process starts on its CPUs: it inherits the spawning thread's mask while it is set.
   const std::vector<unsigned> cpus = placement ? placement->cpus : std::vector<unsigned>{};
-  request.cpus = cpus;
   auto pid = spawner_.run([&]() -> node::CallResult<ProcessId> {
     std::optional<ScopedThreadCpus> pinned;
     if (!cpus.empty() && !pinned.emplace(cpus).pinned())

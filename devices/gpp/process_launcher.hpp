@@ -35,9 +35,6 @@ using ProcessId = pid_t;
 // name it goes by in logs.
 struct ExecRequest : process::Command {
   std::string label; // names the process in logs; empty: the program's file name
-  // The CPUs it starts on when a fork server starts it (empty: the server's). A spawned process
-  // inherits the spawning thread's mask instead, which the GPP sets (gpp/affinity.hpp).
-  std::vector<unsigned> cpus{};
 };
 
 struct ExitStatus {

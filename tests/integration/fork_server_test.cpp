@@ -145,3 +145,33 @@ TEST_CASE("a node whose GPP's fork_server is false executes every process",
   REQUIRE(domain.call("app.release", Json{{"app", "a"}}).has_value());
   domain.require_clean(pids);
 }
+
+namespace {
+
+std::string cpus_allowed(long pid) {
+  std::ifstream status(fmt::format("/proc/{}/status", pid));
+  for (std::string line; std::getline(status, line);)
+    if (line.rfind("Cpus_allowed_list:", 0) == 0)
+      return line.substr(line.find_first_not_of(" \t", line.find(':') + 1));
+  return {};
+}
+
+} // namespace
+
+TEST_CASE("a process forked after one pinned to a CPU runs on the node's CPUs, not that one's",
+          "[integration][fork_server]") {
+  // A node that leaves periodic components free (the producer is one), so that only an
+  // instance's affinity pins a process.
+  TestDomain domain({kTestSdr / "dev/nodes/free1/DeviceManager.dcd.xml"});
+  // The first process of the producer's executable is pinned: its server starts then.
+  const auto pinned = pids_of(domain.create("Pinned"));
+  REQUIRE(pinned.size() == 1);
+  CHECK(cpus_allowed(pinned.front()) == "0");
+  const auto pids = launch(domain, "a");
+  REQUIRE(pids.size() == 2);
+  const std::string node_cpus = cpus_allowed(domain.node_pid(1));
+  for (const long pid : pids)
+    CHECK(cpus_allowed(pid) == node_cpus);
+  for (const auto &server : fork_servers_of(domain.node_pid(1)))
+    CHECK(cpus_allowed(server.pid) == node_cpus);
+}

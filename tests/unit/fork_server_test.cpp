@@ -9,6 +9,7 @@
 #include <string>
 
 #include <fcntl.h>
+#include <sched.h>
 #include <signal.h>
 #include <sys/prctl.h>
 #include <sys/wait.h>
@@ -73,7 +74,15 @@ TEST_CASE("a process forked from a fork server has what spawn would have given i
                         .working_dir = dir.path(),
                         .log_file = dir.path() / "logs/forked.log",
                         .inherit = {{write_end.get(), 3}}};
-  auto child = server.spawn(command, {0}, 10s);
+  // On the calling thread's CPUs, as a spawned child: here CPU 0 alone.
+  cpu_set_t saved;
+  REQUIRE(::sched_getaffinity(0, sizeof saved, &saved) == 0);
+  cpu_set_t zero;
+  CPU_ZERO(&zero);
+  CPU_SET(0, &zero);
+  REQUIRE(::sched_setaffinity(0, sizeof zero, &zero) == 0);
+  auto child = server.spawn(command, 10s);
+  REQUIRE(::sched_setaffinity(0, sizeof saved, &saved) == 0);
   INFO((child ? "" : child.error().to_string()));
   REQUIRE(child.has_value());
   CHECK(exit_code_of(child->pid) == 7); // this process's child: it reaps it
@@ -99,7 +108,7 @@ TEST_CASE("a fork server starts many processes, one after the other", "[process]
   TempDir dir;
   auto server = started_server();
   for (int i = 0; i < 20; ++i) {
-    auto child = server.spawn({.program = kForked, .args = {std::to_string(i)}}, {}, 10s);
+    auto child = server.spawn({.program = kForked, .args = {std::to_string(i)}}, 10s);
     REQUIRE(child.has_value());
     CHECK(exit_code_of(child->pid) == i);
   }
@@ -111,7 +120,7 @@ TEST_CASE("a process forked from a fork server has its own command line, can be 
   TempDir dir;
   auto server = started_server();
   auto child = server.spawn(
-      {.program = kForked, .args = {"wait", "--flag"}, .log_file = dir.path() / "log"}, {}, 10s);
+      {.program = kForked, .args = {"wait", "--flag"}, .log_file = dir.path() / "log"}, 10s);
   REQUIRE(child.has_value());
   REQUIRE(::kill(-child->pid, 0) == 0); // its group exists as soon as its pid is known
   // Once it runs main (it has said something), /proc shows its arguments (cut to the server's
@@ -143,7 +152,7 @@ TEST_CASE("a program that does not serve forks is not started as a fork server",
 TEST_CASE("a fork server that died says so, and starts nothing", "[process][fork_server]") {
   auto server = started_server();
   REQUIRE(::kill(server.pid(), SIGKILL) == 0);
-  auto child = server.spawn({.program = kForked, .args = {"0"}}, {}, 10s);
+  auto child = server.spawn({.program = kForked, .args = {"0"}}, 10s);
   REQUIRE_FALSE(child.has_value());
   CHECK_THAT(child.error().to_string(), Catch::Contains("did not answer"));
   CHECK_FALSE(server.alive());
@@ -152,7 +161,7 @@ TEST_CASE("a fork server that died says so, and starts nothing", "[process][fork
 TEST_CASE("a fork server's checks are spawn's: a bad working directory starts nothing",
           "[process][fork_server]") {
   auto server = started_server();
-  auto child = server.spawn({.program = kForked, .working_dir = "/no/such/dir"}, {}, 10s);
+  auto child = server.spawn({.program = kForked, .working_dir = "/no/such/dir"}, 10s);
   REQUIRE_FALSE(child.has_value());
   CHECK_THAT(child.error().to_string(), Catch::Contains("no such directory"));
   CHECK(server.alive());
