@@ -20,6 +20,9 @@ the nodes (10, or 1 for 100 processes connected through the node's shared memory
   a bare Cyclone DDS participant joined as a component process joins, and the time until each has
   discovered all the others: what launching N component processes costs DDS alone.
 Growth from one N to the next says whether launch time is about linear in N.
+A node forks the processes of an executable from a fork server of it (gpp/fork_servers.hpp);
+--executed gives the nodes DCDs whose GPP executes every process instead (fork_server false), the
+launch as it was before fork servers, for a before/after in one session.
 """
 import argparse
 import json
@@ -103,6 +106,26 @@ def host_footprint(domain, app):
             "cpu_percent_idle": 100.0 * ticks / os.sysconf("SC_CLK_TCK") / 2.0}
 
 
+def executing_nodes(count, folder):
+    """DCDs of nodes node1..N whose GPP executes every process (fork_server false): the launch as
+    it was before fork servers, for --executed."""
+    with open(os.path.join(ROOT, "profiles/dev/nodes/node1/DeviceManager.dcd.xml")) as f:
+        template = f.read()
+    dcds = []
+    for i in range(1, count + 1):
+        text = (template.replace('name="node1"', f'name="node{i}"')
+                .replace("node1:GPP_1", f"node{i}:GPP_1")
+                .replace("f84aba57-3d9f-41c9-97e2-603b07e7eb5c", f"rsca-bench-executing-{i}")
+                .replace("<usagename>GPP_1</usagename>",
+                         '<usagename>GPP_1</usagename><componentproperties><simpleref '
+                         'refid="fork_server" value="false"/></componentproperties>'))
+        path = os.path.join(folder, f"node{i}.dcd.xml")
+        with open(path, "w") as f:
+            f.write(text)
+        dcds.append((f"node{i}", path))
+    return dcds
+
+
 def bench_n(domain, n, hosted, runs, sdr, relay, raw):
     sad, name = generate(n, hosted, sdr)
     domain.cli("install", "--sdrroot", sdr, sad)
@@ -144,6 +167,9 @@ def main():
     parser.add_argument("--only", default="",
                         help="measure only these, e.g. 100p1,500p10 (components, p or h for "
                              "processes or hosted, nodes)")
+    parser.add_argument("--executed", action="store_true",
+                        help="nodes whose GPP executes every process (fork_server false), as "
+                             "launches were before fork servers")
     args = parser.parse_args()
     # (components, hosted, nodes): processes on one node connect through its shared memory; on
     # ten, a chain spread over them crosses nodes at every link.
@@ -167,7 +193,8 @@ def main():
                                 "skipped": "not tried with --quick (the full run tries it)"})
             else:
                 print(f"launch of {n} {kind} on {nodes} nodes...", file=sys.stderr)
-                with Domain(rsca, nodes=nodes) as domain:
+                dcds = executing_nodes(nodes, sdr) if args.executed else None
+                with Domain(rsca, nodes=nodes, node_dcds=dcds) as domain:
                     n_runs = min(runs, 3) if n >= 500 else runs
                     results.append(bench_n(domain, n, hosted, n_runs, sdr,
                                            os.path.join(args.bin, "rsca-relay"),
@@ -211,7 +238,8 @@ def main():
                   f"{r['launch_domain_ms']['median'] / base:.2f} (launch "
                   f"{r['launch_domain_ms']['median']:.0f} ms, fork/exec "
                   f"{r['baseline_fork_exec_ms']['median']:.0f} ms, join of one participant "
-                  f"{r['join_ms']['median']:.0f} ms)")
+                  f"{r['join_ms']['median']:.0f} ms)"
+                  f"{' with every process executed (no fork server)' if args.executed else ''}")
     for a, b in zip(results, results[1:]):
         if a["kind"] != b["kind"] or "launch_domain_ms" not in a or "launch_domain_ms" not in b:
             continue

@@ -233,7 +233,7 @@ class Domain:
             for i in range(1, self.nodes + 1)]
         for i, (name, dcd) in enumerate(dcds, start=1):
             self._spawn(name, [
-                os.path.join(bin_dir, "rsca-noded"), "--dcd", dcd, "--log-dir",
+                os.path.join(bin_dir, "rsca-noded"), "--dcd", dcd, "--sdrroot", sdrroot, "--log-dir",
                 os.path.join(self.run_dir, "logs"), "--exec-path", bin_dir,
                 "--control-socket", os.path.join(self.run_dir, f"{name}.sock")],
                 host=self.hosts and self.hosts[i])
@@ -250,7 +250,7 @@ class Domain:
 
     def __enter__(self):
         try:
-            if self.domaind_args or self.hosts:
+            if self.domaind_args is not None or self.hosts or self.node_dcds:
                 self._up_by_hand()
             else:
                 subprocess.run([self.rsca, *self._global(), "domain", "up", "--nodes",
