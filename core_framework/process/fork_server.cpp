@@ -83,7 +83,7 @@ bool send_request(const Fd &socket, const std::string &message, const std::vecto
 } // namespace
 
 bool may_serve_forks(const std::filesystem::path &program) {
-  const Fd file{::open(program.c_str(), O_RDONLY | O_CLOEXEC)};
+  const Fd file{::open(program.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK)}; // a FIFO: no wait
   struct stat status {};
   if (!file || ::fstat(file.get(), &status) != 0 || !S_ISREG(status.st_mode) || status.st_size <= 0)
     return false;
@@ -145,9 +145,15 @@ void ForkServer::stop() {
   socket_.reset();
   if (!server_.pidfd)
     return;
-  ::kill(server_.pid, SIGKILL);
+  // The server's whole group: a middle process it had forked goes with it (re-parented here, as
+  // this process is a child subreaper, and reaped below with the server).
+  ::kill(-server_.pid, SIGKILL);
   while (::waitpid(server_.pid, nullptr, 0) < 0 && errno == EINTR) {
   }
+  siginfo_t info{};
+  while (::waitid(P_PGID, static_cast<id_t>(server_.pid), &info, WEXITED | WNOHANG) == 0 &&
+         info.si_pid != 0)
+    info = {};
   server_.pidfd.reset();
 }
 

@@ -40,11 +40,42 @@ struct Received {
   bool truncated = false;
 };
 
-// What a started process continues with: its request, its descriptors, and the middle process
-// whose exit re-parents it to the node.
+// What a started process tells its middle process once it has taken its request, and the middle
+// process the server: the process's pid, or the step that failed and its errno. One write of less
+// than PIPE_BUF: whole or not at all.
+struct Report {
+  pid_t pid = 0;
+  int error = 0;
+  char step[32] = {};
+};
+
+Report failure(const char *step, int error) {
+  Report report;
+  report.error = error;
+  std::strncpy(report.step, step, sizeof report.step - 1);
+  return report;
+}
+
+void write_report(int fd, const Report &report) {
+  [[maybe_unused]] const auto written = ::write(fd, &report, sizeof report);
+}
+
+// A report from `fd`; a failure at `step` when the writer went without one.
+Report read_report(int fd, const char *step) {
+  Report report;
+  ssize_t size = 0;
+  do {
+    size = ::read(fd, &report, sizeof report);
+  } while (size < 0 && errno == EINTR);
+  return size == static_cast<ssize_t>(sizeof report) ? report : failure(step, EIO);
+}
+
+// What a started process continues with: its request, its descriptors, where it reports, and the
+// middle process whose exit re-parents it to the node.
 struct Started {
   ForkRequest request;
   std::vector<Fd> fds;
+  int report = -1;
   pid_t middle = 0;
 };
 
@@ -86,20 +117,36 @@ std::optional<Received> receive(int socket) {
   return received;
 }
 
-// In the middle process: forks the started process, tells the server its pid through `report`
-// (a negative errno when the fork failed), and exits. Returns only in the started process: the
-// middle process's pid.
-pid_t fork_from_middle(int report) {
+// In the middle process: forks the started process and waits for it to say it has taken its
+// request (a process that failed to is reaped here), tells the server through `to_server`, and
+// exits. Returns only in the started process, with the middle process's pid and where it
+// reports.
+std::pair<pid_t, int> fork_from_middle(int to_server) {
+  int status[2];
+  if (::pipe2(status, O_CLOEXEC) != 0) {
+    write_report(to_server, failure("pipe", errno));
+    ::_exit(0);
+  }
   const pid_t middle = ::getpid();
   const pid_t child = ::fork();
-  if (child == 0)
-    return middle;
+  if (child == 0) {
+    ::close(status[0]);
+    return {middle, status[1]};
+  }
+  ::close(status[1]);
+  if (child < 0) {
+    write_report(to_server, failure("fork", errno));
+    ::_exit(0);
+  }
   // Its process group exists before the node learns its pid (it sets it too: either may run
   // first), so that the node can signal the group at once.
-  if (child > 0)
-    ::setpgid(child, child);
-  const pid_t said = child > 0 ? child : -errno;
-  [[maybe_unused]] const auto written = ::write(report, &said, sizeof said);
+  ::setpgid(child, child);
+  Report report = read_report(status[0], "start");
+  if (report.error != 0)
+    ::waitpid(child, nullptr, 0);
+  else
+    report.pid = child;
+  write_report(to_server, report);
   ::_exit(0);
 }
 
@@ -126,25 +173,27 @@ Started serve(int socket, std::string_view ready) {
     Fd write_end{pipe_ends[1]};
     const pid_t middle = ::fork();
     if (middle == 0) {
-      const pid_t parent = fork_from_middle(write_end.get());
-      return Started{std::move(*request), std::move(received->fds), parent};
+      read_end.reset();
+      const auto [parent, report] = fork_from_middle(write_end.get());
+      return Started{std::move(*request), std::move(received->fds), report, parent};
     }
     write_end.reset();
-    pid_t child = middle < 0 ? -errno : 0;
-    if (middle > 0) {
-      if (::read(read_end.get(), &child, sizeof child) != static_cast<ssize_t>(sizeof child))
-        child = -EIO;
+    Report report = middle < 0 ? failure("fork", errno) : read_report(read_end.get(), "fork");
+    if (middle > 0)
       while (::waitpid(middle, nullptr, 0) < 0 && errno == EINTR) {
       }
-    }
-    send_message(socket,
-                 encode(child > 0 ? ForkReply{child, {}}
-                                  : ForkReply{0, std::string("fork: ") + std::strerror(-child)}));
+    send_message(socket, encode(report.error == 0 ? ForkReply{report.pid, {}}
+                                                  : ForkReply{0, std::string(report.step) + ": " +
+                                                                     std::strerror(report.error)}));
   }
 }
 
-[[noreturn]] void fail(const char *step) {
+// Before it has reported: the middle process hears of the failure, and so do the server and the
+// node. After: its log says it.
+[[noreturn]] void fail(const Started &started, const char *step) {
   const int error = errno;
+  if (started.report >= 0)
+    write_report(started.report, failure(step, error));
   std::fprintf(stderr, "fork server: cannot start the process: %s: %s\n", step,
                std::strerror(error));
   ::_exit(127);
@@ -152,41 +201,40 @@ Started serve(int socket, std::string_view ready) {
 
 // stdin from /dev/null, stdout and stderr to the log, each inherited descriptor as its number,
 // and no other descriptor (the server's socket among them).
-void take_descriptors(const ForkRequest &request, std::vector<Fd> &fds) {
-  // Each descriptor first goes above every number it may be given as, so giving one its number
+void take_descriptors(const Started &started, std::vector<Fd> &fds) {
+  const ForkRequest &request = started.request;
+  std::set<int> given(request.fd_numbers.begin(), request.fd_numbers.end());
+  // Each descriptor first goes above every number it is given as, so giving one its number
   // cannot close another not given yet.
-  constexpr int kAbove = 1024;
+  const int above = given.empty() ? STDERR_FILENO + 1 : *given.rbegin() + 1;
   std::vector<int> moved;
   for (auto &fd : fds) {
-    moved.push_back(::fcntl(fd.get(), F_DUPFD, kAbove));
+    moved.push_back(::fcntl(fd.get(), F_DUPFD, above));
     if (moved.back() < 0)
-      fail("fcntl");
+      fail(started, "fcntl");
   }
   const int null = ::open("/dev/null", O_RDONLY);
   if (null < 0 || ::dup2(null, STDIN_FILENO) < 0)
-    fail("/dev/null");
+    fail(started, "/dev/null");
   std::size_t next = 0;
   if (request.log) {
     if (::dup2(moved[0], STDOUT_FILENO) < 0 || ::dup2(moved[0], STDERR_FILENO) < 0)
-      fail("dup2");
+      fail(started, "dup2");
     next = 1;
   }
-  std::set<int> given;
-  for (const int number : request.fd_numbers) {
+  for (const int number : request.fd_numbers)
     if (::dup2(moved[next++], number) < 0)
-      fail("dup2");
-    given.insert(number);
-  }
-  const int first_closed = given.empty() ? STDERR_FILENO + 1 : *given.rbegin() + 1;
-  for (int fd = STDERR_FILENO + 1; fd < first_closed; ++fd)
+      fail(started, "dup2");
+  for (int fd = STDERR_FILENO + 1; fd < above; ++fd)
     if (given.count(fd) == 0)
       ::close(fd);
-  ::syscall(SYS_close_range, first_closed, ~0U, 0);
+  ::closefrom(above);
   for (auto &fd : fds) // already closed above: forget them without closing again
     [[maybe_unused]] const int released = fd.release();
 }
 
-void take_cpus(const std::vector<unsigned> &cpus) {
+void take_cpus(const Started &started) {
+  const auto &cpus = started.request.cpus;
   if (cpus.empty())
     return;
   cpu_set_t set;
@@ -194,11 +242,12 @@ void take_cpus(const std::vector<unsigned> &cpus) {
   for (const unsigned cpu : cpus)
     CPU_SET(cpu, &set);
   if (::sched_setaffinity(0, sizeof set, &set) != 0)
-    fail("sched_setaffinity");
+    fail(started, "sched_setaffinity");
 }
 
 // /proc/PID/cmdline says the started process's arguments: pointed at a copy where the kernel lets
-// a process do that (CAP_SYS_RESOURCE), else written over the fork server's own (cut to fit).
+// a process do that (CAP_SYS_RESOURCE), else written over the fork server's own (cut to fit; the
+// rest of that room reads as empty arguments).
 void take_command_line(const std::string &program, const std::vector<std::string> &args,
                        ArgumentArea area) {
   static std::string line; // the process's for the rest of its life
@@ -228,20 +277,27 @@ void wait_until_adopted(pid_t middle) {
     ::poll(&exited, 1, 5000);
 }
 
-// The started process takes its request; the new argv lives for the rest of its life.
+// The started process takes its request: first what may fail, then it reports, then its
+// descriptors (its report's among those closed). The new argv lives for the rest of its life.
 void become(Started &started, ArgumentArea area, int &argc, char **&argv) {
   static std::vector<std::string> arguments;
   static std::vector<char *> pointers;
   const ForkRequest &request = started.request;
   const std::string program = request.program.empty() ? argv[0] : request.program;
   if (::setpgid(0, 0) != 0)
-    fail("setpgid");
-  take_descriptors(request, started.fds);
+    fail(started, "setpgid");
   if (!request.working_dir.empty() && ::chdir(request.working_dir.c_str()) != 0)
-    fail("chdir");
+    fail(started, "chdir");
+  take_cpus(started);
   for (const auto &[name, value] : request.env)
-    ::setenv(name.c_str(), value.c_str(), 1);
-  take_cpus(request.cpus);
+    if (::setenv(name.c_str(), value.c_str(), 1) != 0)
+      fail(started, "setenv");
+  Report taken;
+  taken.pid = ::getpid();
+  write_report(started.report, taken);
+  ::close(started.report);
+  started.report = -1;
+  take_descriptors(started, started.fds);
   take_command_line(program, request.args, area);
   arguments.assign({program});
   arguments.insert(arguments.end(), request.args.begin(), request.args.end());

@@ -25,16 +25,21 @@ constexpr auto kRequestTimeout = 10s;
 // How many executables the node remembers serve forks or not.
 constexpr std::size_t kMaxRemembered = 1024;
 
-bool for_the_loader(const std::string &name) {
-  return name.rfind("LD_", 0) == 0;
+// Read once, as a process starts (by the dynamic loader, glibc, the sanitizers), so a fork cannot
+// change them: the server must be started with them.
+bool read_at_start(const std::string &name) {
+  for (const char *prefix : {"LD_", "GLIBC_TUNABLES", "MALLOC_", "ASAN_", "UBSAN_", "LSAN_",
+                             "TSAN_", "LLVM_PROFILE_FILE"})
+    if (name.rfind(prefix, 0) == 0)
+      return true;
+  return false;
 }
 
-// What the server must be started with: the variables its dynamic loader reads, which a fork
-// cannot change.
-std::vector<std::pair<std::string, std::string>> loader_environment(const ExecRequest &request) {
+// What the server must be started with: the request's variables read at start.
+std::vector<std::pair<std::string, std::string>> startup_environment(const ExecRequest &request) {
   std::vector<std::pair<std::string, std::string>> env;
   for (const auto &variable : request.env)
-    if (for_the_loader(variable.first))
+    if (read_at_start(variable.first))
       env.push_back(variable);
   return env;
 }
@@ -46,17 +51,17 @@ std::vector<std::pair<std::string, std::string>> loader_environment(const ExecRe
 // reused while it runs.
 std::string key_of(const ExecRequest &request) {
   struct stat status {};
-  if (::stat(request.program.c_str(), &status) != 0)
+  if (::stat(request.program.c_str(), &status) != 0 || !S_ISREG(status.st_mode))
     return {};
   std::string key = fmt::format("{}:{}:{}", status.st_dev, status.st_ino, status.st_size);
-  for (const auto &[name, value] : loader_environment(request))
+  for (const auto &[name, value] : startup_environment(request))
     key += fmt::format("\n{}={}", name, value);
   return key;
 }
 
 } // namespace
 
-std::optional<Expected<process::Child>> ForkServers::start(const ExecRequest &request) {
+std::optional<process::Child> ForkServers::fork(const ExecRequest &request) {
   const std::lock_guard lock(mutex_);
   const std::string key = key_of(request);
   if (key.empty())
@@ -66,14 +71,13 @@ std::optional<Expected<process::Child>> ForkServers::start(const ExecRequest &re
     return std::nullopt;
   auto child = server->spawn(request, kRequestTimeout);
   if (child)
-    return child;
-  if (!server->alive()) {
-    spdlog::warn("fork server of {} (pid {}) stopped: {}; the process is executed",
-                 request.program.string(), server->pid(), child.error().to_string());
+    return std::move(*child);
+  // Executed instead, which says again what is wrong with the request itself.
+  spdlog::warn("fork server of {} (pid {}): {}; the process is executed", request.program.string(),
+               server->pid(), child.error().to_string());
+  if (!server->alive())
     servers_.erase(key);
-    return std::nullopt;
-  }
-  return child;
+  return std::nullopt;
 }
 
 process::ForkServer *ForkServers::server_for(const ExecRequest &request, const std::string &key) {
@@ -89,7 +93,7 @@ process::ForkServer *ForkServers::server_for(const ExecRequest &request, const s
   if (!serves->second)
     return nullptr;
   auto started =
-      process::ForkServer::start(request.program, loader_environment(request), kStartTimeout);
+      process::ForkServer::start(request.program, startup_environment(request), kStartTimeout);
   if (!started) {
     spdlog::warn("{}; its processes are executed", started.error().to_string());
     serves->second = false;

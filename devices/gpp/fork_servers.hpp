@@ -23,9 +23,10 @@ class ForkServers {
 public:
   static constexpr std::size_t kMaxServers = 16;
 
-  // The request's process started by its executable's fork server; nullopt when no server can
-  // start it (the caller spawns it). An error is one process::spawn would give too (its checks).
-  std::optional<Expected<process::Child>> start(const ExecRequest &request);
+  // The request's process forked by its executable's fork server; nullopt when no server can
+  // fork it (an executable that does not serve, a server that failed, a request it refused): the
+  // caller executes it, which reports what is wrong with the request itself.
+  std::optional<process::Child> fork(const ExecRequest &request);
 
 private:
   struct Entry {

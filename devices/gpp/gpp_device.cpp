@@ -42,7 +42,7 @@ std::optional<Json> override_of(const node::DeviceContext &context, const char *
 GppDevice::GppDevice(node::DeviceContext context)
     : context_(std::move(context)),
       launcher_([this](ProcessId pid, ExitStatus status) { on_exit(pid, status); },
-                [this](const ExecRequest &request) { return start(request); }) {
+                [this](const ExecRequest &request) { return start_process(request); }) {
   const HostInfo host = read_host_info();
   properties_ = {
       {"os_name", override_of(context_, "os_name").value_or(host.os_name)},
@@ -77,9 +77,9 @@ bool GppDevice::uses_fork_servers() const {
   return is_true(properties_.at("fork_server"));
 }
 
-Expected<process::Child> GppDevice::start(const ExecRequest &request) {
+Expected<process::Child> GppDevice::start_process(const ExecRequest &request) {
   if (uses_fork_servers())
-    if (auto forked = fork_servers_.start(request))
+    if (auto forked = fork_servers_.fork(request))
       return std::move(*forked);
   return process::spawn(request, process::Group::Own);
 }

@@ -42,7 +42,7 @@ private:
                       const node::PackageLease &package) const;
   void on_exit(ProcessId pid, const ExitStatus &status);
   // How the launcher starts a process: forked by a fork server when there is one, else spawned.
-  Expected<process::Child> start(const ExecRequest &request);
+  Expected<process::Child> start_process(const ExecRequest &request);
 
   node::DeviceContext context_;
   node::Json properties_;

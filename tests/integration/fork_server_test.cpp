@@ -26,10 +26,12 @@ struct ProcessFacts {
   long group = 0;
   std::string command_line; // NULs as spaces
   std::string executable;
+  std::string
+      first_mapping; // its lowest mapping's address range: a forked process's is its server's
 };
 
 ProcessFacts facts_of(long pid) {
-  ProcessFacts facts{pid, 0, 0, {}, {}};
+  ProcessFacts facts{pid, 0, 0, {}, {}, {}};
   const fs::path proc = fmt::format("/proc/{}", pid);
   std::ifstream stat(proc / "stat");
   std::string text((std::istreambuf_iterator<char>(stat)), std::istreambuf_iterator<char>());
@@ -46,6 +48,8 @@ ProcessFacts facts_of(long pid) {
     c = c == '\0' ? ' ' : c;
   std::error_code ec;
   facts.executable = fs::read_symlink(proc / "exe", ec).string();
+  std::ifstream maps(proc / "maps");
+  maps >> facts.first_mapping;
   return facts;
 }
 
@@ -96,14 +100,18 @@ TEST_CASE("a node forks the processes of an executable from a fork server of it,
     servers = fork_servers_of(node);
     REQUIRE(servers.size() == 2); // one per executable: the producer's, the consumer's
     std::set<std::string> served;
-    for (const auto &server : servers)
+    std::set<std::string> layouts; // where each server's executable is mapped
+    for (const auto &server : servers) {
       served.insert(server.executable);
+      layouts.insert(server.first_mapping);
+    }
     for (const long pid : pids) {
       const auto facts = facts_of(pid);
       INFO(facts.command_line);
       CHECK(facts.parent == node);
       CHECK(facts.group == pid);
       CHECK(served.count(facts.executable) == 1);
+      CHECK(layouts.count(facts.first_mapping) == 1); // forked from one: an exec maps it anew
       CHECK_THAT(facts.command_line, Catch::Contains("COMPONENT_IDENTIFIER"));
     }
     // A forked process that dies is reported as any: the application is degraded.

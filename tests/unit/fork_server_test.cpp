@@ -12,6 +12,7 @@
 #include <sched.h>
 #include <signal.h>
 #include <sys/prctl.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -102,6 +103,43 @@ TEST_CASE("a process forked from a fork server has what spawn would have given i
   CHECK_THAT(log, Catch::Contains("stdin: empty\n"));
   CHECK_THAT(log, Catch::Contains("fd 4: closed\n")); // the server's socket did not leak
   CHECK(server.alive());
+}
+
+TEST_CASE("a process forked with no descriptor to inherit has none of the server's",
+          "[process][fork_server]") {
+  TempDir dir;
+  auto server = started_server();
+  auto child =
+      server.spawn({.program = kForked, .args = {"0"}, .log_file = dir.path() / "log"}, 10s);
+  REQUIRE(child.has_value());
+  CHECK(exit_code_of(child->pid) == 0);
+  const std::string log = slurp(dir.path() / "log");
+  INFO(log);
+  CHECK_THAT(log, Catch::Contains("fd 4: closed\n"));
+  CHECK_THAT(log, Catch::Contains("fd 3: closed\n")); // the server's socket
+}
+
+TEST_CASE("a fork server works under a low limit of descriptors", "[process][fork_server]") {
+  TempDir dir;
+  rlimit saved{};
+  REQUIRE(::getrlimit(RLIMIT_NOFILE, &saved) == 0);
+  rlimit low = saved;
+  low.rlim_cur = 128; // the server inherits it (process::spawn needs 64 and more)
+  REQUIRE(::setrlimit(RLIMIT_NOFILE, &low) == 0);
+  auto server = started_server();
+  REQUIRE(::setrlimit(RLIMIT_NOFILE, &saved) == 0);
+  int pipe_ends[2];
+  REQUIRE(::pipe2(pipe_ends, O_CLOEXEC) == 0);
+  rsca::process::Fd read_end{pipe_ends[0]};
+  rsca::process::Fd write_end{pipe_ends[1]};
+  auto child = server.spawn({.program = kForked,
+                             .args = {"5"},
+                             .log_file = dir.path() / "log",
+                             .inherit = {{write_end.get(), 3}}},
+                            10s);
+  REQUIRE(child.has_value());
+  CHECK(exit_code_of(child->pid) == 5);
+  CHECK_THAT(slurp(dir.path() / "log"), Catch::Contains("args: 5\n"));
 }
 
 TEST_CASE("a fork server starts many processes, one after the other", "[process][fork_server]") {
