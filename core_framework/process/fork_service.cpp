@@ -40,9 +40,8 @@ struct Received {
   bool truncated = false;
 };
 
-// What a started process tells its middle process once it has taken its request, and the middle
-// process the server: the process's pid, or the step that failed and its errno. One write of less
-// than PIPE_BUF: whole or not at all.
+// What the middle process tells the server: the started process's pid, or the step that failed
+// and its errno. One write of less than PIPE_BUF: whole or not at all.
 struct Report {
   pid_t pid = 0;
   int error = 0;
@@ -70,12 +69,11 @@ Report read_report(int fd, const char *step) {
   return size == static_cast<ssize_t>(sizeof report) ? report : failure(step, EIO);
 }
 
-// What a started process continues with: its request, its descriptors, where it reports, and the
-// middle process whose exit re-parents it to the node.
+// What a started process continues with: its request, its descriptors, and the middle process
+// whose exit re-parents it to the node.
 struct Started {
   ForkRequest request;
   std::vector<Fd> fds;
-  int report = -1;
   pid_t middle = 0;
 };
 
@@ -117,23 +115,39 @@ std::optional<Received> receive(int socket) {
   return received;
 }
 
-// In the middle process: forks the started process and waits for it to say it has taken its
-// request (a process that failed to is reaped here), tells the server through `to_server`, and
-// exits. Returns only in the started process, with the middle process's pid and where it
-// reports.
-std::pair<pid_t, int> fork_from_middle(int to_server) {
-  int status[2];
-  if (::pipe2(status, O_CLOEXEC) != 0) {
-    write_report(to_server, failure("pipe", errno));
+// In the middle process: what the started process inherits and may fail (its directory, CPUs,
+// variables); the failed step, or none.
+const char *take_place(const ForkRequest &request) {
+  if (!request.working_dir.empty() && ::chdir(request.working_dir.c_str()) != 0)
+    return "chdir";
+  if (!request.cpus.empty()) {
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    for (const unsigned cpu : request.cpus)
+      CPU_SET(cpu, &set);
+    cpu_set_t now; // most requests ask for the server's own CPUs, the node's: nothing to do
+    const bool same = ::sched_getaffinity(0, sizeof now, &now) == 0 && CPU_EQUAL(&now, &set);
+    if (!same && ::sched_setaffinity(0, sizeof set, &set) != 0)
+      return "sched_setaffinity";
+  }
+  for (const auto &[name, value] : request.env)
+    if (::setenv(name.c_str(), value.c_str(), 1) != 0)
+      return "setenv";
+  return nullptr;
+}
+
+// In the middle process: takes what may fail for the started process, which inherits it, forks
+// it, tells the server through `to_server`, and exits. Returns only in the started process: the
+// middle process's pid. A process the node is told of has started, as with spawn.
+pid_t fork_from_middle(const ForkRequest &request, int to_server) {
+  if (const char *failed = take_place(request)) {
+    write_report(to_server, failure(failed, errno));
     ::_exit(0);
   }
   const pid_t middle = ::getpid();
   const pid_t child = ::fork();
-  if (child == 0) {
-    ::close(status[0]);
-    return {middle, status[1]};
-  }
-  ::close(status[1]);
+  if (child == 0)
+    return middle;
   if (child < 0) {
     write_report(to_server, failure("fork", errno));
     ::_exit(0);
@@ -141,11 +155,8 @@ std::pair<pid_t, int> fork_from_middle(int to_server) {
   // Its process group exists before the node learns its pid (it sets it too: either may run
   // first), so that the node can signal the group at once.
   ::setpgid(child, child);
-  Report report = read_report(status[0], "start");
-  if (report.error != 0)
-    ::waitpid(child, nullptr, 0);
-  else
-    report.pid = child;
+  Report report;
+  report.pid = child;
   write_report(to_server, report);
   ::_exit(0);
 }
@@ -174,8 +185,8 @@ Started serve(int socket, std::string_view ready) {
     const pid_t middle = ::fork();
     if (middle == 0) {
       read_end.reset();
-      const auto [parent, report] = fork_from_middle(write_end.get());
-      return Started{std::move(*request), std::move(received->fds), report, parent};
+      const pid_t parent = fork_from_middle(*request, write_end.get());
+      return Started{std::move(*request), std::move(received->fds), parent};
     }
     write_end.reset();
     Report report = middle < 0 ? failure("fork", errno) : read_report(read_end.get(), "fork");
@@ -188,12 +199,10 @@ Started serve(int socket, std::string_view ready) {
   }
 }
 
-// Before it has reported: the middle process hears of the failure, and so do the server and the
-// node. After: its log says it.
-[[noreturn]] void fail(const Started &started, const char *step) {
+// A started process that cannot take its descriptors (a failure no test has made happen) says so
+// in its log, or the node's, and exits as a failed exec would.
+[[noreturn]] void fail(const char *step) {
   const int error = errno;
-  if (started.report >= 0)
-    write_report(started.report, failure(step, error));
   std::fprintf(stderr, "fork server: cannot start the process: %s: %s\n", step,
                std::strerror(error));
   ::_exit(127);
@@ -211,38 +220,26 @@ void take_descriptors(const Started &started, std::vector<Fd> &fds) {
   for (auto &fd : fds) {
     moved.push_back(::fcntl(fd.get(), F_DUPFD, above));
     if (moved.back() < 0)
-      fail(started, "fcntl");
+      fail("fcntl");
   }
   const int null = ::open("/dev/null", O_RDONLY);
   if (null < 0 || ::dup2(null, STDIN_FILENO) < 0)
-    fail(started, "/dev/null");
+    fail("/dev/null");
   std::size_t next = 0;
   if (request.log) {
     if (::dup2(moved[0], STDOUT_FILENO) < 0 || ::dup2(moved[0], STDERR_FILENO) < 0)
-      fail(started, "dup2");
+      fail("dup2");
     next = 1;
   }
   for (const int number : request.fd_numbers)
     if (::dup2(moved[next++], number) < 0)
-      fail(started, "dup2");
+      fail("dup2");
   for (int fd = STDERR_FILENO + 1; fd < above; ++fd)
     if (given.count(fd) == 0)
       ::close(fd);
   ::closefrom(above);
   for (auto &fd : fds) // already closed above: forget them without closing again
     [[maybe_unused]] const int released = fd.release();
-}
-
-void take_cpus(const Started &started) {
-  const auto &cpus = started.request.cpus;
-  if (cpus.empty())
-    return;
-  cpu_set_t set;
-  CPU_ZERO(&set);
-  for (const unsigned cpu : cpus)
-    CPU_SET(cpu, &set);
-  if (::sched_setaffinity(0, sizeof set, &set) != 0)
-    fail(started, "sched_setaffinity");
 }
 
 // /proc/PID/cmdline says the started process's arguments: pointed at a copy where the kernel lets
@@ -277,26 +274,15 @@ void wait_until_adopted(pid_t middle) {
     ::poll(&exited, 1, 5000);
 }
 
-// The started process takes its request: first what may fail, then it reports, then its
-// descriptors (its report's among those closed). The new argv lives for the rest of its life.
+// The started process takes the rest of its request (its middle process took what it inherits);
+// the new argv lives for the rest of its life.
 void become(Started &started, ArgumentArea area, int &argc, char **&argv) {
   static std::vector<std::string> arguments;
   static std::vector<char *> pointers;
   const ForkRequest &request = started.request;
   const std::string program = request.program.empty() ? argv[0] : request.program;
   if (::setpgid(0, 0) != 0)
-    fail(started, "setpgid");
-  if (!request.working_dir.empty() && ::chdir(request.working_dir.c_str()) != 0)
-    fail(started, "chdir");
-  take_cpus(started);
-  for (const auto &[name, value] : request.env)
-    if (::setenv(name.c_str(), value.c_str(), 1) != 0)
-      fail(started, "setenv");
-  Report taken;
-  taken.pid = ::getpid();
-  write_report(started.report, taken);
-  ::close(started.report);
-  started.report = -1;
+    fail("setpgid");
   take_descriptors(started, started.fds);
   take_command_line(program, request.args, area);
   arguments.assign({program});
