@@ -115,8 +115,9 @@ std::optional<Received> receive(int socket) {
   return received;
 }
 
-// In the middle process: what the started process inherits and may fail (its directory, CPUs,
-// variables); the failed step, or none.
+// In the middle process: what the started process inherits and may fail (its directory, its
+// CPUs); the failed step, or none. System calls only: the middle process is on the server's
+// critical path, and what it wrote to memory it would copy (copy-on-write) before it forks.
 const char *take_place(const ForkRequest &request) {
   if (!request.working_dir.empty() && ::chdir(request.working_dir.c_str()) != 0)
     return "chdir";
@@ -130,9 +131,6 @@ const char *take_place(const ForkRequest &request) {
     if (!same && ::sched_setaffinity(0, sizeof set, &set) != 0)
       return "sched_setaffinity";
   }
-  for (const auto &[name, value] : request.env)
-    if (::setenv(name.c_str(), value.c_str(), 1) != 0)
-      return "setenv";
   return nullptr;
 }
 
@@ -199,8 +197,8 @@ Started serve(int socket, std::string_view ready) {
   }
 }
 
-// A started process that cannot take its descriptors (a failure no test has made happen) says so
-// in its log, or the node's, and exits as a failed exec would.
+// A started process that cannot take its variables or descriptors (out of memory: a failure no
+// test has made happen) says so in its log, or the node's, and exits as a failed exec would.
 [[noreturn]] void fail(const char *step) {
   const int error = errno;
   std::fprintf(stderr, "fork server: cannot start the process: %s: %s\n", step,
@@ -283,6 +281,9 @@ void become(Started &started, ArgumentArea area, int &argc, char **&argv) {
   const std::string program = request.program.empty() ? argv[0] : request.program;
   if (::setpgid(0, 0) != 0)
     fail("setpgid");
+  for (const auto &[name, value] : started.request.env)
+    if (::setenv(name.c_str(), value.c_str(), 1) != 0)
+      fail("setenv");
   take_descriptors(started, started.fds);
   take_command_line(program, request.args, area);
   arguments.assign({program});
