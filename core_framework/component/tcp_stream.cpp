@@ -180,20 +180,31 @@ TcpReceiver::~TcpReceiver() {
 }
 
 void TcpReceiver::run() {
+  process::Fd stream = accept_writer();
+  if (!stream)
+    return;
+  // The token admits this writer once: nobody else may connect, now or after it has gone.
+  listening_.reset();
+  std::fill(token_.begin(), token_.end(), '\0');
+  no_delay(stream.get());
+  writers_.store(1, std::memory_order_relaxed);
+  read_frames(stream.get());
+  writers_.store(0, std::memory_order_relaxed);
+  spent_.store(true, std::memory_order_relaxed);
+}
+
+// The first stream that sends the token; those that do not are closed and counted. An invalid
+// descriptor when the receiver is stopped first.
+process::Fd TcpReceiver::accept_writer() {
   for (;;) {
     if (!wait_for(listening_.get(), POLLIN, stop_.get(), std::nullopt))
-      return;
+      return process::Fd();
     process::Fd stream(::accept4(listening_.get(), nullptr, nullptr, SOCK_CLOEXEC | SOCK_NONBLOCK));
     if (!stream)
       continue;
-    if (!take_token(stream.get())) {
-      refused_.fetch_add(1, std::memory_order_relaxed);
-      continue;
-    }
-    no_delay(stream.get());
-    writers_.store(1, std::memory_order_relaxed);
-    read_frames(stream.get());
-    writers_.store(0, std::memory_order_relaxed);
+    if (take_token(stream.get()))
+      return stream;
+    refused_.fetch_add(1, std::memory_order_relaxed);
   }
 }
 

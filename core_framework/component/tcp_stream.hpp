@@ -5,6 +5,10 @@
 // token the domain gave both ends; then each sample is one frame, a 32-bit length and the
 // sample's ring record (component/port_record.hpp). Nothing from the network is trusted: a frame
 // longer than kMaxFrame, a wrong token or a token not sent within kTokenTimeout closes the stream.
+// The token travels over the control plane in clear until that is authenticated (DDS Security), so
+// it admits one writer once: the reader stops listening when its writer has sent it, and a
+// connection whose writer has gone is not taken up again by anyone who learnt the token (the
+// domain wires a new connection, with a new token, instead).
 #pragma once
 
 #include <atomic>
@@ -34,9 +38,9 @@ bool valid_token(const std::string &token);
 // (RSCA_DDS_INTERFACE, dds/dds_settings.hpp), or loopback when that is "lo" or has none.
 std::string listen_address();
 
-// The reading end: listens, takes one writer at a time (a writer that reconnects is taken
-// again), and hands each frame to `on_frame` on its own thread. `on_frame` must not wait for the
-// thread that destroys the stream.
+// The reading end: listens until one writer has sent the token, then closes its listening socket
+// and hands each of that writer's frames to `on_frame` on its own thread; once that writer has
+// gone the stream is spent. `on_frame` must not wait for the thread that destroys the stream.
 class TcpReceiver {
 public:
   using OnFrame = std::function<void(const std::byte *data, std::size_t bytes)>;
@@ -52,11 +56,14 @@ public:
   std::int32_t writers() const { return writers_.load(std::memory_order_relaxed); }
   // Streams closed for a wrong or missing token, or a frame too long.
   std::uint64_t refused() const { return refused_.load(std::memory_order_relaxed); }
+  // True once the writer that sent the token has gone: nothing more arrives on this stream.
+  bool spent() const { return spent_.load(std::memory_order_relaxed); }
 
 private:
   TcpReceiver(process::Fd listening, process::Fd stop, std::string endpoint, std::string token,
               OnFrame on_frame);
   void run();
+  process::Fd accept_writer();
   bool take_token(int fd);
   void read_frames(int fd);
 
@@ -67,6 +74,7 @@ private:
   OnFrame on_frame_;
   std::atomic<std::int32_t> writers_{0};
   std::atomic<std::uint64_t> refused_{0};
+  std::atomic<bool> spent_{false};
   std::thread thread_;
 };
 

@@ -98,6 +98,19 @@ TEST_CASE("tcp stream: frames arrive whole and in order, and the writer is count
   CHECK(r->refused() == 0);
 }
 
+namespace {
+
+// A good writer is taken after streams that never sent the token, and its frames arrive.
+void good_writer_taken(TcpReceiver &r, Frames &frames) {
+  auto good = TcpSender::connect(r.endpoint(), kToken, 2s);
+  REQUIRE(good.has_value());
+  REQUIRE(send_text(**good, "hello").has_value());
+  REQUIRE(eventually([&] { return frames.size() == 1; }));
+  CHECK(frames.got[0] == "hello");
+}
+
+} // namespace
+
 TEST_CASE("tcp stream: a wrong token, no token, or a frame too long closes the stream unread",
           "[component][tcp]") {
   Frames frames;
@@ -107,6 +120,16 @@ TEST_CASE("tcp stream: a wrong token, no token, or a frame too long closes the s
     REQUIRE(s.has_value()); // TCP connects; the reader closes it once it reads the token
     REQUIRE(eventually([&] { return r->refused() == 1; }));
     (void)send_text(**s, "not for you");
+    CHECK(frames.size() == 0);
+    good_writer_taken(*r, frames);
+  }
+  SECTION("a token of the wrong length") {
+    const int fd = raw_connect(r->endpoint());
+    raw_frame(fd, 1u << 30, "");
+    REQUIRE(eventually([&] { return r->refused() == 1; }));
+    ::close(fd);
+    CHECK(frames.size() == 0);
+    good_writer_taken(*r, frames);
   }
   SECTION("a frame longer than a stream takes, after the right token") {
     const int fd = raw_connect(r->endpoint());
@@ -116,21 +139,39 @@ TEST_CASE("tcp stream: a wrong token, no token, or a frame too long closes the s
     REQUIRE(eventually([&] { return r->refused() == 1; }));
     CHECK(eventually([&] { return r->writers() == 0; }));
     ::close(fd);
+    // The token was spent by that stream: nobody is taken after it.
+    CHECK(frames.size() == 0);
+    CHECK(r->spent());
+    CHECK_FALSE(TcpSender::connect(r->endpoint(), kToken, 2s).has_value());
   }
-  SECTION("a token of the wrong length") {
-    const int fd = raw_connect(r->endpoint());
-    raw_frame(fd, 1u << 30, "");
-    REQUIRE(eventually([&] { return r->refused() == 1; }));
-    ::close(fd);
-  }
-  // The stream was closed before any frame was handed on; a good writer is taken after it.
-  CHECK(frames.size() == 0);
-  CHECK(r->writers() == 0);
-  auto good = TcpSender::connect(r->endpoint(), kToken, 2s);
-  REQUIRE(good.has_value());
-  REQUIRE(send_text(**good, "hello").has_value());
+}
+
+// The token travels over the control plane in clear: whoever learnt it must not be taken instead
+// of the writer, nor after it (the hostile test delivered 200 forged samples once the writer had
+// gone).
+TEST_CASE("tcp stream: a token admits one writer once, not a second one, nor anyone after it",
+          "[component][tcp]") {
+  Frames frames;
+  auto r = receiver(frames);
+  auto writer = TcpSender::connect(r->endpoint(), kToken, 2s);
+  REQUIRE(writer.has_value());
+  REQUIRE(send_text(**writer, "from the writer").has_value());
   REQUIRE(eventually([&] { return frames.size() == 1; }));
-  CHECK(frames.got[0] == "hello");
+  // A second connection with the same token while the writer is connected: not taken.
+  auto second = TcpSender::connect(r->endpoint(), kToken, 2s);
+  if (second)
+    (void)send_text(**second, "forged while connected");
+  writer->reset(); // the writer goes
+  REQUIRE(eventually([&] { return r->spent(); }));
+  CHECK(r->writers() == 0);
+  // After it: refused at once (nobody listens any more), and nothing forged arrives.
+  auto after = TcpSender::connect(r->endpoint(), kToken, 2s);
+  CHECK_FALSE(after.has_value());
+  if (after)
+    for (int i = 0; i < 200; ++i)
+      (void)send_text(**after, "forged " + std::to_string(i));
+  REQUIRE(frames.size() == 1);
+  CHECK(frames.got[0] == "from the writer");
 }
 
 TEST_CASE("tcp stream: bad endpoints and tokens are refused before anything is opened",
