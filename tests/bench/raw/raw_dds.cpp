@@ -5,12 +5,15 @@
 // dds::Participant from the RSCA_DDS_* environment with the settings of a component process). No
 // component runtime, no control endpoint, no domain: one participant, the data readers and writers,
 // a waitset with a read condition (or, with --wake listener, the wake rsca's receive loop uses),
-// and dds_take with loans.
+// and dds_take with loans. With --spin-us S the receiving thread, after data, looks for more for S
+// microseconds (yielding the CPU) before it sleeps, as rsca's receive thread does after same-host
+// data (RSCA_RECEIVE_SPIN_US): the busy-polling side of a like-for-like comparison.
 //
 //   rsca-bench-raw sizes
-//   rsca-bench-raw ping --out TOPIC --in TOPIC --qos JSON [--wake waitset|listener]
+//   rsca-bench-raw ping --out TOPIC --in TOPIC --qos JSON [--wake waitset|listener] [--spin-us S]
 //                       --count N --warmup W --output FILE
-//   rsca-bench-raw echo --in TOPIC --out TOPIC --qos JSON [--wake waitset|listener] (until SIGTERM)
+//   rsca-bench-raw echo --in TOPIC --out TOPIC --qos JSON [--wake waitset|listener] [--spin-us S]
+//                       (until SIGTERM)
 //   rsca-bench-raw pub --topic TOPIC --qos JSON --subscribers N --output FILE [schedule...]
 //   rsca-bench-raw sub --topic TOPIC --qos JSON --capacity N --output FILE   (until SIGTERM)
 //   rsca-bench-raw discovery --participants N --timeout-ms T [--existing K]
@@ -19,6 +22,7 @@
 #include <fcntl.h>
 #include <linux/futex.h>
 #include <poll.h>
+#include <sched.h>
 #include <signal.h>
 #include <sys/resource.h>
 #include <sys/syscall.h>
@@ -104,12 +108,14 @@ struct Dds {
 // How the receiving thread learns that `reader` has data: a waitset with a read condition (the
 // usual way), or a data-available listener that only wakes it with a flag and a futex, the way
 // rsca's receive loop does (component/receive_loop.cpp). Either wakes every `timeout` as well,
-// to look at the stop flag.
+// to look at the stop flag. With a spin time, after a take that had data the thread first looks
+// for more that long, yielding the CPU, as rsca's receive loop does after same-host data.
 enum class Wake { waitset, listener };
 
 class Receiver {
 public:
-  Receiver(const Dds &dds, dds_entity_t reader, Wake wake) : reader_(reader) {
+  Receiver(const Dds &dds, dds_entity_t reader, Wake wake, std::uint64_t spin_us = 0)
+      : reader_(reader), spin_ns_(spin_us * 1000u) {
     if (wake == Wake::listener) {
       listener_ = dds_create_listener(this);
       dds_lset_data_available(listener_, &Receiver::on_data_available);
@@ -132,7 +138,12 @@ public:
 
   dds_entity_t reader() const { return reader_; }
 
+  // What the last take found: data starts a spin before the next sleep.
+  void took(dds_return_t n) { spin_next_ = spin_ns_ > 0 && n > 0; }
+
   void wait(dds_duration_t timeout) {
+    if (spin_next_ && spin_for_data())
+      return;
     if (listener_ == nullptr) {
       dds_waitset_wait(waitset_, nullptr, 0, timeout);
       return;
@@ -150,6 +161,19 @@ public:
   }
 
 private:
+  // Looks for data for the spin time; whatever else is runnable on this CPU (Cyclone's receive
+  // thread, the other end of the exchange) goes first, as in rsca's ReceiveLoop::spin_for_wake.
+  bool spin_for_data() {
+    const std::uint64_t until = mono_ns() + spin_ns_;
+    while (mono_ns() < until) {
+      if (listener_ != nullptr ? woken_.exchange(0) != 0
+                               : dds_waitset_wait(waitset_, nullptr, 0, 0) > 0)
+        return true;
+      sched_yield();
+    }
+    return false;
+  }
+
   static void on_data_available(dds_entity_t, void *self) {
     auto *receiver = static_cast<Receiver *>(self);
     receiver->woken_.store(1);
@@ -162,6 +186,8 @@ private:
   dds_listener_t *listener_ = nullptr;
   std::atomic<std::uint32_t> woken_{0};
   std::atomic<std::uint32_t> sleeping_{0};
+  std::uint64_t spin_ns_;
+  bool spin_next_ = false;
 };
 
 constexpr std::uint32_t kBatch = 32;
@@ -196,11 +222,11 @@ void pause_until(std::uint64_t at_ns) {
 }
 
 int ping(const std::string &out_topic, const std::string &in_topic, const std::string &qos,
-         Wake wake, std::uint64_t count, std::uint64_t warmup, std::uint64_t timeout_ms,
-         std::uint64_t interval_us, const std::string &output) {
+         Wake wake, std::uint64_t spin_us, std::uint64_t count, std::uint64_t warmup,
+         std::uint64_t timeout_ms, std::uint64_t interval_us, const std::string &output) {
   Dds dds(qos);
   const dds_entity_t writer = dds.writer(dds.topic(&rsca_port_SampleSeq_desc, out_topic));
-  Receiver in(dds, dds.reader(dds.topic(&rsca_port_SampleSeq_desc, in_topic)), wake);
+  Receiver in(dds, dds.reader(dds.topic(&rsca_port_SampleSeq_desc, in_topic)), wake, spin_us);
   double values[rsca::bench::kSampleDoubles] = {0, 0, 0};
   rsca_port_SampleSeq sample{};
   sample.stream_id = const_cast<char *>("");
@@ -223,6 +249,7 @@ int ping(const std::string &out_topic, const std::string &in_topic, const std::s
     void *samples[kBatch] = {nullptr};
     dds_sample_info_t infos[kBatch];
     const dds_return_t n = dds_take(in.reader(), samples, infos, kBatch, kBatch);
+    in.took(n);
     bool answered = false;
     std::uint64_t now = 0;
     for (dds_return_t i = 0; i < n; ++i) {
@@ -257,16 +284,17 @@ int ping(const std::string &out_topic, const std::string &in_topic, const std::s
 }
 
 int echo(const std::string &in_topic, const std::string &out_topic, const std::string &qos,
-         Wake wake) {
+         Wake wake, std::uint64_t spin_us) {
   Dds dds(qos);
   const dds_entity_t writer = dds.writer(dds.topic(&rsca_port_SampleSeq_desc, out_topic));
-  Receiver in(dds, dds.reader(dds.topic(&rsca_port_SampleSeq_desc, in_topic)), wake);
+  Receiver in(dds, dds.reader(dds.topic(&rsca_port_SampleSeq_desc, in_topic)), wake, spin_us);
   std::uint64_t echoed = 0;
   while (!g_stop) {
     in.wait(DDS_MSECS(100));
     void *samples[kBatch] = {nullptr};
     dds_sample_info_t infos[kBatch];
     const dds_return_t n = dds_take(in.reader(), samples, infos, kBatch, kBatch);
+    in.took(n);
     for (dds_return_t i = 0; i < n; ++i)
       if (infos[i].valid_data && dds_write(writer, samples[i]) >= 0)
         ++echoed;
@@ -455,12 +483,16 @@ int main(int argc, char **argv) {
   Wake wake = Wake::waitset;
   ping_cmd->add_option("--wake", wake, "How the receiving thread is woken")
       ->transform(CLI::CheckedTransformer(wakes));
+  std::uint64_t spin_us = 0;
+  ping_cmd->add_option("--spin-us", spin_us, "After data, look for more this long before sleeping")
+      ->check(CLI::Range(0, 1'000'000));
 
   auto *echo_cmd = app.add_subcommand("echo", "Writes back every sample, until SIGTERM");
   echo_cmd->add_option("--in", in_topic)->required();
   echo_cmd->add_option("--out", out_topic)->required();
   echo_cmd->add_option("--qos", qos);
   echo_cmd->add_option("--wake", wake)->transform(CLI::CheckedTransformer(wakes));
+  echo_cmd->add_option("--spin-us", spin_us)->check(CLI::Range(0, 1'000'000));
 
   auto *pub_cmd = app.add_subcommand("pub", "Publishes the fan-out schedule; send times");
   pub_cmd->add_option("--topic", topic)->required();
@@ -501,9 +533,10 @@ int main(int argc, char **argv) {
   sigaction(SIGINT, &action, nullptr);
 
   if (*ping_cmd)
-    return ping(out_topic, in_topic, qos, wake, count, warmup, timeout_ms, interval_us, output);
+    return ping(out_topic, in_topic, qos, wake, spin_us, count, warmup, timeout_ms, interval_us,
+                output);
   if (*echo_cmd)
-    return echo(in_topic, out_topic, qos, wake);
+    return echo(in_topic, out_topic, qos, wake, spin_us);
   if (*pub_cmd)
     return pub(topic, qos, subscribers, match_timeout_ms, schedule, output);
   if (*sub_cmd)

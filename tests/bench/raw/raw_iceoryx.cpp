@@ -1,8 +1,13 @@
 // The raw iceoryx baseline of the same-host port round trip (tools/bench port-latency): iceoryx
 // 2.0.3 from Debian, as its users would write a ping-pong between two processes, each woken by a
-// WaitSet (no spinning). `roudi` runs the daemon every iceoryx process needs (one per machine:
-// shm/arena.hpp says why rsca does not build on it); `echo` writes back what it takes; `ping`
-// measures round trips and writes them, in ns, to --output, with a JSON summary on stdout.
+// WaitSet; with --spin-us S, after data each looks for more for S microseconds (yielding the CPU)
+// before it sleeps, as rsca's receive thread does after same-host data (RSCA_RECEIVE_SPIN_US).
+// --instance lets two pairs share one RouDi (each its own services). `roudi` runs the daemon every
+// iceoryx process needs (one per machine: shm/arena.hpp says why rsca does not build on it); `echo`
+// writes back what it takes; `ping` measures round trips and writes them, in ns, to --output, with
+// a JSON summary on stdout.
+#include <sched.h>
+
 #include <atomic>
 #include <chrono>
 #include <csignal>
@@ -50,21 +55,43 @@ int run_roudi() {
   return 0;
 }
 
-iox::capro::ServiceDescription service(const char *event) {
-  return {"rsca", "bench", iox::capro::IdString_t(iox::cxx::TruncateToCapacity, event)};
+iox::capro::ServiceDescription service(const std::string &instance, const char *event) {
+  return {"rsca", iox::capro::IdString_t(iox::cxx::TruncateToCapacity, instance.c_str()),
+          iox::capro::IdString_t(iox::cxx::TruncateToCapacity, event)};
 }
 
-// Waits (no spinning) until `subscriber` has a sample, then takes and releases it; false when
-// stopping or nothing came within the timeout.
+// After data, how long a side looks for more before it sleeps (0: it sleeps at once).
+std::chrono::microseconds spin_time{0};
+
+bool take_and_release(iox::popo::UntypedSubscriber &subscriber) {
+  auto taken = subscriber.take();
+  if (taken.has_error())
+    return false;
+  subscriber.release(taken.value());
+  return true;
+}
+
+// Looks for a sample for spin_time, yielding the CPU as rsca's receive loop does.
+bool spin_for_one(iox::popo::UntypedSubscriber &subscriber) {
+  const auto until = std::chrono::steady_clock::now() + spin_time;
+  while (std::chrono::steady_clock::now() < until) {
+    if (take_and_release(subscriber))
+      return true;
+    sched_yield();
+  }
+  return false;
+}
+
+// Waits until `subscriber` has a sample (spinning first when spin_time is set: each call follows
+// data), then takes and releases it; false when stopping or nothing came within the timeout.
 bool take_one(iox::popo::UntypedSubscriber &subscriber, iox::popo::WaitSet<> &waitset,
               std::chrono::milliseconds timeout) {
+  if (spin_time.count() > 0 && spin_for_one(subscriber))
+    return true;
   const auto until = std::chrono::steady_clock::now() + timeout;
   while (!stopping && std::chrono::steady_clock::now() < until) {
-    auto taken = subscriber.take();
-    if (!taken.has_error()) {
-      subscriber.release(taken.value());
+    if (take_and_release(subscriber))
       return true;
-    }
     waitset.timedWait(iox::units::Duration::fromMilliseconds(100));
   }
   return false;
@@ -80,16 +107,18 @@ bool publish(iox::popo::UntypedPublisher &publisher, std::size_t bytes) {
 }
 
 // The process's iceoryx runtime, registered with RouDi: first, before any port.
-bool init_runtime(const char *name) {
-  iox::runtime::PoshRuntime::initRuntime(iox::RuntimeName_t(iox::cxx::TruncateToCapacity, name));
+bool init_runtime(const std::string &name) {
+  iox::runtime::PoshRuntime::initRuntime(
+      iox::RuntimeName_t(iox::cxx::TruncateToCapacity, name.c_str()));
   return true;
 }
 
 // One side of the ping-pong: this process's iceoryx runtime, what it sends on `out`, and what it
 // waits for on `in`.
 struct Side {
-  Side(const char *runtime, const char *out, const char *in)
-      : initialized(init_runtime(runtime)), publisher(service(out)), subscriber(service(in)) {
+  Side(const std::string &role, const std::string &instance, const char *out, const char *in)
+      : initialized(init_runtime("rsca-bench-iceoryx-" + role + "-" + instance)),
+        publisher(service(instance, out)), subscriber(service(instance, in)) {
     attached = !waitset.attachState(subscriber, iox::popo::SubscriberState::HAS_DATA).has_error();
   }
   bool initialized;
@@ -99,8 +128,8 @@ struct Side {
   bool attached = false;
 };
 
-int run_echo(std::size_t bytes) {
-  Side side("rsca-bench-iceoryx-echo", "pong", "ping");
+int run_echo(std::size_t bytes, const std::string &instance) {
+  Side side("echo", instance, "pong", "ping");
   if (!side.attached)
     return 1;
   std::puts("ready");
@@ -111,8 +140,9 @@ int run_echo(std::size_t bytes) {
   return 0;
 }
 
-int run_ping(std::size_t bytes, int count, int warmup, const std::string &output) {
-  Side side("rsca-bench-iceoryx-ping", "ping", "pong");
+int run_ping(std::size_t bytes, int count, int warmup, const std::string &output,
+             const std::string &instance) {
+  Side side("ping", instance, "ping", "pong");
   if (!side.attached)
     return 1;
   auto &publisher = side.publisher;
@@ -159,21 +189,28 @@ int main(int argc, char **argv) {
   app.require_subcommand(1);
   std::size_t bytes = 64;
   int count = 2000, warmup = 2000;
-  std::string output;
+  std::string output, instance = "bench";
+  std::uint64_t spin_us = 0;
   auto *roudi = app.add_subcommand("roudi", "Runs RouDi until SIGTERM");
   auto *echo = app.add_subcommand("echo", "Writes back every ping, until SIGTERM");
   echo->add_option("--bytes", bytes);
+  echo->add_option("--instance", instance, "Service instance: pairs of one RouDi apart");
+  echo->add_option("--spin-us", spin_us, "After data, look for more this long before sleeping")
+      ->check(CLI::Range(0, 1'000'000));
   auto *ping = app.add_subcommand("ping", "Strict ping-pong; round-trip times to --output");
   ping->add_option("--bytes", bytes);
   ping->add_option("--count", count);
   ping->add_option("--warmup", warmup);
   ping->add_option("--output", output)->required();
+  ping->add_option("--instance", instance);
+  ping->add_option("--spin-us", spin_us)->check(CLI::Range(0, 1'000'000));
   CLI11_PARSE(app, argc, argv);
   std::signal(SIGTERM, on_signal);
   std::signal(SIGINT, on_signal);
   if (roudi->parsed())
     return run_roudi();
+  spin_time = std::chrono::microseconds(spin_us);
   if (echo->parsed())
-    return run_echo(bytes);
-  return run_ping(bytes, count, warmup, output);
+    return run_echo(bytes, instance);
+  return run_ping(bytes, count, warmup, output, instance);
 }
