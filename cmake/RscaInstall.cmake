@@ -20,14 +20,8 @@ install(DIRECTORY schemas/ DESTINATION ${CMAKE_INSTALL_DATADIR}/rsca/schemas COM
         FILES_MATCHING PATTERN "*.xsd")
 install(DIRECTORY profiles/ DESTINATION ${CMAKE_INSTALL_DATADIR}/rsca/profiles COMPONENT runtime
         FILES_MATCHING PATTERN "*.xml")
-# Where rsca-noded@NAME.service reads its node's DCD (/etc/rsca/nodes/NAME.dcd.xml), empty.
-# /etc for the /usr prefix (the packages'), else under the prefix, wherever it is installed to.
-if(CMAKE_INSTALL_PREFIX STREQUAL "/usr")
-  set(rsca_sysconf ${CMAKE_INSTALL_FULL_SYSCONFDIR})
-else()
-  set(rsca_sysconf ${CMAKE_INSTALL_SYSCONFDIR})
-endif()
-install(DIRECTORY DESTINATION ${rsca_sysconf}/rsca/nodes COMPONENT runtime)
+# The folder of the nodes' DCDs is laid out with the units, at install time
+# (tools/systemd/install_units.cmake).
 
 # The SDK.
 install(TARGETS rsca_runtime rsca_sdk_headers rsca_component_headers rsca_device_headers EXPORT rscaTargets
