@@ -17,10 +17,15 @@ latency: strict ping-pong between BenchPing_1 and BenchEcho_1 (uses port -> prov
   baseline), and between `rsca-bench-raw ping` and `rsca-bench-raw echo`, once woken by a waitset
   (the baseline of the ratio lines) and once by a listener as rsca's receive loop is; each raw
   pair in one session, as the two components are in their node's (docs/architecture.md says why
-  that matters). Rounds of 2000 warm-up round trips (not measured) and 2000 measured ones
-  (--quick: 1000), 5 rounds of each side (--quick: 3), each round running the sides in another
-  order so that a change of the machine's load falls on all alike. Median, p99 (and more) of the round
-  trip and the CPU time both processes spend per round trip; the output ends with the ratio lines.
+  that matters). Every side runs in two modes, like for like: both spinning (every receiving
+  thread looks for more data 50 us after data before it sleeps: rsca's default
+  RSCA_RECEIVE_SPIN_US, the raw programs' --spin-us 50) and both sleeping (RSCA_RECEIVE_SPIN_US=0,
+  --spin-us 0), rsca's two modes on two domains side by side. Rounds of 2000 warm-up round trips
+  (not measured) and 2000 measured ones (--quick: 1000), 12 rounds (--quick: 3), each running
+  every side of both modes in another order, so that a change of the machine's load falls on all
+  alike. Median, p99 (and more) of the round trip and the CPU time both processes spend per round
+  trip, through the nodes the node daemons' CPU as well; the output ends with the ratio lines,
+  each for both modes.
 fanout: BenchPublisher_1 publishes on the event channel BenchFanOut to N BenchSubscriber_i
   processes (N = 1, 10, 50, 100; --quick: 1 and 10), raw DDS the same with one raw publisher and N
   raw subscriber processes on one topic, in one session per node as the components were placed
@@ -38,7 +43,6 @@ Every process started is stopped at the end, also on failure.
 import argparse
 import array
 import contextlib
-import itertools
 import json
 import math
 import os
@@ -48,8 +52,8 @@ import tempfile
 
 from local_domain import Domain, NetHosts, skipped_without_hosts
 from port_bench_fanout import Schedule, analyse_fanout, fanout_raw, fanout_rsca
-from port_bench_helpers import (FANOUT_LEASE_MS, SDRROOT, SIDES, LatencyIceoryx, LatencyRaw,
-                                LatencyRsca, busy_note, host_state, latency_stats, lease_env, ratio,
+from port_bench_helpers import (FANOUT_LEASE_MS, MODES, SDRROOT, SIDES, SPIN_US, LatencyIceoryx,
+                                LatencyRaw, LatencyRsca, busy_note, host_state, latency_stats, lease_env, ratio,
                                 raw_sizes)
 
 
@@ -111,93 +115,176 @@ def bench_latency_hosts(args):
     return 0
 
 
+def latency_orders(quick):
+    """The rounds' orders of every side in both modes: the modes interleaved side by side, each
+    round a rotation of that list (so that a change of the machine's load during the run falls on
+    all alike and none always follows the same other); --quick: three rotations spread over it."""
+    names = [f"{side}@{mode}" for side in SIDES for mode in MODES]
+    shifts = range(len(names))
+    if quick:
+        shifts = [i * len(names) // 3 for i in range(3)]
+    return [names[i:] + names[:i] for i in shifts]
+
+
+def mode_domain_env(mode, lease):
+    """The environment of the domain of one mode: rsca's receive threads spinning or not, and a
+    DDS domain id and discovery tag of the mode's own (the two domains run side by side)."""
+    env = dict(lease, RSCA_RECEIVE_SPIN_US=str(MODES[mode]))
+    if mode == "sleep":
+        env.update(RSCA_DDS_DOMAIN=str(1 + (os.getpid() + 50) % 101),
+                   RSCA_DDS_TAG=f"bench-{os.getpid()}-sleep")
+    return env
+
+
+def latency_sides(domain, mode, args, work, count, warmup, closing, sizes):
+    """The six sides of one mode, each closed by `closing`; their files in a folder of the
+    mode's own (the two modes' rsca sides share names)."""
+    spin = MODES[mode]
+    work = os.path.join(work, mode)
+    os.makedirs(work, exist_ok=True)
+
+    def keep(side):
+        closing.callback(side.close)
+        return side
+    raw = os.path.join(args.bin, "rsca-bench-raw")
+    sides = {"rsca": keep(LatencyRsca(domain, work, count, warmup))}
+    sides["rsca_same_host"] = keep(LatencyRsca(domain, work, count, warmup, "same_host"))
+    sides["rsca_direct"] = keep(LatencyRsca(domain, work, count, warmup, "direct"))
+    # One RouDi a machine: the first mode's iceoryx side starts it, the other shares it.
+    sides["iceoryx"] = keep(LatencyIceoryx(os.path.join(args.bin, "rsca-bench-iceoryx"), work,
+                                           count, warmup, sizes["ping_sample_bytes"], spin,
+                                           roudi=mode == next(iter(MODES))))
+    for name, wake in (("raw", "waitset"), ("raw_listener", "listener")):
+        sides[name] = keep(LatencyRaw(domain, raw, work, sides["rsca"].qos, count, warmup, wake,
+                                      spin_us=spin))
+    return sides
+
+
+def mode_results(sides, rtts):
+    """One mode's figures: each side's round trips and CPU, and the ratios."""
+    results = {}
+    for name, side in sides.items():
+        results[name] = dict(latency_stats(rtts[name]), resent=side.resent,
+                             cpu_us_per_round_trip=side.cpu_us / max(1, side.round_trips))
+        if hasattr(side, "cpu_nodes_us"):
+            results[name]["cpu_nodes_us_per_round_trip"] = (
+                side.cpu_nodes_us / max(1, side.round_trips))
+    r, w, wl = results["rsca"], results["raw"], results["raw_listener"]
+    sh, ix, d = results["rsca_same_host"], results["iceoryx"], results["rsca_direct"]
+    for key, a, b, p in (("ratio_p50", r, w, "p50_us"), ("ratio_p99", r, w, "p99_us"),
+                         ("ratio_p50_listener", r, wl, "p50_us"),
+                         ("ratio_p99_listener", r, wl, "p99_us"),
+                         ("ratio_same_host_p50", sh, w, "p50_us"),
+                         ("ratio_same_host_iceoryx_p50", sh, ix, "p50_us"),
+                         ("ratio_direct_p50", d, w, "p50_us"), ("ratio_direct_p99", d, w, "p99_us")):
+        results[key] = ratio(a[p], b[p])
+    results["ratio_cpu"] = ratio(r["cpu_us_per_round_trip"], w["cpu_us_per_round_trip"])
+    results["ratio_same_host_cpu"] = ratio(sh["cpu_us_per_round_trip"], w["cpu_us_per_round_trip"])
+    return results
+
+
+RATIO_LINES = (("ratio_p50_listener", "ratio rsca/raw-listener p50"),
+               ("ratio_p99_listener", "ratio rsca/raw-listener p99"),
+               ("ratio_p50", "ratio rsca/raw p50"), ("ratio_p99", "ratio rsca/raw p99"),
+               ("ratio_direct_p50", "ratio direct rsca/raw p50"),
+               ("ratio_direct_p99", "ratio direct rsca/raw p99"),
+               ("ratio_same_host_p50", "ratio same-host rsca/raw p50"),
+               ("ratio_same_host_iceoryx_p50", "ratio same-host rsca/iceoryx p50"),
+               ("ratio_cpu", "ratio rsca/raw CPU per round trip (nodes counted)"),
+               ("ratio_same_host_cpu", "ratio same-host rsca/raw CPU per round trip"))
+MODE_WORDS = {"spin": f"both spinning ({SPIN_US} us after data)", "sleep": "both sleeping"}
+
+
+def print_latency(results, qos):
+    print(f"Round trip of a {results['payload_bytes']}-byte SampleSeq between two processes on one "
+          f"host, strict ping-pong, {results['rounds']} rounds of {results['warmup_per_round']} "
+          f"warm-up and {results['round_trips'] // results['rounds']} measured round trips per "
+          f"side, every side in both modes in each round, in another order each round "
+          f"(interleaved); clock CLOCK_MONOTONIC in the ping, each side's own; each raw pair in "
+          f"one session, as the components are in their node's; QoS {qos['reliability']}, "
+          f"{qos['durability']}, {qos['history']} {qos.get('depth', '')}. Modes: "
+          f"spin = every receiving thread looks for more data {SPIN_US} us after data, yielding, "
+          f"before it sleeps (rsca: RSCA_RECEIVE_SPIN_US={SPIN_US}, its default, which spins after "
+          f"same-host data only; raw DDS and iceoryx: --spin-us {SPIN_US}); sleep = every one "
+          f"sleeps at once (RSCA_RECEIVE_SPIN_US=0, --spin-us 0); one domain per mode, side by "
+          f"side. CPU per round trip: both processes; for rsca through the nodes, the two node "
+          f"daemons' CPU too (/proc/PID/stat over the side's whole run, its `start` included).")
+    rows = [("min_us", "min"), ("p50_us", "p50"), ("p90_us", "p90"), ("p99_us", "p99"),
+            ("p999_us", "p99.9"), ("max_us", "max"), ("mean_us", "mean"),
+            ("cpu_us_per_round_trip", "CPU per round trip"),
+            ("cpu_nodes_us_per_round_trip",
+             "node daemons' CPU per round trip (in the row above through the nodes only)")]
+    for mode in MODES:
+        m = results["modes"][mode]
+        r, w, wl = m["rsca"], m["raw"], m["raw_listener"]
+        sh, ix, d = m["rsca_same_host"], m["iceoryx"], m["rsca_direct"]
+        print()
+        print(f"{MODE_WORDS[mode]}:")
+        print()
+        print("| round trip | rsca, two nodes (through the nodes) | raw Cyclone DDS (waitset) "
+              "| rsca/raw | raw, rsca's wake (listener) | rsca/that | rsca, two nodes (direct DDS) "
+              "| direct/raw | rsca, one node (shared memory) | same-host/raw | raw iceoryx "
+              "(waitset) | same-host/iceoryx |")
+        print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+
+        def v(side, key):  # a figure the side does not have (node daemons: raw) is "-"
+            return f"{side[key]:.1f} us" if key in side else "-"
+
+        def q(a, b, key):
+            return f"{ratio(a[key], b[key]):.2f}" if key in a and key in b else "-"
+        for key, label in rows:
+            print(f"| {label} | {v(r, key)} | {v(w, key)} | {q(r, w, key)} | {v(wl, key)} "
+                  f"| {q(r, wl, key)} | {v(d, key)} | {q(d, w, key)} | {v(sh, key)} "
+                  f"| {q(sh, w, key)} | {v(ix, key)} | {q(sh, ix, key)} |")
+    print()
+    for key, line in RATIO_LINES:
+        for mode in MODES:
+            print(f"{line}, {MODE_WORDS[mode].split(' (')[0]} = {results['modes'][mode][key]:.2f}")
+    if busy_note(results):
+        print(busy_note(results))
+
+
 def bench_latency(args):
-    # Each round runs the sides in another order, so that a change of the machine's load during
-    # the run falls on all alike and none always follows the same other: each side first once (its
-    # rotations), or (--quick) three of them.
-    orders = [SIDES[i:] + SIDES[:i] for i in range(len(SIDES))]
-    if args.quick:
-        orders = orders[:3]
-    rounds = len(orders)
+    orders = latency_orders(args.quick)
     count, warmup = (1000, 2000) if args.quick else (2000, 2000)  # per round
     rsca = os.path.join(args.bin, "rsca")
     raw = os.path.join(args.bin, "rsca-bench-raw")
-    iceoryx = os.path.join(args.bin, "rsca-bench-iceoryx")
     work = tempfile.mkdtemp(prefix="rsca-portbench-")
     lease = lease_env(args.lease_ms)
-    rtts = {name: array.array("Q") for name in SIDES}
+    rtts = {name: array.array("Q") for order in orders[:1] for name in order}
     before = host_state()
+    sides = {}
     try:
-        with Domain(rsca, nodes=2, sdrroot=SDRROOT, env=lease) as domain, \
-                contextlib.ExitStack() as closing:
-            sizes = raw_sizes(raw, domain.env)
-            sides = {"rsca": LatencyRsca(domain, work, count, warmup)}
-            closing.callback(sides["rsca"].close)
-            sides["rsca_same_host"] = LatencyRsca(domain, work, count, warmup, "same_host")
-            closing.callback(sides["rsca_same_host"].close)
-            sides["rsca_direct"] = LatencyRsca(domain, work, count, warmup, "direct")
-            closing.callback(sides["rsca_direct"].close)
-            sides["iceoryx"] = LatencyIceoryx(iceoryx, work, count, warmup,
-                                              sizes["ping_sample_bytes"])
-            closing.callback(sides["iceoryx"].close)
-            for name, wake in (("raw", "waitset"), ("raw_listener", "listener")):
-                sides[name] = LatencyRaw(domain, raw, work, sides["rsca"].qos, count, warmup,
-                                         wake)
-                closing.callback(sides[name].close)
+        with contextlib.ExitStack() as closing:
+            for mode in MODES:
+                domain = closing.enter_context(
+                    Domain(rsca, nodes=2, sdrroot=SDRROOT, env=mode_domain_env(mode, lease)))
+                sizes = raw_sizes(raw, domain.env)
+                for name, side in latency_sides(domain, mode, args, work, count, warmup, closing,
+                                                sizes).items():
+                    sides[f"{name}@{mode}"] = side
             run_rounds(sides, orders, rtts)
     finally:
         if not args.keep:
             shutil.rmtree(work, ignore_errors=True)
-    qos = sides["rsca"].qos
+    qos = sides["rsca@spin"].qos
     results = {
-        "payload_bytes": sizes["ping_sample_bytes"], "qos": qos, "rounds": rounds,
-        "warmup_per_round": warmup, "round_trips": rounds * count,
-        "dds_lease_ms": args.lease_ms or "default", "host_before": before}
-    for name, side in sides.items():
-        results[name] = dict(latency_stats(rtts[name]), resent=side.resent,
-                             cpu_us_per_round_trip=side.cpu_us / max(1, side.round_trips))
-    r, w, wl = results["rsca"], results["raw"], results["raw_listener"]
-    results["ratio_p50"] = ratio(r["p50_us"], w["p50_us"])
-    results["ratio_p99"] = ratio(r["p99_us"], w["p99_us"])
-    results["ratio_p50_listener"] = ratio(r["p50_us"], wl["p50_us"])
-    results["ratio_p99_listener"] = ratio(r["p99_us"], wl["p99_us"])
-    sh, ix = results["rsca_same_host"], results["iceoryx"]
-    results["ratio_same_host_p50"] = ratio(sh["p50_us"], w["p50_us"])
-    results["ratio_same_host_iceoryx_p50"] = ratio(sh["p50_us"], ix["p50_us"])
-    d = results["rsca_direct"]
-    results["ratio_direct_p50"] = ratio(d["p50_us"], w["p50_us"])
-    results["ratio_direct_p99"] = ratio(d["p99_us"], w["p99_us"])
+        "payload_bytes": sizes["ping_sample_bytes"], "qos": qos, "rounds": len(orders),
+        "warmup_per_round": warmup, "round_trips": len(orders) * count,
+        "dds_lease_ms": args.lease_ms or "default", "host_before": before,
+        "method": {"clock": "CLOCK_MONOTONIC, in each side's ping",
+                   "order": "every side of both modes in each round, rotated round by round",
+                   "modes": {"spin": f"rsca RSCA_RECEIVE_SPIN_US={SPIN_US} (default; after "
+                                     f"same-host data only), raw and iceoryx --spin-us {SPIN_US}",
+                             "sleep": "RSCA_RECEIVE_SPIN_US=0, raw and iceoryx --spin-us 0"},
+                   "cpu": "utime+stime of both processes (/proc/PID/stat, getrusage); rsca "
+                          "relayed: the node daemons' too"},
+        "modes": {mode: mode_results({name: sides[f"{name}@{mode}"] for name in SIDES},
+                                     {name: rtts[f"{name}@{mode}"] for name in SIDES})
+                  for mode in MODES}}
     with open(args.out, "w") as f:
         json.dump(results, f, indent=2)
-
-    print(f"Round trip of a {results['payload_bytes']}-byte SampleSeq between two processes on one "
-          f"host, strict ping-pong, {rounds} rounds of {warmup} warm-up and {count} measured round "
-          f"trips each, the sides in another order each round; each raw pair in one session, "
-          f"as the components are in their node's; QoS {qos['reliability']}, "
-          f"{qos['durability']}, {qos['history']} {qos.get('depth', '')}.")
-    print()
-    print("| round trip | rsca, two nodes (through the nodes) | raw Cyclone DDS (waitset) "
-          "| rsca/raw | raw, rsca's wake (listener) | rsca/that | rsca, two nodes (direct DDS) "
-          "| direct/raw | rsca, one node (shared memory) | same-host/raw | raw iceoryx (waitset) "
-          "| same-host/iceoryx |")
-    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
-    rows = [("min_us", "min"), ("p50_us", "p50"), ("p90_us", "p90"), ("p99_us", "p99"),
-            ("p999_us", "p99.9"), ("max_us", "max"), ("mean_us", "mean"),
-            ("cpu_us_per_round_trip", "CPU per round trip (both processes)")]
-    for key, label in rows:
-        print(f"| {label} | {r[key]:.1f} us | {w[key]:.1f} us | {ratio(r[key], w[key]):.2f} "
-              f"| {wl[key]:.1f} us | {ratio(r[key], wl[key]):.2f} | {d[key]:.1f} us "
-              f"| {ratio(d[key], w[key]):.2f} | {sh[key]:.1f} us "
-              f"| {ratio(sh[key], w[key]):.2f} | {ix[key]:.1f} us | {ratio(sh[key], ix[key]):.2f} |")
-    print()
-    print(f"ratio rsca/raw-listener p50 = {results['ratio_p50_listener']:.2f}")
-    print(f"ratio rsca/raw-listener p99 = {results['ratio_p99_listener']:.2f}")
-    print(f"ratio rsca/raw p50 = {results['ratio_p50']:.2f}")
-    print(f"ratio rsca/raw p99 = {results['ratio_p99']:.2f}")
-    print(f"ratio direct rsca/raw p50 = {results['ratio_direct_p50']:.2f}")
-    print(f"ratio direct rsca/raw p99 = {results['ratio_direct_p99']:.2f}")
-    print(f"ratio same-host rsca/raw p50 = {results['ratio_same_host_p50']:.2f}")
-    print(f"ratio same-host rsca/iceoryx p50 = {results['ratio_same_host_iceoryx_p50']:.2f}")
+    print_latency(results, qos)
     return 0
 
 

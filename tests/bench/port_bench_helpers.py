@@ -134,6 +134,10 @@ class LatencyRsca:
         self.domain, self.work, self.count, self.warmup = domain, work, count, warmup
         self.name = {"same_host": "latency-same-host", "relayed": "latency",
                      "direct": "latency-direct"}[path]
+        # The node daemons carry the relayed path (their rings and relays): their CPU is part of a
+        # round trip's; counted apart (cpu_nodes_us) on every path, in cpu_us on the relayed one.
+        self.node_pids = [pid for name, pid in domain.daemons.items() if name != "domaind"]
+        self.count_nodes = path == "relayed"
         sad = os.path.join(SDRROOT, "dom/waveforms/BenchPortLatency/BenchPortLatency.sad.xml")
         installed, sdr = "BenchPortLatency", []
         if path == "direct":
@@ -151,16 +155,23 @@ class LatencyRsca:
             raise RuntimeError(f"{self.name}: connections are not all {path}: {listed}")
         domain.cli("configure", f"{self.name}/BenchPing_1", f"count={count}", f"warmup={warmup}")
         self.cpu_us = 0.0
+        self.cpu_nodes_us = 0.0
         self.round_trips = 0
         self.resent = 0
 
     def run(self, index):
         output = os.path.join(self.work, f"{self.name}-rtt-{index}.bin")
         self.domain.cli("configure", f"{self.name}/BenchPing_1", f"output={output}")
+        # The window is the components' whole run (`start` to the file), the nodes' handling of
+        # `start` included: an over-count of the nodes' part, never an under-count.
         before = sum(cpu_us(p) for p in self.pids.values())
+        nodes_before = sum(cpu_us(p) for p in self.node_pids)
         self.domain.cli("start", self.name)
         wait_for_file(output, 8 * self.count, 60 + self.count * 0.01, "BenchPing_1")
-        self.cpu_us += sum(cpu_us(p) for p in self.pids.values()) - before
+        nodes = sum(cpu_us(p) for p in self.node_pids) - nodes_before
+        self.cpu_nodes_us += nodes
+        self.cpu_us += sum(cpu_us(p) for p in self.pids.values()) - before + (
+            nodes if self.count_nodes else 0.0)
         props, _ = self.domain.cli("query", f"{self.name}/BenchPing_1", "completed", "resent")
         self.domain.cli("stop", self.name)
         self.round_trips += props["properties"]["completed"]
@@ -227,24 +238,31 @@ class LatencyIceoryx(RawPingSide):
     whole run, in one session as a node's processes are; each round runs a ping to its end. The
     payload is the size of the ping's SampleSeq on DDS."""
 
-    def __init__(self, program, work, count, warmup, payload_bytes):
+    def __init__(self, program, work, count, warmup, payload_bytes, spin_us=0, roudi=True):
         super().__init__(work, count, warmup)
         self.program, self.bytes = program, str(payload_bytes)
+        # With roudi, this side starts the machine's RouDi; another side (roudi False) shares
+        # it, its pair apart by a service instance of its own.
+        self.roudi, self.instance = roudi, f"spin{spin_us}"
+        self.spin = ["--spin-us", str(spin_us), "--instance", self.instance]
         self.start(self._start_roudi_and_echo)
 
     def _start_roudi_and_echo(self):
-        roudi = self.procs.start([self.program, "roudi"], dict(os.environ),
-                                 os.path.join(self.work, "iceoryx-roudi.log"))
-        wait_for_line(roudi, "ready", 30, "RouDi")
-        self.echo = self.procs.start([self.program, "echo", "--bytes", self.bytes],
-                                     dict(os.environ), os.path.join(self.work, "iceoryx-echo.log"))
+        if self.roudi:
+            roudi = self.procs.start([self.program, "roudi"], dict(os.environ),
+                                     os.path.join(self.work, "iceoryx-roudi.log"))
+            wait_for_line(roudi, "ready", 30, "RouDi")
+        self.echo = self.procs.start([self.program, "echo", "--bytes", self.bytes, *self.spin],
+                                     dict(os.environ),
+                                     os.path.join(self.work, f"iceoryx-{self.instance}-echo.log"))
         wait_for_line(self.echo, "ready", 30, "the iceoryx echo")
 
     def run(self, index):
-        output = os.path.join(self.work, f"iceoryx-rtt-{index}.bin")
+        output = os.path.join(self.work, f"iceoryx-{self.instance}-rtt-{index}.bin")
         return run_ping(self, [self.program, "ping", "--bytes", self.bytes, "--count",
-                               str(self.count), "--warmup", str(self.warmup), "--output", output],
-                        dict(os.environ), f"iceoryx-ping-{index}.log", output)
+                               str(self.count), "--warmup", str(self.warmup), "--output", output,
+                               *self.spin],
+                        dict(os.environ), f"iceoryx-{self.instance}-ping-{index}.log", output)
 
 
 def run_ping(side, args, env, log_name, output):
@@ -290,12 +308,17 @@ class LatencyRaw(RawPingSide):
     The two share a session of their own, as BenchPing_1 and BenchEcho_1 share the session of the
     node that started them (local_domain.Processes says why that matters)."""
 
-    def __init__(self, domain, raw, work, qos, count, warmup, wake, hosts=(None, None)):
+    def __init__(self, domain, raw, work, qos, count, warmup, wake, hosts=(None, None),
+                 spin_us=0):
         super().__init__(work, count, warmup)
         self.domain, self.raw, self.wake = domain, raw, wake
         self.ping_host, self.echo_host = hosts  # network hosts (port_bench.py --hosts), or here
-        self.ping_topic = f"rsca_bench_raw_ping_{wake}_{os.getpid()}"
-        self.echo_topic = f"rsca_bench_raw_echo_{wake}_{os.getpid()}"
+        # After data, both look for more this long before they sleep (rsca's
+        # RSCA_RECEIVE_SPIN_US); the files of each spin apart.
+        self.spin = ["--spin-us", str(spin_us)]
+        self.label = f"{wake}-spin{spin_us}"
+        self.ping_topic = f"rsca_bench_raw_ping_{wake}_{spin_us}_{os.getpid()}"
+        self.echo_topic = f"rsca_bench_raw_echo_{wake}_{spin_us}_{os.getpid()}"
         self.qos = json.dumps(qos)
         self.start(self._start_echo)
 
@@ -303,19 +326,24 @@ class LatencyRaw(RawPingSide):
         self.echo = self.procs.start(
             on_host(self.echo_host,
                     [self.raw, "echo", "--in", self.ping_topic, "--out", self.echo_topic, "--qos",
-                     self.qos, "--wake", self.wake]), self.domain.env,
-            os.path.join(self.work, f"raw-{self.wake}-echo.log"))
+                     self.qos, "--wake", self.wake, *self.spin]), self.domain.env,
+            os.path.join(self.work, f"raw-{self.label}-echo.log"))
 
     def run(self, index):
-        output = os.path.join(self.work, f"raw-{self.wake}-rtt-{index}.bin")
+        output = os.path.join(self.work, f"raw-{self.label}-rtt-{index}.bin")
         return run_ping(self, on_host(self.ping_host, [
                             self.raw, "ping", "--out", self.ping_topic, "--in", self.echo_topic,
                             "--qos", self.qos, "--wake", self.wake, "--count", str(self.count),
-                            "--warmup", str(self.warmup), "--output", output]),
-                        self.domain.env, f"raw-{self.wake}-ping-{index}.log", output)
+                            "--warmup", str(self.warmup), "--output", output, *self.spin]),
+                        self.domain.env, f"raw-{self.label}-ping-{index}.log", output)
 
 
 # The latency benchmark's sides: the rsca components on two nodes (over DDS) and on one (through
 # its shared memory), the raw programs with a waitset (the baseline of the ratio lines), the raw
 # programs woken the way rsca's receive loop wakes, and a raw iceoryx ping-pong.
 SIDES = ("rsca", "rsca_direct", "rsca_same_host", "raw", "raw_listener", "iceoryx")
+# Each side runs in two modes, in the same run: "spin", every receiving thread looks for more data
+# for SPIN_US after data before it sleeps (rsca's default, RSCA_RECEIVE_SPIN_US; the raw programs
+# with --spin-us), and "sleep", every one sleeps at once (RSCA_RECEIVE_SPIN_US=0, --spin-us 0).
+SPIN_US = 50
+MODES = {"spin": SPIN_US, "sleep": 0}
