@@ -1,7 +1,9 @@
 #!/usr/bin/env python3
 """The RSCA paper's three-way comparison (run by tools/bench, never by ctest): the same StopCrash
 control loop (drive toward the wall at 0.3 m/s, the IR range read every 20 ms, stop below 0.6 m)
-run three ways, in real time, each over 20 runs (--quick: 1):
+run three ways, in real time, each over 20 runs (--quick: 1), the ways taking turns run by run
+(run i: each way once with seed 1 + i, in an order rotated by one each run; METHOD says how each
+is measured, and the output says it too):
 
 - inprocess: one process, direct calls (tests/bench/rangestop/rangestop_inprocess.cpp): the world
   stepped in real time on one thread, a sensor thread every period calling the controller, which
@@ -11,20 +13,24 @@ run three ways, in real time, each over 20 runs (--quick: 1):
   with a command carrying it back. Delay: from the reading's timestamp to the command's arrival.
 - dds (not the paper's; a baseline of what rsca is built on): raw Cyclone DDS ping-pong between
   the controller's and the robot's host with RangeStop's QoS, one round trip a sensor period
-  (run_dds). Delay: the round trip, a reading there and a command back.
+  (class Dds). Delay: the round trip, a reading there and a command back.
 - rsca: a real local domain (rsca-domaind, rsca-noded for node1, a GPP, and rsca-noded for the
   robot's DCD), RangeStop launched: StopCrash in a process of its own on node1, the IRSensor and
   the DriveSystem devices in the robot's node daemon, connected over Cyclone DDS. Delay: what the
-  DriveSystem measures (latency_mean_us, latency_p50_us, latency_p99_us, over every command of all
-  runs, including the zero commands StopCrash sends once it has stopped the robot).
+  DriveSystem measures: the mean of each run's commands from its command count and delay sum
+  before and after the run; p50 and p99 from the DriveSystem's own window over every command of
+  all runs, including the zero commands StopCrash sends once it has stopped the robot (their
+  share is estimated from the Robot's trace and printed): the DriveSystem keeps no per-command
+  record the benchmark could cut at rest. So that the phase is the baselines' (start to rest),
+  each run lasts what the last baseline run took to rest (its world time).
   Between runs the application is stopped, the Robot given the run's seed and reset (its world
   re-created, the robot back at its start), and the application started again (StopCrash.start()
   clears its latch). The CLI is not called while StopCrash runs: every CLI call is a DDS
   participant whose discovery every process of the domain feels (on an idle 2-core host, the
   DriveSystem's p99 was 1.0 ms over a quiet minute, 2.8 ms over that minute and one of CLI queries
-  back to back). So the script sleeps for the drive toward the wall plus a margin
-  (REST_MARGIN_S), stops the application, checks that StopCrash had stopped the robot, and then
-  polls the Robot until it rests.
+  back to back). So the script sleeps for the last baseline run's time to rest (without one:
+  the drive toward the wall plus a margin, REST_MARGIN_S), stops the application, checks that
+  StopCrash had stopped the robot, and then polls the Robot until it rests.
 
 Run i (from 0) uses seed 1 + i in all three ways (the sensor's noise). The stopping distance is the
 exact distance from the sensor to the wall at rest (world.true_range(0); the Robot's
@@ -43,6 +49,7 @@ and with the dds way `ratio rsca/dds delay p50 = R`.
 Every process started is stopped at the end, also on failure.
 """
 import argparse
+import contextlib
 import json
 import os
 import platform
@@ -65,6 +72,10 @@ LAUNCH_ATTEMPTS = 3
 # After the drive toward the threshold at full speed: the start (~0.1 s), the braking (~0.15 s),
 # and the rest of the margin for a late start on a busy host.
 REST_MARGIN_S = 2.0
+# A run that the last baseline run's time has not brought to a stop goes on in steps of this, and
+# once it has stopped, for the braking as well (about 0.15 s at 0.3 m/s).
+LATE_STEP_S = 0.1
+BRAKING_S = 0.2
 
 
 def p50_p99(values):
@@ -103,20 +114,35 @@ def baseline_result(header, runs):
     }
 
 
-def common_args(args, runs):
-    return ["--runs", str(runs), "--first-seed", "1", "--speed", str(args.speed),
+def common_args(args, seed):
+    """One run of a baseline program with the run's seed (the ways take turns run by run)."""
+    return ["--runs", "1", "--first-seed", str(seed), "--speed", str(args.speed),
             "--threshold", str(args.threshold), "--period-ms", str(args.period_ms)]
 
 
-def run_inprocess(args, runs, logs):
-    exe = os.path.join(args.bin, "rsca-bench-rangestop-inprocess")
-    with Processes() as procs:
-        p = procs.start([exe, *common_args(args, runs)], os.environ,
-                        os.path.join(logs, "inprocess.log"))
-        out, _ = p.communicate(timeout=60 * runs + 30)
-        if p.returncode != 0:
-            raise RuntimeError(f"{exe} failed ({p.returncode}), see {logs}/inprocess.log")
-    return baseline_result(*parse_lines(out, exe))
+def one_run(header_and_runs, run, seed):
+    """The run a baseline program printed (its only one), as run `run` with `seed`."""
+    header, runs = header_and_runs
+    if len(runs) != 1:
+        raise RuntimeError(f"expected one run, got {len(runs)}")
+    return header, dict(runs[0], run=run, seed=seed)
+
+
+class Inprocess:
+    """The inprocess way, one run a call."""
+
+    def __init__(self, args, logs):
+        self.args, self.logs = args, logs
+        self.exe = os.path.join(args.bin, "rsca-bench-rangestop-inprocess")
+
+    def run(self, run, seed):
+        with Processes() as procs:
+            log = os.path.join(self.logs, f"inprocess-{run}.log")
+            p = procs.start([self.exe, *common_args(self.args, seed)], os.environ, log)
+            out, _ = p.communicate(timeout=90)
+            if p.returncode != 0:
+                raise RuntimeError(f"{self.exe} failed ({p.returncode}), see {log}")
+        return one_run(parse_lines(out, self.exe), run, seed)
 
 
 def read_line(proc, timeout, what):
@@ -136,61 +162,83 @@ def host_address(index):
     return f"10.77.0.{index + 1}"
 
 
-def run_tcp(args, runs, logs):
-    exe = os.path.join(args.bin, "rsca-bench-rangestop-tcp")
-    hosts = args.net_hosts
-    address = host_address(CONTROLLER_HOST) if hosts else "127.0.0.1"
-    with Processes() as procs:
-        controller = procs.start(
-            on_host(hosts and hosts[CONTROLLER_HOST],
-                    [exe, "--role", "controller", "--address", address, *common_args(args, runs)]),
-            os.environ, os.path.join(logs, "tcp-controller.log"))
-        port = read_line(controller, 10, "the TCP controller")["listening"]
-        robot = procs.start(
-            on_host(hosts and hosts[ROBOT_HOST],
-                    [exe, "--role", "robot", "--port", str(port), "--address", address,
-                     *common_args(args, runs)]),
-            os.environ, os.path.join(logs, "tcp-robot.log"))
-        out, _ = robot.communicate(timeout=60 * runs + 30)
-        if robot.returncode != 0:
-            raise RuntimeError(f"{exe} --role robot failed ({robot.returncode}), "
-                               f"see {logs}/tcp-robot.log")
-        controller.wait(timeout=10)  # it leaves when the robot hangs up
-    return baseline_result(*parse_lines(out, exe))
+class Tcp:
+    """The tcp way, one run a call: a controller and a robot process each run."""
+
+    def __init__(self, args, logs):
+        self.args, self.logs = args, logs
+        self.exe = os.path.join(args.bin, "rsca-bench-rangestop-tcp")
+
+    def run(self, run, seed):
+        hosts = self.args.net_hosts
+        address = host_address(CONTROLLER_HOST) if hosts else "127.0.0.1"
+        with Processes() as procs:
+            controller = procs.start(
+                on_host(hosts and hosts[CONTROLLER_HOST],
+                        [self.exe, "--role", "controller", "--address", address,
+                         *common_args(self.args, seed)]),
+                os.environ, os.path.join(self.logs, f"tcp-controller-{run}.log"))
+            port = read_line(controller, 10, "the TCP controller")["listening"]
+            robot = procs.start(
+                on_host(hosts and hosts[ROBOT_HOST],
+                        [self.exe, "--role", "robot", "--port", str(port), "--address", address,
+                         *common_args(self.args, seed)]),
+                os.environ, os.path.join(self.logs, f"tcp-robot-{run}.log"))
+            out, _ = robot.communicate(timeout=90)
+            if robot.returncode != 0:
+                raise RuntimeError(f"{self.exe} --role robot failed ({robot.returncode}), "
+                                   f"see {self.logs}/tcp-robot-{run}.log")
+            controller.wait(timeout=10)  # it leaves when the robot hangs up
+        return one_run(parse_lines(out, self.exe), run, seed)
 
 
-def run_dds(args, runs, logs):
+class Dds:
     """Raw Cyclone DDS between the controller's host and the robot's, with RangeStop's QoS
-    (reliable, keep last 1) and its pace: `rsca-bench-raw echo` where the controller runs, and
-    `rsca-bench-raw ping` where the robot runs, a ping every sensor period, each answered before
-    the next (--interval-us). A round trip is what the other ways' delay is: a reading to the
-    controller and a command back, two hops, with DDS's own threads woken from idle as a
-    periodic loop wakes them. Not a baseline rsca could beat by design (rsca carries its data on
-    Cyclone DDS), but it tells what of rsca's delay is DDS's."""
-    exe = os.path.join(args.bin, "rsca-bench-raw")
-    hosts = args.net_hosts
-    env = dds_env()
-    if hosts:
-        env["RSCA_DDS_INTERFACE"] = "eth0"
-    qos = json.dumps({"reliability": "reliable", "history": "keeplast", "depth": 1})
-    topics = [f"rsca_bench_rangestop_{name}_{os.getpid()}" for name in ("reading", "command")]
-    output = os.path.join(logs, "dds-rtt.bin")
-    count = DDS_ROUND_TRIPS_A_RUN * runs
-    with Processes() as procs:
-        procs.start(on_host(hosts and hosts[CONTROLLER_HOST],
-                            [exe, "echo", "--in", topics[0], "--out", topics[1], "--qos", qos]),
-                    env, os.path.join(logs, "dds-echo.log"))
-        ping = procs.start(
+    (reliable, keep last 1) and its pace: `rsca-bench-raw echo` where the controller runs (for
+    the whole session), and a `rsca-bench-raw ping` each run where the robot runs, a ping every
+    sensor period, each answered before the next (--interval-us), about as many as the readings
+    of a run of the others. A round trip is what the other ways' delay is: a reading to the
+    controller and a command back, two hops, with DDS's own threads woken from idle as a periodic
+    loop wakes them. Not a baseline rsca could beat by design (rsca carries its data on Cyclone
+    DDS), but it tells what of rsca's delay is DDS's."""
+
+    def __init__(self, args, logs):
+        self.args, self.logs = args, logs
+        self.exe = os.path.join(args.bin, "rsca-bench-raw")
+        self.env = dds_env()
+        if args.net_hosts:
+            self.env["RSCA_DDS_INTERFACE"] = "eth0"
+        self.qos = json.dumps({"reliability": "reliable", "history": "keeplast", "depth": 1})
+        self.topics = [f"rsca_bench_rangestop_{name}_{os.getpid()}"
+                       for name in ("reading", "command")]
+        self.procs = Processes()
+
+    def __enter__(self):
+        hosts = self.args.net_hosts
+        self.procs.start(on_host(hosts and hosts[CONTROLLER_HOST],
+                                 [self.exe, "echo", "--in", self.topics[0], "--out",
+                                  self.topics[1], "--qos", self.qos]),
+                         self.env, os.path.join(self.logs, "dds-echo.log"))
+        return self
+
+    def __exit__(self, *exc):
+        self.procs.close()
+
+    def run(self, run, seed):
+        hosts = self.args.net_hosts
+        output = os.path.join(self.logs, f"dds-rtt-{run}.bin")
+        ping = self.procs.start(
             on_host(hosts and hosts[ROBOT_HOST],
-                    [exe, "ping", "--out", topics[0], "--in", topics[1], "--qos", qos,
-                     "--count", str(count), "--warmup", "20",
-                     "--interval-us", str(args.period_ms * 1000), "--output", output]),
-            env, os.path.join(logs, "dds-ping.log"))
-        ping.communicate(timeout=60 + count * args.period_ms / 1000 * 2)
+                    [self.exe, "ping", "--out", self.topics[0], "--in", self.topics[1], "--qos",
+                     self.qos, "--count", str(DDS_ROUND_TRIPS_A_RUN), "--warmup", "20",
+                     "--interval-us", str(self.args.period_ms * 1000), "--output", output]),
+            self.env, os.path.join(self.logs, f"dds-ping-{run}.log"))
+        ping.communicate(timeout=60 + DDS_ROUND_TRIPS_A_RUN * self.args.period_ms / 1000 * 2)
         if ping.returncode != 0:
-            raise RuntimeError(f"{exe} ping failed ({ping.returncode}), see {logs}/dds-ping.log")
-    delays = [ns / 1e3 for ns in read_u64(output)]
-    return {"delay_us": delay_summary(delays), "round_trips": len(delays)}
+            raise RuntimeError(f"{self.exe} ping failed ({ping.returncode}), see "
+                               f"{self.logs}/dds-ping-{run}.log")
+        return None, {"run": run, "seed": seed,
+                      "delays_us": [ns / 1e3 for ns in read_u64(output)]}
 
 
 class RobotDomain(Domain):
@@ -254,16 +302,53 @@ def wait_for_rest(domain, args, run):
     raise RuntimeError(f"rsca run {run}: the robot did not come to rest within 60 s")
 
 
-def run_rsca(args, runs, logs):
-    rsca = os.path.join(args.bin, "rsca")
-    dcd = os.path.join(args.sdrroot, "dev/nodes/robot/DeviceManager.dcd.xml")
-    # The drive toward the threshold at full speed.
-    drive_s = max(0.0, (args.wall_distance - args.threshold) / args.speed)
-    results = []
-    with RobotDomain(rsca, dcd, args.sdrroot, hosts=args.net_hosts, pinned=args.pinned) as domain:
+def drive_counters(domain):
+    """The DriveSystem's command count and delay sum so far: a run's own mean is the difference
+    over the run."""
+    drive = props(domain, "robot:DriveSystem_1", "latency_samples", "latency_mean_us")
+    return drive["latency_samples"], drive["latency_mean_us"] * drive["latency_samples"]
+
+
+def rest_sim_time(robot):
+    """When the robot came to rest after the stop, in the world's time, as the baselines end a run
+    (slower than 1 mm/s for 50 ms once a stop was commanded; from the Robot's trace), or None."""
+    times, speeds, commands = (robot.get(k, []) for k in ("trace_time", "trace_speed",
+                                                            "trace_command"))
+    driven, stopped, still_since = False, False, None
+    for t, v, c in zip(times, speeds, commands):
+        driven = driven or c != 0.0  # before the first command, the robot waits at rest
+        stopped = stopped or driven and c == 0.0
+        if stopped and abs(v) < 1e-3:
+            still_since = t if still_since is None else still_since
+            if t - still_since >= 0.05:
+                return t
+        else:
+            still_since = None
+    return None
+
+
+class Rsca:
+    """The rsca way: a domain for the whole session, RangeStop launched once; each run stops the
+    application, gives the Robot the run's seed, resets it (its world re-created, the robot back
+    at its start) and starts the application again (StopCrash.start() clears its latch)."""
+
+    def __init__(self, args, logs):
+        self.args, self.logs = args, logs
+        # The drive toward the threshold at full speed.
+        self.drive_s = max(0.0, (args.wall_distance - args.threshold) / args.speed)
+        dcd = os.path.join(args.sdrroot, "dev/nodes/robot/DeviceManager.dcd.xml")
+        self.domain = RobotDomain(os.path.join(args.bin, "rsca"), dcd, args.sdrroot,
+                                  hosts=args.net_hosts, pinned=args.pinned)
+        self.drive = {}
+        # How long the last baseline run took from its start to the robot's rest (world time),
+        # the phase every way is recorded over; None until a baseline has run.
+        self.phase_s = None
+
+    def __enter__(self):
+        domain = self.domain.__enter__()
         try:
-            domain.cli("configure", "robot:IRSensor_1", f"period_ms={args.period_ms}")
-            domain.cli("install", os.path.join(args.sdrroot,
+            domain.cli("configure", "robot:IRSensor_1", f"period_ms={self.args.period_ms}")
+            domain.cli("install", os.path.join(self.args.sdrroot,
                                                "dom/waveforms/RangeStop/RangeStop.sad.xml"))
             for attempt in range(1, LAUNCH_ATTEMPTS + 1):
                 try:
@@ -274,46 +359,71 @@ def run_rsca(args, runs, logs):
                         raise
                     print(f"launch of RangeStop failed (attempt {attempt}), trying again: {e}",
                           file=sys.stderr, flush=True)
-                    time.sleep(5)
-            domain.cli("configure", "RangeStop/StopCrash_1", f"speed={args.speed}",
-                       f"threshold={args.threshold}")
-            for run in range(runs):
-                seed = 1 + run
-                domain.cli("configure", "robot:Robot_1", f"seed={seed}")
-                domain.cli("configure", "robot:Robot_1", "reset=true")
-                domain.cli("start", "RangeStop")
-                time.sleep(drive_s + REST_MARGIN_S)  # the run, undisturbed by the CLI
-                domain.cli("stop", "RangeStop")
-                stop = props(domain, "RangeStop/StopCrash_1", "stopped", "stop_range",
-                             "commands_sent")
-                if not stop["stopped"]:
-                    raise RuntimeError(f"rsca run {run}: StopCrash had not stopped the robot "
-                                       f"{drive_s + REST_MARGIN_S:.1f} s after its start")
-                wait_for_rest(domain, args, run)
-                robot = props(domain, "robot:Robot_1", "distance_to_wall", "sim_time", "seed")
-                results.append({"way": "rsca", "run": run, "seed": seed,
-                                "distance_to_wall": robot["distance_to_wall"],
-                                "stop_range": stop["stop_range"], "sim_time": robot["sim_time"],
-                                "commands_sent_total": stop["commands_sent"],
-                                "robot_seed": robot["seed"]})
-                print(f"rsca run {run}: rests {robot['distance_to_wall']:.4f} m from the wall",
-                      file=sys.stderr, flush=True)
-            drive = props(domain, "robot:DriveSystem_1")
+                    time.sleep(5)  # a pause before trying again on a host that was too busy
+            domain.cli("configure", "RangeStop/StopCrash_1", f"speed={self.args.speed}",
+                       f"threshold={self.args.threshold}")
+        except BaseException:
+            self.domain.__exit__(*sys.exc_info())
+            raise
+        return self
+
+    def __exit__(self, *exc):
+        domain = self.domain
+        try:
+            if exc[0] is None:
+                self.drive = props(domain, "robot:DriveSystem_1")
         finally:
             domain.cli("release", "RangeStop", check=False)
             for log in os.listdir(domain.run_dir):
                 if log.endswith(".log"):
                     with open(os.path.join(domain.run_dir, log), "rb") as src, \
-                            open(os.path.join(logs, f"rsca-{log}"), "wb") as dst:
+                            open(os.path.join(self.logs, f"rsca-{log}"), "wb") as dst:
                         dst.write(src.read())
-    return {
-        "runs": results,
-        "delay_us": {"mean": drive["latency_mean_us"], "p50": drive["latency_p50_us"],
-                     "p99": drive["latency_p99_us"], "samples": drive["latency_samples"]},
-        "drive": {k: drive[k] for k in ("commands_received", "safety_stops", "command_timeout_ms")
-                  if k in drive},
-        "stop_distance_m": distance_summary([r["distance_to_wall"] for r in results]),
-    }
+            domain.__exit__(*exc)
+
+    def run(self, run, seed):
+        domain, args = self.domain, self.args
+        domain.cli("configure", "robot:Robot_1", f"seed={seed}")
+        domain.cli("configure", "robot:Robot_1", "reset=true")
+        samples_before, sum_before = drive_counters(domain)
+        domain.cli("start", "RangeStop")
+        # The run, undisturbed by the CLI: as long as the last baseline run took to rest (the
+        # same phase; the world's clock started at the reset, before `start`, so the robot has
+        # had that and the start's time more), or without one the drive and a margin.
+        time.sleep(self.phase_s or self.drive_s + REST_MARGIN_S)
+        # A late start on a busy host: a little longer, until StopCrash has stopped the robot
+        # (bounded by the margin), and its braking.
+        late = 0.0
+        while (self.phase_s and late < REST_MARGIN_S and
+               not props(domain, "RangeStop/StopCrash_1", "stopped")["stopped"]):
+            late += LATE_STEP_S
+            time.sleep(LATE_STEP_S)
+        if late:
+            time.sleep(BRAKING_S)
+        domain.cli("stop", "RangeStop")
+        stopped_at = props(domain, "robot:Robot_1", "sim_time")["sim_time"]
+        stop = props(domain, "RangeStop/StopCrash_1", "stopped", "stop_range", "commands_sent")
+        if not stop["stopped"]:
+            raise RuntimeError(f"rsca run {run}: StopCrash had not stopped the robot by the "
+                               f"end of the run")
+        wait_for_rest(domain, args, run)
+        samples_after, sum_after = drive_counters(domain)
+        robot = props(domain, "robot:Robot_1", "distance_to_wall", "sim_time", "seed",
+                      "trace_time", "trace_speed", "trace_command")
+        rest = rest_sim_time(robot)
+        commands = samples_after - samples_before
+        # The commands of the run after the robot rested: the share of its samples the baselines
+        # do not have (they end at rest); an estimate, from the world's time.
+        after_rest = (max(0.0, stopped_at - rest) * 1000 / args.period_ms
+                      if rest is not None else None)
+        return None, {"way": "rsca", "run": run, "seed": seed,
+                      "distance_to_wall": robot["distance_to_wall"],
+                      "stop_range": stop["stop_range"], "sim_time": robot["sim_time"],
+                      "commands_sent_total": stop["commands_sent"], "robot_seed": robot["seed"],
+                      "commands": commands, "rest_sim_time": rest,
+                      "stopped_sim_time": stopped_at,
+                      "commands_after_rest_estimate": after_rest,
+                      "delay_mean_us": (sum_after - sum_before) / commands if commands else None}
 
 
 def main():
@@ -346,6 +456,78 @@ def main():
     return experiment(args, parser)
 
 
+# How the ways are measured, said in the output and the JSON.
+METHOD = ("The ways take turns run by run (run i: every way once, with seed 1 + i, in an order "
+          "rotated by one each run), with rsca among them all while its domain is up; the "
+          "baselines' delays are "
+          "each command's, taken at the drive, from the run's start until the robot rests "
+          "(slower than 1 mm/s for 50 ms of world time after the stop), and their percentiles "
+          "are computed here (sorted[n/2], sorted[n*99/100]) over every run; clock: the system "
+          "clock of the reading's stamp and of the drive. rsca: its mean is computed here per run "
+          "from the DriveSystem's command count and delay sum before and after the run (the "
+          "run's commands only; the run is stopped once the last baseline run's time to rest "
+          "has passed since its start, so that few come after rest), its percentiles are the "
+          "DriveSystem's own window (not a like-for-like figure: the DriveSystem keeps no "
+          "per-command record the benchmark can read; the share of its commands sent after rest "
+          "is estimated from the Robot's trace). dds: round trips, no robot.")
+
+
+def run_interleaved(args, ways, runs, logs):
+    """Every way's session open at once; run i runs each way once, in an order rotated by i.
+    Returns each way's runs, the baseline programs' headers, wall clock by way, the sessions."""
+    classes = {"inprocess": Inprocess, "tcp": Tcp, "dds": Dds, "rsca": Rsca}
+    per_way, headers = {w: [] for w in ways}, {}
+    clock = {w: 0.0 for w in ways}
+    with contextlib.ExitStack() as stack:
+        sessions = {}
+        for w in ways:
+            session = classes[w](args, logs)
+            sessions[w] = (stack.enter_context(session) if hasattr(session, "__enter__")
+                           else session)
+        for i in range(runs):
+            for w in ways[i % len(ways):] + ways[:i % len(ways)]:
+                print(f"run {i}: {w}...", file=sys.stderr, flush=True)
+                began = time.monotonic()
+                header, result = sessions[w].run(i, 1 + i)
+                clock[w] += time.monotonic() - began
+                if header:
+                    headers[w] = header
+                if w in ("inprocess", "tcp") and "rsca" in sessions:
+                    sessions["rsca"].phase_s = result["sim_time"]
+                per_way[w].append(result)
+                if "distance_to_wall" in result:
+                    print(f"{w} run {i}: rests {result['distance_to_wall']:.4f} m from the wall",
+                          file=sys.stderr, flush=True)
+    return per_way, headers, clock, sessions
+
+
+def way_result(way, header, runs, session):
+    """One way's figures over all its runs."""
+    if way in ("inprocess", "tcp"):
+        return baseline_result(header, runs)
+    if way == "dds":
+        delays = [d for r in runs for d in r["delays_us"]]
+        return {"delay_us": delay_summary(delays), "round_trips": len(delays)}
+    drive = session.drive
+    means = [r["delay_mean_us"] for r in runs if r["delay_mean_us"] is not None]
+    commands = sum(r["commands"] for r in runs)
+    after = [r["commands_after_rest_estimate"] for r in runs
+             if r["commands_after_rest_estimate"] is not None]
+    return {
+        "runs": runs,
+        "delay_us": {"mean": (sum(r["delay_mean_us"] * r["commands"] for r in runs
+                                  if r["delay_mean_us"] is not None) / commands
+                              if commands else float("nan")),
+                     "p50": drive.get("latency_p50_us"), "p99": drive.get("latency_p99_us"),
+                     "samples": commands, "percentiles_from": "the DriveSystem's window",
+                     "run_means": means},
+        "commands_after_rest_share_estimate": sum(after) / commands if commands and after else None,
+        "drive": {k: drive[k] for k in ("commands_received", "safety_stops", "command_timeout_ms")
+                  if k in drive},
+        "stop_distance_m": distance_summary([r["distance_to_wall"] for r in runs]),
+    }
+
+
 def experiment(args, parser):
     args.sdrroot = os.path.abspath(args.sdrroot)
     runs = args.runs or (1 if args.quick else 20)
@@ -366,12 +548,11 @@ def experiment(args, parser):
                "host": {"cpus": os.cpu_count(), "machine": platform.machine(),
                         "loadavg_before": os.getloadavg()},
                "ways": {}}
-    run = {"inprocess": run_inprocess, "tcp": run_tcp, "dds": run_dds, "rsca": run_rsca}
+    per_way, headers, clock, sessions = run_interleaved(args, ways, runs, logs)
     for w in ways:
-        print(f"{w}: {runs} runs in real time...", file=sys.stderr, flush=True)
-        t = time.monotonic()
-        results["ways"][w] = run[w](args, runs, logs)
-        results["ways"][w]["wall_clock_s"] = time.monotonic() - t
+        results["ways"][w] = way_result(w, headers.get(w), per_way[w], sessions[w])
+        results["ways"][w]["wall_clock_s"] = clock[w]
+    results["method"] = METHOD
     for w in ("inprocess", "tcp"):  # the prediction, from sim::stop_tolerance
         if w in results["ways"]:
             header = results["ways"][w]["header"]
@@ -387,6 +568,8 @@ def experiment(args, parser):
     with open(args.out, "w") as f:
         json.dump(results, f, indent=2)
 
+    print(f"How measured: {METHOD}")
+    print()
     print("| way | runs | delay mean µs | p50 | p99 | stop distance mean m | sd | min | max |")
     print("| --- | --- | --- | --- | --- | --- | --- | --- | --- |")
     for w in ways:
@@ -397,7 +580,9 @@ def experiment(args, parser):
                   f"{d['p99']:.1f} | | | | |")
             continue
         s = r["stop_distance_m"]
-        print(f"| {w} | {len(r['runs'])} | {d['mean']:.1f} | {d['p50']:.1f} | {d['p99']:.1f} | "
+        window = " (p50, p99: DriveSystem's window)" if w == "rsca" else ""
+        print(f"| {w}{window} | {len(r['runs'])} | {d['mean']:.1f} | {d['p50']:.1f} "
+              f"| {d['p99']:.1f} | "
               f"{s['mean']:.4f} | {s['sd']:.4f} | {s['min']:.4f} | {s['max']:.4f} |")
     if "prediction" in results:
         p = results["prediction"]
@@ -417,10 +602,22 @@ def experiment(args, parser):
             json.dump(results, f, indent=2)
         print(f"{'' if baseline == 'dds' else chr(10)}ratio {where}rsca/{baseline} delay p50 = "
               f"{ratio:.2f}")
+    for baseline in ("inprocess", "tcp"):  # means over each way's runs, computed here
+        if "rsca" in results["ways"] and baseline in results["ways"]:
+            ratio = (results["ways"]["rsca"]["delay_us"]["mean"] /
+                     results["ways"][baseline]["delay_us"]["mean"])
+            results[f"ratio_rsca_{baseline}_mean"] = ratio
+            print(f"ratio {where}rsca/{baseline} delay mean = {ratio:.2f} (rsca's commands after "
+                  "rest included)")
+    with open(args.out, "w") as f:
+        json.dump(results, f, indent=2)
     if "rsca" in results["ways"]:
-        print(f"rsca delay over {results['ways']['rsca']['delay_us']['samples']} commands "
-              f"(all runs, DriveSystem); drive safety stops: "
-              f"{results['ways']['rsca']['drive'].get('safety_stops')}")
+        r = results["ways"]["rsca"]
+        share = r["commands_after_rest_share_estimate"]
+        print(f"rsca delay over {r['delay_us']['samples']} commands of its runs; of them sent "
+              f"after the robot rested (estimate): "
+              f"{'unknown' if share is None else f'{100 * share:.0f} %'}; drive safety stops: "
+              f"{r['drive'].get('safety_stops')}")
     return 0
 
 
