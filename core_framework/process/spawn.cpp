@@ -4,9 +4,11 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cstring>
 #include <string_view>
 #include <system_error>
 #include <thread>
+#include <variant>
 
 #include <fcntl.h>
 #include <poll.h>
@@ -98,8 +100,22 @@ Expected<Fd> open_log(const Command &command) {
   return log;
 }
 
-// Above the numbers a child is given descriptors as (Command::inherit).
-constexpr int kFirstCopiedFd = 64;
+// The lowest number a child's descriptors are copied to before it is given them: above every
+// number it is given one as (Command::inherit), so that giving one its number cannot overwrite
+// another not given yet. Not a fixed number: under a low descriptor limit (64) there is no
+// descriptor above a fixed 64, and every launch failed.
+int first_free_number(const Command &command) {
+  int above = STDERR_FILENO + 1;
+  for (const auto &i : command.inherit) {
+    above = std::max(above, i.as + 1);
+  }
+  return above;
+}
+
+// A copy of `fd` at `above` or higher, close-on-exec; an empty Fd on failure (errno says why).
+Fd copy_above(int fd, int above) {
+  return Fd{::fcntl(fd, F_DUPFD_CLOEXEC, above)};
+}
 
 class SpawnActions {
 public:
@@ -141,14 +157,12 @@ int prepare_files(SpawnActions &actions, const Command &command, int log_fd,
   if (rc == 0 && !command.working_dir.empty()) {
     rc = ::posix_spawn_file_actions_addchdir_np(actions.get(), command.working_dir.c_str());
   }
-  int first_closed = STDERR_FILENO + 1;
   for (std::size_t i = 0; rc == 0 && i < command.inherit.size(); ++i) {
     rc = ::posix_spawn_file_actions_adddup2(actions.get(), inherited[i].get(),
                                             command.inherit[i].as);
-    first_closed = std::max(first_closed, command.inherit[i].as + 1);
   }
   if (rc == 0) {
-    rc = ::posix_spawn_file_actions_addclosefrom_np(actions.get(), first_closed);
+    rc = ::posix_spawn_file_actions_addclosefrom_np(actions.get(), first_free_number(command));
   }
   return rc;
 }
@@ -232,20 +246,28 @@ std::vector<char *> c_strings(std::vector<std::string> &strings) {
   return pointers;
 }
 
+// Each inherited descriptor copied above every number a descriptor is given as.
+Expected<std::vector<Fd>> copy_inherited(const Command &command) {
+  std::vector<Fd> inherited;
+  for (const auto &i : command.inherit) {
+    inherited.push_back(copy_above(i.fd, first_free_number(command)));
+    if (!inherited.back())
+      return spawn_error(command, fmt::format("cannot hand descriptor {} to {}: {}", i.fd,
+                                              command.program.string(), errno_text(errno)));
+  }
+  return inherited;
+}
+
 // Runs the program in a new process; exec failures come back from posix_spawn itself (glibc
 // reaps the child that failed to exec).
 Expected<pid_t> start(const Command &command, Group group, int log_fd) {
   SpawnActions actions;
   SpawnAttributes attributes;
-  // Each inherited descriptor is first copied above every number it is given as, so that giving
-  // one its number cannot overwrite another not given yet.
-  std::vector<Fd> inherited;
-  for (const auto &i : command.inherit) {
-    inherited.emplace_back(::fcntl(i.fd, F_DUPFD_CLOEXEC, kFirstCopiedFd));
-    if (!inherited.back())
-      return spawn_error(command, fmt::format("cannot hand descriptor {} to {}: {}", i.fd,
-                                              command.program.string(), errno_text(errno)));
+  auto copies = copy_inherited(command);
+  if (!copies) {
+    return tl::unexpected(std::move(copies.error()));
   }
+  const auto &inherited = *copies;
   int rc = prepare_files(actions, command, log_fd, inherited);
   if (rc == 0) {
     rc = prepare_attributes(attributes, group);
@@ -277,6 +299,198 @@ Expected<pid_t> start(const Command &command, Group group, int log_fd) {
   return pid;
 }
 
+// --- A child that changes user: forked, and only system calls until it executes ----------------
+
+// What the forked child needs, all made before the fork: the child must not allocate or take a
+// lock (another thread of this process may have held one as it forked).
+struct ForkPlan {
+  const char *program = nullptr;
+  char *const *argv = nullptr;
+  char *const *envp = nullptr;
+  const char *working_dir = nullptr; // null: this process's
+  int null_fd = -1;
+  int log_fd = -1; // -1: this process's stdout and stderr
+  const std::vector<Fd> *inherited = nullptr;
+  const std::vector<Command::Inherited> *inherit = nullptr;
+  int report_fd = -1; // close-on-exec: closed by a successful exec, so the parent reads nothing
+  int first_closed = STDERR_FILENO + 1;
+  Group group = Group::Own;
+  const Credentials *user = nullptr;
+};
+
+// What a child that cannot execute tells its parent: the step that failed and its errno. Less
+// than PIPE_BUF: written whole.
+struct ForkReport {
+  int error = 0;
+  char step[24] = {};
+};
+
+[[noreturn]] void fail_in_child(int report_fd, const char *step) {
+  ForkReport report;
+  report.error = errno;
+  for (std::size_t i = 0; step[i] != '\0' && i + 1 < sizeof report.step; ++i) {
+    report.step[i] = step[i];
+  }
+  [[maybe_unused]] const auto written = ::write(report_fd, &report, sizeof report);
+  ::_exit(127);
+}
+
+// The user's groups, group and user, in that order (the group and groups can no longer be set
+// once the user is not root), each checked. Raw system calls: glibc's wrappers would signal
+// every thread of the process, which the child's copy of glibc may still believe it has.
+const char *become_user(const Credentials &user) {
+  if (::syscall(SYS_setgroups, user.groups.size(), user.groups.data()) != 0) {
+    return "setgroups";
+  }
+  if (::syscall(SYS_setresgid, user.gid, user.gid, user.gid) != 0) {
+    return "setresgid";
+  }
+  if (::syscall(SYS_setresuid, user.uid, user.uid, user.uid) != 0) {
+    return "setresuid";
+  }
+  return nullptr;
+}
+
+// stdin, stdout and stderr, the inherited descriptors as their numbers, and no other descriptor
+// but the report's, which its exec closes.
+const char *hand_descriptors(const ForkPlan &plan) {
+  if (::dup2(plan.null_fd, STDIN_FILENO) < 0) {
+    return "/dev/null";
+  }
+  if (plan.log_fd >= 0 &&
+      (::dup2(plan.log_fd, STDOUT_FILENO) < 0 || ::dup2(plan.log_fd, STDERR_FILENO) < 0)) {
+    return "log file";
+  }
+  for (std::size_t i = 0; i < plan.inherit->size(); ++i) {
+    if (::dup2((*plan.inherited)[i].get(), (*plan.inherit)[i].as) < 0) {
+      return "dup2";
+    }
+  }
+  const auto report = static_cast<unsigned>(plan.report_fd);
+  const auto first = static_cast<unsigned>(plan.first_closed);
+  if (report > first && ::close_range(first, report - 1, 0) != 0) {
+    return "close_range";
+  }
+  if (::close_range(report + 1, ~0U, 0) != 0) {
+    return "close_range";
+  }
+  return nullptr;
+}
+
+[[noreturn]] void run_forked(const ForkPlan &plan) {
+  // Every signal's default action first: a handler of this process must never run here.
+  struct sigaction default_action {};
+  default_action.sa_handler = SIG_DFL;
+  for (int signal = 1; signal < NSIG; ++signal) {
+    ::sigaction(signal, &default_action, nullptr); // SIGKILL, SIGSTOP and glibc's own refuse
+  }
+  if (plan.group == Group::Own && ::setpgid(0, 0) != 0) {
+    fail_in_child(plan.report_fd, "setpgid");
+  }
+  if (plan.group == Group::Session && ::setsid() < 0) {
+    fail_in_child(plan.report_fd, "setsid");
+  }
+  if (const char *failed = hand_descriptors(plan)) {
+    fail_in_child(plan.report_fd, failed);
+  }
+  if (const char *failed = plan.user != nullptr ? become_user(*plan.user) : nullptr) {
+    fail_in_child(plan.report_fd, failed);
+  }
+  // As the user: a folder it may not enter fails here, not in the program.
+  if (plan.working_dir != nullptr && ::chdir(plan.working_dir) != 0) {
+    fail_in_child(plan.report_fd, "chdir");
+  }
+  sigset_t none;
+  ::sigemptyset(&none);
+  ::sigprocmask(SIG_SETMASK, &none, nullptr);
+  ::execve(plan.program, plan.argv, plan.envp);
+  fail_in_child(plan.report_fd, "execve");
+}
+
+// One fork; the child's pid once it has executed the program, else its report (the child
+// reaped).
+std::variant<pid_t, ForkReport> fork_once(ForkPlan plan) {
+  int ends[2];
+  if (::pipe2(ends, O_CLOEXEC) != 0) {
+    return ForkReport{errno, "pipe"};
+  }
+  Fd read_end{ends[0]};
+  Fd write_end = copy_above(ends[1], plan.first_closed);
+  ::close(ends[1]);
+  if (!write_end) {
+    return ForkReport{errno, "fcntl"};
+  }
+  plan.report_fd = write_end.get();
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    run_forked(plan);
+  }
+  if (pid < 0) {
+    return ForkReport{errno, "fork"};
+  }
+  write_end.reset();
+  ForkReport report;
+  ssize_t size = 0;
+  do {
+    size = ::read(read_end.get(), &report, sizeof report);
+  } while (size < 0 && errno == EINTR);
+  if (size == 0) {
+    return pid;
+  }
+  while (::waitpid(pid, nullptr, 0) < 0 && errno == EINTR) {
+  }
+  return size == static_cast<ssize_t>(sizeof report) ? report : ForkReport{EIO, "report"};
+}
+
+// start() for a command that changes user.
+Expected<pid_t> start_forked(const Command &command, Group group, int log_fd) {
+  const int above = first_free_number(command);
+  auto inherited = copy_inherited(command);
+  if (!inherited) {
+    return tl::unexpected(std::move(inherited.error()));
+  }
+  const Fd opened_null{::open("/dev/null", O_RDONLY | O_CLOEXEC)};
+  const Fd null = copy_above(opened_null.get(), above);
+  const Fd log = log_fd >= 0 ? copy_above(log_fd, above) : Fd{};
+  if (!null || (log_fd >= 0 && !log)) {
+    return spawn_error(command, fmt::format("cannot prepare to execute {}: {}",
+                                            command.program.string(), errno_text(errno)));
+  }
+  auto arguments = child_arguments(command);
+  auto environment = child_environment(command);
+  auto argv = c_strings(arguments);
+  auto envp = c_strings(environment);
+  const ForkPlan plan{.program = command.program.c_str(),
+                      .argv = argv.data(),
+                      .envp = envp.data(),
+                      .working_dir =
+                          command.working_dir.empty() ? nullptr : command.working_dir.c_str(),
+                      .null_fd = null.get(),
+                      .log_fd = log_fd >= 0 ? log.get() : -1,
+                      .inherited = &*inherited,
+                      .inherit = &command.inherit,
+                      .report_fd = -1,
+                      .first_closed = above,
+                      .group = group,
+                      .user = command.user ? &*command.user : nullptr};
+  auto forked = fork_once(plan);
+  // ETXTBSY: as in start().
+  for (int delay_ms = 1; std::holds_alternative<ForkReport>(forked) &&
+                         std::get<ForkReport>(forked).error == ETXTBSY && delay_ms <= 64;
+       delay_ms *= 2) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(delay_ms));
+    forked = fork_once(plan);
+  }
+  if (const auto *report = std::get_if<ForkReport>(&forked)) {
+    const std::string step(report->step, ::strnlen(report->step, sizeof report->step));
+    return spawn_error(command,
+                       fmt::format("cannot execute {} as user {}: {}: {}", command.program.string(),
+                                   command.user ? command.user->user : "", step,
+                                   errno_text(report->error)));
+  }
+  return std::get<pid_t>(forked);
+}
+
 // A child that cannot be watched is not kept: it is killed, with its group if it leads one, and
 // reaped.
 void kill_and_reap(pid_t pid, Group group) {
@@ -300,7 +514,8 @@ Expected<Child> spawn(const Command &command, Group group) {
   if (!log) {
     return tl::unexpected(std::move(log.error()));
   }
-  auto pid = start(command, group, log->get());
+  auto pid =
+      command.user ? start_forked(command, group, log->get()) : start(command, group, log->get());
   if (!pid) {
     return tl::unexpected(std::move(pid.error()));
   }

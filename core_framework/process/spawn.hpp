@@ -14,7 +14,10 @@
 //   across exec, and a blocked one blocked (a daemon started from a shell that ignores SIGINT
 //   would never stop on it). Only glibc's own two signals below SIGRTMIN stay ignored when this
 //   process handles them: no spawn attribute reaches them, and a glibc program handles them itself;
-// - the process group or session the caller asks for.
+// - the process group or session the caller asks for;
+// - the user the caller asks for (Command::user): its groups, group and user set in the child,
+//   in that order and each checked, before it runs the program. posix_spawn cannot do that: such
+//   a child is forked, and does only system calls until it executes the program.
 // It returns the child's pid and a pidfd (readable once the child has exited): reaping is the
 // caller's business, since the GPP reaps whole process groups and `rsca domain up` leaves its
 // daemons running when it exits.
@@ -31,6 +34,7 @@
 #include <sys/types.h>
 
 #include "common/diagnostic.hpp"
+#include "process/credentials.hpp"
 #include "process/fd.hpp"
 
 namespace rsca::process {
@@ -62,6 +66,8 @@ struct Command {
     int as = 3;
   };
   std::vector<Inherited> inherit{};
+  // Who the child runs as (this process must be root); none: this process's user.
+  std::optional<Credentials> user{};
 };
 
 // A started process. Not reaped by its destructor: whoever started it reaps it, or leaves it to

@@ -13,11 +13,13 @@
 
 #include <fcntl.h>
 #include <signal.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <catch2/catch.hpp>
+#include <fmt/format.h>
 
 #include "process/spawn.hpp"
 #include "temp_dir.hpp"
@@ -249,4 +251,97 @@ TEST_CASE("an exec that fails is an error naming the program, and leaves no chil
         "invalid environment variable name \"\"");
   CHECK(error_of({.program = "/bin/true", .log_file = dir.path() / "garbage" / "x.log"})
             .rfind("cannot create the directory of log file", 0) == 0);
+}
+
+namespace {
+
+// The credentials of `user`, which must exist on the test host (nobody does on Debian).
+rsca::process::Credentials user_named(const std::string &user) {
+  auto credentials = rsca::process::credentials_of(user);
+  REQUIRE(credentials.has_value());
+  return *credentials;
+}
+
+// For its scope, this process's soft limit of descriptors at `limit`.
+class DescriptorLimit {
+public:
+  explicit DescriptorLimit(rlim_t limit) {
+    REQUIRE(::getrlimit(RLIMIT_NOFILE, &saved_) == 0);
+    rlimit lowered = saved_;
+    lowered.rlim_cur = limit;
+    REQUIRE(::setrlimit(RLIMIT_NOFILE, &lowered) == 0);
+  }
+  ~DescriptorLimit() { ::setrlimit(RLIMIT_NOFILE, &saved_); }
+  DescriptorLimit(const DescriptorLimit &) = delete;
+  DescriptorLimit &operator=(const DescriptorLimit &) = delete;
+
+private:
+  rlimit saved_{};
+};
+
+} // namespace
+
+TEST_CASE("a child given a user runs as that user, with its groups and nothing else of this "
+          "process's",
+          "[spawn]") {
+  INFO("only root may start a process as another user: the tests run as root");
+  REQUIRE(::geteuid() == 0);
+  TempDir dir;
+  fs::permissions(dir.path(), fs::perms::all); // the user writes nothing here, but may enter
+  const auto nobody = user_named("nobody");
+  const CarelessSignals careless;
+  const int leaky = ::open("/dev/null", O_RDONLY);
+  REQUIRE(leaky >= 0);
+  const auto status = output_of(dir, {.program = "/bin/cat",
+                                      .args = {"/proc/self/status"},
+                                      .working_dir = dir.path(),
+                                      .user = nobody});
+  const auto uid = std::to_string(nobody.uid);
+  const auto gid = std::to_string(nobody.gid);
+  CHECK(status_field(status, "Uid") == fmt::format("{0}\t{0}\t{0}\t{0}", uid));
+  CHECK(status_field(status, "Gid") == fmt::format("{0}\t{0}\t{0}\t{0}", gid));
+  // nobody's only group, root's gone ("Groups:" ends with a blank).
+  CHECK(status_field(status, "Groups") == gid + " ");
+  CHECK(status_field(status, "CapEff") == "0000000000000000");
+  CHECK(signals_in(status_field(status, "SigIgn")).empty());
+  CHECK(signals_in(status_field(status, "SigBlk")).empty());
+  // Its descriptors are a spawned child's: stdin, its log, the one it is given.
+  const auto listed = output_of(
+      dir,
+      {.program = "/bin/ls", .args = {"/proc/self/fd"}, .inherit = {{leaky, 5}}, .user = nobody});
+  ::close(leaky);
+  CHECK(listed == "0\n1\n2\n3\n5\n");
+  auto group = start({.program = "/bin/sleep", .args = {"30"}, .user = nobody});
+  CHECK(::getpgid(group.pid) == group.pid);
+  ::kill(group.pid, SIGKILL);
+  REQUIRE(::waitpid(group.pid, nullptr, 0) == group.pid);
+}
+
+TEST_CASE("a child that cannot take its user's working directory is an error naming the step, "
+          "and leaves no child",
+          "[spawn]") {
+  INFO("only root may start a process as another user: the tests run as root");
+  REQUIRE(::geteuid() == 0);
+  TempDir dir; // mkdtemp's 0700: nobody may not enter it
+  auto child = rsca::process::spawn(
+      {.program = "/bin/true", .working_dir = dir.path(), .user = user_named("nobody")},
+      Group::Own);
+  REQUIRE_FALSE(child.has_value());
+  CHECK(child.error().diagnostics().front().message ==
+        "cannot execute /bin/true as user nobody: chdir: permission denied");
+  CHECK(::waitpid(-1, nullptr, WNOHANG) == -1);
+}
+
+TEST_CASE("a process under a limit of 64 descriptors hands a child its descriptors", "[spawn]") {
+  TempDir dir;
+  const int given = ::open("/dev/null", O_RDONLY | O_CLOEXEC);
+  REQUIRE(given >= 0);
+  std::string listed;
+  {
+    const DescriptorLimit limit(64);
+    listed =
+        output_of(dir, {.program = "/bin/ls", .args = {"/proc/self/fd"}, .inherit = {{given, 4}}});
+  }
+  ::close(given);
+  CHECK(listed == "0\n1\n2\n3\n4\n");
 }
