@@ -22,14 +22,21 @@ set(CPACK_DEBIAN_RUNTIME_PACKAGE_RECOMMENDS "graphviz") # rsca show --graph svg
 set(CPACK_COMPONENT_RUNTIME_DESCRIPTION
     "rsca's domain and node daemons, its CLI, the component host and runtime, the schemas and the default profiles")
 
+# postinst creates the user rsca, whom the nodes run component processes as.
+if(CPACK_DEBIAN_RUNTIME_PACKAGE_DEPENDS)
+  string(APPEND CPACK_DEBIAN_RUNTIME_PACKAGE_DEPENDS ", adduser")
+else()
+  set(CPACK_DEBIAN_RUNTIME_PACKAGE_DEPENDS "adduser")
+endif()
 set(CPACK_DEBIAN_DEV_PACKAGE_NAME rsca-dev)
 set(CPACK_DEBIAN_DEV_PACKAGE_DEPENDS
     "rsca (= ${PROJECT_VERSION}), libexpected-dev, libfmt-dev, libspdlog-dev, nlohmann-json3-dev, cyclonedds-dev")
 set(CPACK_COMPONENT_DEV_DESCRIPTION
     "rsca's component SDK: headers, find_package(rsca) with rsca_add_component, pkg-config")
 
-# The maintainer scripts (cmake/debian/): systemd reloads its units when the package installs,
-# upgrades or goes, and the daemons stop before their programs are removed; no unit is enabled
+# The maintainer scripts (cmake/debian/): the user rsca is made, systemd reloads its units when
+# the package installs, upgrades or goes, and the daemons stop before their programs are
+# removed; no unit is enabled
 # (README, "Install"). Each package has its copyright file where Debian looks for it.
 set(rsca_debian ${CMAKE_CURRENT_LIST_DIR}/debian)
 set(CPACK_DEBIAN_RUNTIME_PACKAGE_CONTROL_EXTRA

@@ -142,11 +142,17 @@ CallResult<void> FileManager::add_code(const profile::ResolvedSoftPkg &softpkg,
   if (code.file.name.empty())
     return {};
   if (fs::path(code.file.name).is_absolute())
-    return {}; // installed on the node itself, as REDHAWK allows: nothing to deliver
+    return fail(Status::BadRequest,
+                fmt::format("{}: code file {} is an absolute path: a node runs only code the "
+                            "domain delivers; put it beside the SPD or in the domain's exec path",
+                            softpkg.spd_path.string(), code.file.name));
   const fs::path spd_dir = softpkg.spd_path.parent_path();
   const std::string path = package_path(spd_dir / code.file.name);
   if (path.empty())
     return fail(Status::BadRequest,
+  // REDHAWK allows code installed on the node itself; a node runs only code of its package
+  // (gpp/gpp_device.cpp), the control plane not being authenticated: refused here, before any
+  // node is asked.
                 fmt::format("{}: code file {} lies outside the application's folder",
                             softpkg.spd_path.string(), code.file.name));
   auto found = find_code(spd_dir, code.file.name);

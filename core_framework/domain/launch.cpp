@@ -419,7 +419,7 @@ ApplicationFactory::Launch::host_request(const ComponentInstance &first) const {
           affinity ? fmt::format("ComponentHost_{}_{}", first.device, first.id)
                    : fmt::format("ComponentHost_{}", first.device),
           first.device,
-          "rsca-component-host",
+          std::string(protocol::node::kComponentHostProgram),
           "",
           {},
           std::nullopt,

@@ -52,6 +52,25 @@ std::optional<control::CallError> budget_spent(const op::ExecuteRequest &request
                                                          *request.budget_ms, before)};
 }
 
+// Why the node refuses an execute before it fetches anything, if it does. The control plane is
+// not authenticated: any peer may send one. The application and component become the log's
+// path (LOG_DIR/APPLICATION/COMPONENT.log): each must be a name. And the process runs from a
+// package the domain delivered (the device runs only its executables): without one there is
+// nothing the node may run.
+std::optional<control::CallError> refusal(const op::ExecuteRequest &request) {
+  for (const auto &[what, name] : {std::pair{"the application", &request.application},
+                                   std::pair{"the component", &request.component}})
+    if (auto ok = check_name(what, *name); !ok)
+      return control::CallError{Status::BadRequest, ok.error().diagnostics().front().message};
+  if (!request.package)
+    return control::CallError{
+        Status::BadRequest,
+        fmt::format("{}/{}: a process without a package: a node runs only code its domain "
+                    "delivered",
+                    request.application, request.component)};
+  return std::nullopt;
+}
+
 // The DCD's property values for one device, keyed by property id and by name.
 Json overrides_of(const profile::ComponentInstantiation &ci, const profile::ResolvedSoftPkg &pkg) {
   Json out = Json::object();
@@ -282,22 +301,22 @@ DeviceManager::Impl::execute(const op::ExecuteRequest &request,
                                                              dcd->name, request.device));
   if (request.launch && request.launch->size() > protocol::file::kMaxLaunchLength)
     return control::call_error(Status::BadRequest, "launch: an id too long");
+  if (auto refused = refusal(request)) {
+    spdlog::warn("node.execute refused: {}", excerpt(refused->message, 4 * kExcerptLength));
+    return tl::unexpected(*refused);
+  }
   if (auto spent = budget_spent(request, context, "the node took it up"))
     return tl::unexpected(*spent);
-  std::shared_ptr<const PackageLease> package;
-  if (request.package) {
-    auto acquired = cache->acquire(*request.package, request.launch.value_or(""));
-    if (!acquired) {
-      spdlog::warn("{}/{} not started: its package: {}", request.application, request.component,
-                   acquired.error().message);
-      return control::call_error(acquired.error().status,
-                                 fmt::format("node {}: {}", dcd->name, acquired.error().message));
-    }
-    package = std::move(*acquired);
-    if (auto spent = budget_spent(request, context, "its package was delivered"))
-      return tl::unexpected(*spent);
+  auto package = cache->acquire(*request.package, request.launch.value_or(""));
+  if (!package) {
+    spdlog::warn("{}/{} not started: its package: {}", request.application, request.component,
+                 package.error().message);
+    return control::call_error(package.error().status,
+                               fmt::format("node {}: {}", dcd->name, package.error().message));
   }
-  return device->execute(request, std::move(package));
+  if (auto spent = budget_spent(request, context, "its package was delivered"))
+    return tl::unexpected(*spent);
+  return device->execute(request, std::move(*package));
 }
 
 Expected<void> DeviceManager::Impl::open_cache() {

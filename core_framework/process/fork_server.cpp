@@ -101,7 +101,8 @@ bool may_serve_forks(const std::filesystem::path &program) {
 
 Expected<ForkServer> ForkServer::start(const std::filesystem::path &program,
                                        const std::vector<std::pair<std::string, std::string>> &env,
-                                       std::chrono::milliseconds timeout) {
+                                       std::chrono::milliseconds timeout,
+                                       const std::optional<Credentials> &user) {
   int ends[2];
   if (::socketpair(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0, ends) != 0)
     return fork_error(program, fmt::format("cannot start a fork server of {}: socketpair: {}",
@@ -114,6 +115,7 @@ Expected<ForkServer> ForkServer::start(const std::filesystem::path &program,
   command.args.emplace_back(4096, ' ');
   command.env.emplace_back(kForkServerVariable, std::to_string(kForkServerFd));
   command.inherit.push_back({theirs.get(), kForkServerFd});
+  command.user = user;
   auto child = process::spawn(command, Group::Own);
   if (!child)
     return tl::unexpected(std::move(child.error()));

@@ -11,11 +11,13 @@
 
 #include <chrono>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "common/diagnostic.hpp"
+#include "process/credentials.hpp"
 #include "process/fd.hpp"
 #include "process/spawn.hpp"
 
@@ -29,12 +31,13 @@ bool may_serve_forks(const std::filesystem::path &program);
 class ForkServer {
 public:
   // Starts `program` as a fork server with `env` added to this process's environment (what its
-  // dynamic loader must see, as LD_LIBRARY_PATH), in a process group of its own, and waits at most
-  // `timeout` for it to serve. An error when it cannot start or does not serve in time: nothing
-  // is left running.
+  // dynamic loader must see, as LD_LIBRARY_PATH), in a process group of its own, as `user` (what
+  // it forks runs as that user too; none: this process's), and waits at most `timeout` for it to
+  // serve. An error when it cannot start or does not serve in time: nothing is left running.
   static Expected<ForkServer> start(const std::filesystem::path &program,
                                     const std::vector<std::pair<std::string, std::string>> &env,
-                                    std::chrono::milliseconds timeout);
+                                    std::chrono::milliseconds timeout,
+                                    const std::optional<Credentials> &user = std::nullopt);
 
   ForkServer(ForkServer &&) noexcept = default;
   ForkServer &operator=(ForkServer &&) noexcept;

@@ -25,19 +25,25 @@ struct AffinityDirective {
   }
 };
 
-// Start one process on an executable device: a component, or a component host for several.
+// The one program a node runs by name, with no SPD: rsca's component host, found only in the
+// node's own exec path (its hosted components' code comes in the package).
+inline constexpr std::string_view kComponentHostProgram = "rsca-component-host";
+
+// Start one process on an executable device: a component, or a component host for several. The
+// node runs only an executable of the package (or the component host), inside the package, and
+// checks every name that becomes a path (application, component) itself.
 struct ExecuteRequest {
   std::string application;
   std::string component; // the component's id, or the host's name: names its log
   std::string device;    // the executable device; empty: the node's first
   std::string entrypoint;
-  // Where the SPD is, that a relative entry point is found from. Empty: the entry point is an
-  // rsca program the node has (the component host), found in the node's exec path.
+  // Where the SPD is in the package, that the entry point is found from. Empty: the entry point
+  // is kComponentHostProgram.
   std::string spd_dir;
   std::vector<std::string> args; // the exec parameters (protocol/exec_params.hpp)
   // The files the process needs: the node runs it inside the package, from its cache, with
-  // spd_dir and the paths in args relative to the package. None: an rsca program the node has
-  // installed (the component host), found in the node's exec path.
+  // spd_dir and the paths in args relative to the package. Required: a request without one is
+  // refused (optional in the contract only so that the refusal can say why).
   std::optional<Package> package;
   std::optional<std::string> launch; // the launch it is part of (its progress shows transfers)
   std::optional<AffinityDirective> affinity;

@@ -56,6 +56,8 @@ std::string key_of(const ExecRequest &request) {
   std::string key = fmt::format("{}:{}:{}", status.st_dev, status.st_ino, status.st_size);
   for (const auto &[name, value] : startup_environment(request))
     key += fmt::format("\n{}={}", name, value);
+  // What it forks runs as its server's user: one server per user.
+  key += fmt::format("\nuser {}", request.user ? request.user->uid : ::geteuid());
   return key;
 }
 
@@ -92,8 +94,8 @@ process::ForkServer *ForkServers::server_for(const ExecRequest &request, const s
     serves->second = process::may_serve_forks(request.program);
   if (!serves->second)
     return nullptr;
-  auto started =
-      process::ForkServer::start(request.program, startup_environment(request), kStartTimeout);
+  auto started = process::ForkServer::start(request.program, startup_environment(request),
+                                            kStartTimeout, request.user);
   if (!started) {
     spdlog::warn("{}; its processes are executed", started.error().to_string());
     serves->second = false;
@@ -105,7 +107,8 @@ process::ForkServer *ForkServers::server_for(const ExecRequest &request, const s
     ::sched_setaffinity(started->pid(), sizeof node_cpus, &node_cpus);
   drop_deleted();
   make_room();
-  spdlog::info("fork server of {} started (pid {})", request.program.string(), started->pid());
+  spdlog::info("fork server of {} started (pid {}{})", request.program.string(), started->pid(),
+               request.user ? ", as " + request.user->user : "");
   auto &entry = servers_.emplace(key, Entry{std::move(*started), ++uses_}).first->second;
   return &entry.server;
 }

@@ -1,7 +1,7 @@
 // The GPP's fork servers (process/fork_server.hpp): the first process of an executable built with
 // rsca's runtime starts a fork server of it, and that process and the next are forked from it
 // instead of executed. One server per executable file (not path: two packages with the same
-// verified file share one; a file rewritten is a new file) and library path; at most
+// verified file share one; a file rewritten is a new file), library path and user; at most
 // kMaxServers, the least recently used stopped for a new one, and those whose file was deleted
 // stopped when a new one starts. An executable that does not serve forks, or a server that fails,
 // falls back to process::spawn, said in the node's log.

@@ -12,9 +12,11 @@
 
 #include "affinity.hpp"
 #include "common/exec_environment.hpp"
+#include "common/names.hpp"
 #include "control/link_socket.hpp"
 #include "host_info.hpp"
 #include "protocol/exec_params.hpp"
+#include "run_as.hpp"
 #include "shm/arena.hpp"
 
 namespace rsca::gpp {
@@ -39,8 +41,8 @@ std::optional<Json> override_of(const node::DeviceContext &context, const char *
 
 } // namespace
 
-GppDevice::GppDevice(node::DeviceContext context)
-    : context_(std::move(context)),
+GppDevice::GppDevice(node::DeviceContext context, std::optional<process::Credentials> run_as)
+    : context_(std::move(context)), run_as_(std::move(run_as)),
       launcher_([this](ProcessId pid, ExitStatus status) { on_exit(pid, status); },
                 [this](const ExecRequest &request) { return start_process(request); }) {
   const HostInfo host = read_host_info();
@@ -86,33 +88,46 @@ Expected<process::Child> GppDevice::start_process(const ExecRequest &request) {
 
 Expected<std::unique_ptr<node::LogicalDevice>>
 GppDevice::create(const node::DeviceContext &context) {
-  return std::unique_ptr<node::LogicalDevice>(std::make_unique<GppDevice>(context));
+  auto run_as = component_user(context);
+  if (!run_as)
+    return tl::unexpected(run_as.error());
+  return std::unique_ptr<node::LogicalDevice>(
+      std::make_unique<GppDevice>(context, std::move(*run_as)));
 }
 
-// Where the entrypoint an SPD names is: an absolute path as is; a relative one beside the SPD;
-// else the file of that name in the node's exec path (how a development build is found).
-std::filesystem::path GppDevice::find_executable(const std::string &entrypoint,
-                                                 const std::string &spd_dir) const {
-  const std::filesystem::path ep(entrypoint);
-  if (ep.is_absolute())
-    return ep;
-  if (!spd_dir.empty() && is_executable(std::filesystem::path(spd_dir) / ep))
-    return std::filesystem::path(spd_dir) / ep;
+// rsca's component host in the node's own exec path, by its bare name.
+std::optional<std::filesystem::path> GppDevice::component_host() const {
   for (const auto &dir : context_.exec_path)
-    if (is_executable(dir / ep.filename()))
-      return dir / ep.filename();
-  return std::filesystem::path(spd_dir) / ep;
+    if (is_executable(dir / protocol::node::kComponentHostProgram))
+      return dir / protocol::node::kComponentHostProgram;
+  return std::nullopt;
 }
 
-// The entry point beside the SPD inside the package. An absolute one is on the node itself (as
-// REDHAWK allows), and one without an SPD is an rsca program (the component host): both run
-// inside the package all the same. One that would lie outside the package is refused.
+// The program a request runs: the entry point beside its SPD inside its package (fetched from
+// the domain by content hash and verified: node/package_cache.hpp), or, without an SPD, the
+// component host. Nothing else: an absolute entry point (REDHAWK allows one) or one outside the
+// package would let anyone who can send a request run any program of this host.
 CallResult<std::filesystem::path>
 GppDevice::packaged_executable(const protocol::node::ExecuteRequest &r,
                                const node::PackageLease &package) const {
+  const auto refused = [&](const std::string &why) {
+    return control::call_error(
+        Status::BadRequest,
+        fmt::format("{}: entry point \"{}\" {}", context_.id, excerpt(r.entrypoint), why));
+  };
   const std::filesystem::path ep(r.entrypoint);
-  if (ep.is_absolute() || r.spd_dir.empty())
-    return find_executable(r.entrypoint, "");
+  if (ep.is_absolute())
+    return refused("is absolute: a node runs only the programs of its package");
+  if (r.spd_dir.empty()) {
+    if (r.entrypoint != protocol::node::kComponentHostProgram)
+      return refused(fmt::format("has no SPD: only {} runs without one",
+                                 protocol::node::kComponentHostProgram));
+    if (auto host = component_host())
+      return *host;
+    return control::call_error(Status::Failed,
+                               fmt::format("{}: no {} in its exec path", context_.id,
+                                           protocol::node::kComponentHostProgram));
+  }
   const auto inside = (std::filesystem::path(r.spd_dir) / ep).lexically_normal();
   if (inside.is_absolute() || inside.empty() || *inside.begin() == "..")
     return control::call_error(
@@ -151,23 +166,23 @@ GppDevice::execute(const protocol::node::ExecuteRequest &r,
                                              resolved.error().diagnostics().front().message));
     placement = std::move(*resolved);
   }
+  if (!package) // the node refuses it first (node/device_manager.cpp)
+    return control::call_error(Status::BadRequest, fmt::format("{}: {}/{}: no package", context_.id,
+                                                               application, component));
   ExecRequest request;
-  if (package) {
-    auto program = packaged_executable(r, *package);
-    if (!program)
-      return tl::unexpected(program.error());
-    request.program = std::move(*program);
-    request.working_dir = package->root();
-  } else {
-    request.program = find_executable(r.entrypoint, r.spd_dir);
-  }
+  auto program = packaged_executable(r, *package);
+  if (!program)
+    return tl::unexpected(program.error());
+  request.program = std::move(*program);
+  request.working_dir = package->root();
+  request.user = run_as_;
   request.args = r.args;
   request.env = context_.dds.component_environment();
   // The component dies with this node: it checks that its parent is still this process.
   request.env.emplace_back(kNodePidVariable, std::to_string(::getpid()));
   if (!pins_admitted_cpu())
     request.env.emplace_back(kPinAdmittedVariable, "0");
-  if (package && r.package && !r.package->library_dirs.empty())
+  if (r.package && !r.package->library_dirs.empty())
     request.env.emplace_back("LD_LIBRARY_PATH",
                              library_path(package->root(), r.package->library_dirs));
   request.log_file = context_.log_dir / application / (component + ".log");
@@ -240,8 +255,7 @@ GppDevice::execute(const protocol::node::ExecuteRequest &r,
     owner.component = component;
     owner.addresses = std::move(addresses);
     owners_[*pid] = std::move(owner);
-    if (package)
-      packages_[*pid] = std::move(package);
+    packages_[*pid] = std::move(package);
   }
   // A process that exited before it was recorded above found nothing to report or release: what
   // on_exit would have done is done now (whoever takes the records first does it, once).

@@ -1,13 +1,15 @@
 // The GPP: the ExecutableDevice of a host. Its matching properties (os_name, processor_name, as
 // REDHAWK's GPP names them) and capacities (CPU and memory) come from the host itself, unless the
 // DCD sets them; it executes component processes, each in its own process group with its own
-// log file, and terminates them with bounded escalation.
+// log file, as its run_as user (gpp/run_as.hpp), and terminates them with bounded escalation. It
+// runs only an executable of a package the node took from its cache, or rsca's component host.
 #pragma once
 
 #include <memory>
 
 #include "fork_servers.hpp"
 #include "node/logical_device.hpp"
+#include "process/credentials.hpp"
 #include "process/spawn_thread.hpp"
 #include "process_launcher.hpp"
 
@@ -32,11 +34,11 @@ public:
   terminate(const protocol::node::TerminateRequest &request) override;
   std::vector<protocol::node::ProcessRecord> processes() const override;
 
-  explicit GppDevice(node::DeviceContext context);
+  // `run_as`: whom its processes run as (gpp/run_as.hpp); none: as the node.
+  GppDevice(node::DeviceContext context, std::optional<process::Credentials> run_as);
 
 private:
-  std::filesystem::path find_executable(const std::string &entrypoint,
-                                        const std::string &spd_dir) const;
+  std::optional<std::filesystem::path> component_host() const;
   node::CallResult<std::filesystem::path>
   packaged_executable(const protocol::node::ExecuteRequest &request,
                       const node::PackageLease &package) const;
@@ -47,6 +49,7 @@ private:
   node::DeviceContext context_;
   node::Json properties_;
   node::Json capacity_;
+  std::optional<process::Credentials> run_as_;
   std::mutex mutex_;
   // What each process started is, for the report of its exit: its application, component and
   // the control addresses it serves.

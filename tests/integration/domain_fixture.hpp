@@ -389,4 +389,41 @@ inline long port_connections(TestDomain &domain, const std::string &address,
   return -1;
 }
 
+// A package the domain delivered to node `node` (a manifest of its cache) that holds a file named
+// `program`, and that file's folder in it: what a node.execute of the program names (a node runs
+// only programs of a package it took from its cache).
+inline std::pair<Json, std::string>
+cached_package_of(const TestDomain &domain, const std::string &node, const std::string &program) {
+  const fs::path manifests = domain.run_dir() / "cache" / node / "manifests";
+  for (const auto &entry : fs::directory_iterator(manifests)) {
+    std::ifstream in(entry.path());
+    const Json package = Json::parse(in);
+    for (const auto &file : package.at("files"))
+      if (fs::path(file.at("path").get<std::string>()).filename() == program)
+        return {package, fs::path(file.at("path").get<std::string>()).parent_path().string()};
+  }
+  FAIL("no package of " << program << " in " << manifests);
+  throw std::logic_error("unreachable");
+}
+
+// Node daemon `index` frozen (SIGSTOP), as a hung node is: it answers no call and, past its DDS
+// lease, the domain loses it. Resumed however the test ends, so that the domain can stop it.
+class FrozenNode {
+public:
+  FrozenNode(TestDomain &domain, int index) : pid_(domain.node_pid(index)) {
+    REQUIRE(::kill(pid_, SIGSTOP) == 0);
+  }
+  ~FrozenNode() { resume(); }
+  FrozenNode(const FrozenNode &) = delete;
+  FrozenNode &operator=(const FrozenNode &) = delete;
+  void resume() {
+    if (pid_ > 0)
+      ::kill(pid_, SIGCONT);
+    pid_ = 0;
+  }
+
+private:
+  pid_t pid_;
+};
+
 } // namespace rsca::test

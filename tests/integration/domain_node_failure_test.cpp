@@ -31,6 +31,14 @@ struct KilledDuringLaunch {
   std::vector<long> pids; // the components node1 ran
 };
 
+// The package of rsca-test-faulty that node1 took from its cache for Healthy (launched, then
+// released): a node runs only programs of a package its domain delivered.
+std::pair<Json, std::string> delivered_faulty(TestDomain &domain) {
+  domain.create("Healthy");
+  REQUIRE(domain.call("app.release", Json{{"app", "Healthy"}}).has_value());
+  return cached_package_of(domain, "node1", "rsca-test-faulty");
+}
+
 // Launches HangAtConfigure with the CLI going through `socket` (node1's or node2's); both
 // components land on node1 (first fit), the launch hangs in configure, and node1 is killed.
 KilledDuringLaunch kill_node1_during_launch(TestDomain &domain, const std::string &socket) {
@@ -210,6 +218,7 @@ TEST_CASE("a node does not start a process whose caller has stopped waiting, and
   auto nodes = domain.call("domain.nodes");
   REQUIRE(nodes.has_value());
   const std::string node = nodes->at("nodes")[0].at("address");
+  const auto [package, spd_dir] = delivered_faulty(domain);
   // A process that waits for its signal (and marks it in a file of this test's).
   const fs::path marker = fs::temp_directory_path() / fmt::format("rsca-it-budget-{}", ::getpid());
   auto execute = [&](std::int64_t budget_ms) {
@@ -218,7 +227,8 @@ TEST_CASE("a node does not start a process whose caller has stopped waiting, and
         Json{{"application", "Budget"},
              {"component", fmt::format("Late_{}", budget_ms)},
              {"entrypoint", "rsca-test-faulty"},
-             {"spd_dir", ""},
+             {"spd_dir", spd_dir},
+             {"package", package},
              {"args", {"fault", "mark_signals", "marker", marker.string(), "on_signal", "exit"}},
              {"budget_ms", budget_ms}},
         5s);
@@ -275,6 +285,7 @@ TEST_CASE("a node daemon stopped after or while it ends a process exits cleanly,
     if (d.at("kind") == "gpp")
       gpp = d.at("id");
   REQUIRE_FALSE(gpp.empty());
+  const auto [package, spd_dir] = delivered_faulty(domain);
   const fs::path marker =
       fs::temp_directory_path() / fmt::format("rsca-it-signalled-{}", ::getpid());
   fs::remove(marker);
@@ -285,7 +296,8 @@ TEST_CASE("a node daemon stopped after or while it ends a process exits cleanly,
                                      {"component", "Stubborn_1"},
                                      {"device", gpp},
                                      {"entrypoint", "rsca-test-faulty"},
-                                     {"spd_dir", ""},
+                                     {"spd_dir", spd_dir},
+                                     {"package", package},
                                      {"args",
                                       {"fault", "mark_signals", "marker", marker.string(),
                                        "on_signal", stubborn ? "ignore" : "exit"}}},

@@ -47,26 +47,6 @@ std::string line_starting(const std::string &text, const std::string &prefix) {
   return {};
 }
 
-// Node daemon `index` frozen (SIGSTOP), as a hung node is: it answers no call and, past its DDS
-// lease, the domain loses it. Resumed however the test ends, so that the domain can stop it.
-class FrozenNode {
-public:
-  FrozenNode(TestDomain &domain, int index) : pid_(domain.node_pid(index)) {
-    REQUIRE(::kill(pid_, SIGSTOP) == 0);
-  }
-  ~FrozenNode() { resume(); }
-  FrozenNode(const FrozenNode &) = delete;
-  FrozenNode &operator=(const FrozenNode &) = delete;
-  void resume() {
-    if (pid_ > 0)
-      ::kill(pid_, SIGCONT);
-    pid_ = 0;
-  }
-
-private:
-  pid_t pid_;
-};
-
 void check_sane(const Json &row) {
   INFO(row.dump());
   CHECK(row.at("pid").get<long>() > 0);

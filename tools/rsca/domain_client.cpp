@@ -1,5 +1,7 @@
 #include "domain_client.hpp"
 
+#include <grp.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -63,10 +65,38 @@ std::string own_address(const GlobalOptions &global) {
 // goes on to the next node, or to DDS, instead of waiting out its call.
 constexpr std::chrono::milliseconds kNodeHelloTimeout{1000};
 
-// A link to the first node socket that accepts one and whose node answers.
-std::optional<DomainClient::Link> link_to_a_node(const std::string &address) {
+// The name of group `gid`, else its number.
+std::string group_name(gid_t gid) {
+  std::vector<char> buffer(4096);
+  group entry{};
+  group *found = nullptr;
+  if (::getgrgid_r(gid, &entry, buffer.data(), buffer.size(), &found) == 0 && found != nullptr)
+    return entry.gr_name;
+  return std::to_string(gid);
+}
+
+// A node socket that is there but this user may not open: an error saying what to do. Going
+// over DDS instead would make the socket's mode protect nothing.
+Expected<void> check_may_open(const fs::path &path) {
+  if (::access(path.c_str(), R_OK | W_OK) == 0 || errno != EACCES)
+    return {};
+  struct stat status {};
+  const std::string group = ::stat(path.c_str(), &status) == 0 ? group_name(status.st_gid) : "?";
+  return make_error({path.string(), 0, 0}, "node socket",
+                    fmt::format("this user (uid {}) may not open the node's socket {}: permission "
+                                "denied; run rsca as root, or as a member of the socket's group "
+                                "{}",
+                                ::getuid(), path.string(), group));
+}
+
+// A link to the first node socket that accepts one and whose node answers; none when no socket
+// is there, or none answers (the CLI then goes over DDS); an error for a socket this user may
+// not open.
+Expected<std::optional<DomainClient::Link>> link_to_a_node(const std::string &address) {
   namespace link = protocol::link;
   for (const auto &path : node_sockets()) {
+    if (auto allowed = check_may_open(path); !allowed)
+      return tl::unexpected(allowed.error());
     auto fd = control::connect_link(path.string());
     if (!fd) {
       spdlog::debug("node socket {}: {}", path.string(), fd.error());
@@ -84,7 +114,7 @@ std::optional<DomainClient::Link> link_to_a_node(const std::string &address) {
     }
     return DomainClient::Link{std::move(*opened), path.string()};
   }
-  return std::nullopt;
+  return std::optional<DomainClient::Link>{};
 }
 
 } // namespace
@@ -93,9 +123,12 @@ Expected<DomainClient> DomainClient::connect(const GlobalOptions &global) {
   const std::string address = own_address(global);
   DomainClient client;
   client.domain_ = global.domain;
-  if (auto link = link_to_a_node(address)) {
-    client.server_ = std::move(link->server);
-    client.socket_ = std::move(link->socket);
+  auto link = link_to_a_node(address);
+  if (!link)
+    return tl::unexpected(link.error());
+  if (*link) {
+    client.server_ = std::move((*link)->server);
+    client.socket_ = std::move((*link)->socket);
     return client;
   }
   auto settings = dds::DdsSettings::from_environment();
