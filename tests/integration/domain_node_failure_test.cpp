@@ -28,8 +28,20 @@ namespace {
 struct KilledDuringLaunch {
   int rc = 0;
   std::string out;
-  std::vector<long> pids; // the components node1 ran
+  std::vector<long> pids; // the components both nodes ran
+  long survivor_pid = 0;  // the one on node2, which the roll-back must end
 };
+
+// The pids of the component processes node `index` runs.
+std::vector<long> pids_on_node(TestDomain &domain, int index) {
+  auto status = domain.client().call_sync(fmt::format("rsca/node/node{}", index), "node.status",
+                                          Json::object(), 5s);
+  REQUIRE(status.has_value());
+  std::vector<long> pids;
+  for (const auto &p : status->at("processes"))
+    pids.push_back(p.at("pid").get<long>());
+  return pids;
+}
 
 // The package of rsca-test-faulty that node1 took from its cache for Healthy (launched, then
 // released): a node runs only programs of a package its domain delivered.
@@ -39,17 +51,21 @@ std::pair<Json, std::string> delivered_faulty(TestDomain &domain) {
   return cached_package_of(domain, "node1", "rsca-test-faulty");
 }
 
-// Launches HangAtConfigure with the CLI going through `socket` (node1's or node2's); both
-// components land on node1 (first fit), the launch hangs in configure, and node1 is killed.
+// Launches HangAtConfigure with the CLI going through `socket` (node1's or node2's): Victim_1 on
+// node1, Producer_1 on node2; the launch hangs in configure, and node1 is killed.
 KilledDuringLaunch kill_node1_during_launch(TestDomain &domain, const std::string &socket) {
   domain.install("HangAtConfigure");
   auto launch = std::async(std::launch::async, [&] {
-    return domain.cli({"launch", "HangAtConfigure"},
+    return domain.cli({"launch", "HangAtConfigure", "--assign", "Victim_1=node1:GPP_1", "--assign",
+                       "Producer_1=node2:GPP_1"},
                       {{"RSCA_NODE_SOCKET", (domain.run_dir() / socket).string()}});
   });
   REQUIRE(TestDomain::wait_for([&] { return domain.running_pids().size() == 2; }));
   KilledDuringLaunch killed;
   killed.pids = domain.running_pids();
+  const auto on_node2 = pids_on_node(domain, 2);
+  REQUIRE(on_node2.size() == 1);
+  killed.survivor_pid = on_node2.front();
   domain.kill_node(1);
   std::tie(killed.rc, killed.out) = launch.get();
   return killed;
@@ -66,8 +82,11 @@ TEST_CASE("a node daemon killed during a launch fails it, and the rest is rolled
   INFO(killed.out);
   CHECK(killed.rc != 0);
   CHECK_THAT(killed.out, Catch::Contains("failed at step"));
-  // The node's components die with it; nothing stays allocated; the domain forgot node1.
+  // The node's components die with it, the roll-back ends the one on node2; nothing stays
+  // allocated; the domain forgot node1.
   domain.require_clean(killed.pids);
+  CHECK_FALSE(process_exists(killed.survivor_pid));
+  CHECK(pids_on_node(domain, 2).empty());
   auto nodes = domain.call("domain.nodes");
   REQUIRE(nodes.has_value());
   CHECK(nodes->at("nodes").size() == 1);
@@ -374,4 +393,28 @@ TEST_CASE("a node daemon restarted within its lease is taken for a new run: its 
   // The release frees what is left; require_clean checks nothing stays reserved anywhere.
   REQUIRE(domain.call("app.release", Json{{"app", "Healthy"}}).has_value());
   domain.require_clean(pids_of(app));
+}
+
+TEST_CASE("a release while a node is lost says its processes there end when the node is back, "
+          "and they do then",
+          "[integration][domain]") {
+  TestDomain domain(2);
+  const Json app = domain.create("Healthy"); // first fit: every component on node1
+  const auto pids = pids_of(app);
+  for (const auto &c : app.at("components"))
+    REQUIRE(c.at("node") == "node1");
+  FrozenNode frozen(domain, 1);
+  REQUIRE(TestDomain::wait_for([&] {
+    auto nodes = domain.call("domain.nodes");
+    return nodes && nodes->at("lost").size() == 1;
+  }));
+  auto [rc, out] = domain.cli({"release", "Healthy"});
+  INFO(out);
+  CHECK(rc == 0);
+  CHECK_THAT(out, Catch::Contains("to be ended when its node node1 is back"));
+  CHECK_THAT(out, !Catch::Contains("terminated by its node"));
+  for (const long pid : pids)
+    CHECK(process_exists(pid)); // the node, frozen, ended none of them
+  frozen.resume();
+  domain.require_clean(pids);
 }

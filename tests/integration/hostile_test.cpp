@@ -3,6 +3,7 @@
 #include <csignal>
 #include <future>
 
+#include "dds/dds_settings.hpp"
 #include "domain_fixture.hpp"
 #include "profile/profile_loader.hpp"
 
@@ -286,7 +287,11 @@ TEST_CASE("a launch whose domain daemon dies says so within a lease, not after i
     return orphans.size() == 2; // executed: the launch waits for Victim_1 to register
   }));
   domain.kill_domaind();
-  REQUIRE(launch.wait_for(60s) == std::future_status::ready);
+  // Within a few leases of the daemons' participants (the CLI's own settings, read as it reads
+  // them; 1 s), room left for a loaded host: far below a call's timeout (100 s) or the launch's
+  // whole wait (10 min), either of which a CLI that missed the domain's death would wait out.
+  const auto lease = rsca::dds::DdsSettings::from_environment().timing.lease;
+  REQUIRE(launch.wait_for(10 * lease) == std::future_status::ready);
   auto [rc, out] = launch.get();
   INFO(out);
   CHECK(rc == 4); // unreachable

@@ -267,8 +267,17 @@ TEST_CASE("a hung node's socket still accepts, the CLI finds it silent and goes 
           "[integration][node-agent]") {
   TestDomain domain(2);
   ::kill(domain.node_pid(1), SIGSTOP); // the kernel still accepts on its socket
-  auto [rc, out] = domain.cli({"--json", "--timeout-ms", "5000", "ls", "nodes"});
+  // The CLI's own DDS finds no domain (a discovery tag nobody uses): it can be answered only
+  // through a node's socket, and node1's (tried first) is silent, so only through node2's.
+  auto [rc, out] = domain.cli({"--json", "--timeout-ms", "5000", "ls", "nodes"},
+                              {{"RSCA_DDS_TAG", "nobody-" + std::to_string(::getpid())}});
   ::kill(domain.node_pid(1), SIGCONT);
   INFO(out);
-  CHECK(rc == 0); // through node2, not a timeout waiting on node1
+  REQUIRE(rc == 0); // through node2, not a timeout waiting on node1
+  const auto listed = Json::parse(out, nullptr, false);
+  REQUIRE(listed.is_object());
+  std::set<std::string> names;
+  for (const auto &node : listed.at("nodes"))
+    names.insert(node.at("name").get<std::string>());
+  CHECK(names.count("node2") == 1);
 }

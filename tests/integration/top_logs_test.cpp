@@ -6,6 +6,7 @@
 #include <fstream>
 #include <iterator>
 #include <sstream>
+#include <tuple>
 
 #include "domain_fixture.hpp"
 
@@ -62,12 +63,15 @@ void check_since(TestDomain &domain, const std::string &target, const std::strin
   INFO(out);
   CHECK(rc == 0);
   CHECK(out.find(line) != std::string::npos);
+  // Only an answer counts: a failed command prints no line either.
+  int recent_rc = -1;
   std::string recent;
   CHECK(TestDomain::wait_for([&] {
-    recent = domain.cli({"logs", target, "--since", "0s"}).second;
-    return recent.find(line) == std::string::npos;
+    std::tie(recent_rc, recent) = domain.cli({"logs", target, "--since", "0s"});
+    return recent_rc == 0 && recent.find(line) == std::string::npos;
   }));
   INFO(recent);
+  CHECK(recent_rc == 0);
 }
 
 } // namespace
