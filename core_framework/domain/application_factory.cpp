@@ -106,15 +106,13 @@ std::size_t ApplicationFactory::disconnect_devices(const Application &app) {
   return ends.size();
 }
 
-CallResult<std::vector<std::string>> ApplicationFactory::release(Application &app) {
+CallResult<ApplicationFactory::ProcessesReleased> ApplicationFactory::release(Application &app) {
   disconnect_devices(app);
   auto released = release_processes(app);
   services_.allocator->release(app.plan);
   app.plan = {};
   services_.channels->leave(app.name);
-  if (!released)
-    return tl::unexpected(released.error());
-  return std::move(released->unconfirmed);
+  return released;
 }
 
 CallResult<ApplicationFactory::ProcessesReleased>
@@ -134,6 +132,7 @@ ApplicationFactory::release_processes(Application &app) {
   }
   // Whatever is still running is terminated by its node; the node reaps every process. One its
   // node cannot be asked to end now (the node is lost) is ended when the node is back.
+  std::set<long> deferred_pids;
   const auto end_later = [&](const ComponentInstance &c) {
     if (!services_.end_when_back)
       return;
@@ -141,6 +140,7 @@ ApplicationFactory::release_processes(Application &app) {
                  c.pid, c.id, c.node);
     services_.end_when_back(c.node, c.pid, fmt::format("{}/{}", app.name, c.id));
     ++outcome.deferred;
+    deferred_pids.insert(c.pid);
   };
   std::vector<Call> terminations;
   std::vector<const ComponentInstance *> terminated_of; // per termination
@@ -172,6 +172,12 @@ ApplicationFactory::release_processes(Application &app) {
       failure = control::CallError{
           status, fmt::format("{}: {}", terminations[i].what, terminated[i].error().message)};
   }
+  // Those of a process left running for now were not terminated by their node: said as they are.
+  for (const auto &c : app.components)
+    if (deferred_pids.count(c.pid) != 0) {
+      outcome.lost.push_back({c.id, c.node});
+      std::erase(outcome.unconfirmed, c.id);
+    }
   for (auto &c : app.components) {
     services_.components->forget(c.address);
     services_.endpoint->forget(c.address);

@@ -93,23 +93,24 @@ public:
   using ApplyChange = std::function<void(const std::function<void(Application &)> &change)>;
   control::CallResult<void> start(const Application &app, const ApplyChange &apply);
   control::CallResult<void> stop(const Application &app, const ApplyChange &apply);
+  // What releasing an application's processes left: components that did not confirm their
+  // release (their node terminated them), and processes left to end when their node is back.
+  struct ProcessesReleased {
+    std::vector<std::string> unconfirmed; // not those whose node is lost
+    std::size_t terminated = 0;
+    std::size_t deferred = 0;
+    std::vector<protocol::application::LostComponent> lost; // the components of those deferred
+  };
   // Stops, releases and terminates every component, and frees the allocation. Best effort: a
   // component that does not confirm its release is terminated by its node all the same, and
-  // named in the result.
-  control::CallResult<std::vector<std::string>> release(Application &app);
+  // named in the result; one whose node is lost is ended when the node is back.
+  control::CallResult<ProcessesReleased> release(Application &app);
 
 private:
   class Launch;
   // The undoable parts of a release, which a failed launch also runs (its saga): the devices'
   // ends of the application's connections (how many), and its processes.
   std::size_t disconnect_devices(const Application &app);
-  // What releasing an application's processes left: components that did not confirm their
-  // release (their node terminated them), and processes left to end when their node is back.
-  struct ProcessesReleased {
-    std::vector<std::string> unconfirmed;
-    std::size_t terminated = 0;
-    std::size_t deferred = 0;
-  };
   control::CallResult<ProcessesReleased> release_processes(Application &app);
   DomainServices services_;
 };

@@ -268,14 +268,17 @@ CallResult<app_ops::ReleaseReply> DomainManager::Impl::release(const app_ops::Ap
   runtime_connections->owner_gone([&name](const PortRef &ref) {
     return ref.kind != PortRef::Kind::Device && ref.owner == name;
   });
-  auto unconfirmed = factory().release(*removed->app);
+  auto released = factory().release(*removed->app);
   spdlog::info("application {} released", name);
   events->publish("application.released", {{"application", name}});
-  if (!unconfirmed)
+  if (!released)
     return control::call_error(
-        unconfirmed.error().status,
-        fmt::format("released {} with problems: {}", name, unconfirmed.error().message));
-  return app_ops::ReleaseReply{name, std::move(*unconfirmed)};
+        released.error().status,
+        fmt::format("released {} with problems: {}", name, released.error().message));
+  app_ops::ReleaseReply reply{name, std::move(released->unconfirmed), std::nullopt};
+  if (!released->lost.empty())
+    reply.to_end_later = std::move(released->lost);
+  return reply;
 }
 
 // Start and stop of one application are serialized (its lifecycle lock) and work from a copy;

@@ -242,10 +242,25 @@ struct AppRequest {
 
 struct ReleaseReply {
   std::string name;
+// A component of a released application whose node is lost: its process could not be ended,
+// and is ended when its node is back.
+struct LostComponent {
+  std::string component;
+  std::string node;
+  static constexpr auto fields() {
+    return std::tuple{required("component", &LostComponent::component),
+                      required("node", &LostComponent::node)};
+  }
+};
+
   std::vector<std::string> unconfirmed; // components its node terminated
   static constexpr auto fields() {
     return std::tuple{required("name", &ReleaseReply::name),
-                      required("unconfirmed", &ReleaseReply::unconfirmed)};
+  // Components whose node is lost: to be ended when it is back. Absent when there are none: a
+  // CLI of an earlier version, which refuses a field it does not know, still reads the reply.
+  std::optional<std::vector<LostComponent>> to_end_later;
+                      required("unconfirmed", &ReleaseReply::unconfirmed),
+                      optional("to_end_later", &ReleaseReply::to_end_later)};
   }
 };
 

@@ -403,6 +403,10 @@ void add_lifecycle_commands(CLI::App &app, const GlobalOptions &global, int &exi
           fmt::print("  {} did not confirm its release and was terminated by its node\n", id);
       });
 }
+        for (const auto &lost : r.to_end_later.value_or(std::vector<app_ops::LostComponent>{}))
+          fmt::print("  {} could not be ended: its node {} is lost; to be ended when its node {} "
+                     "is back\n",
+                     lost.component, lost.node, lost.node);
 int show_application(const std::string &name, const GlobalOptions &global) {
   return simple_call<app_ops::Show>(
       "show", {name}, global, [](const app_ops::ApplicationView &app) {
