@@ -394,3 +394,27 @@ TEST_CASE("a node daemon restarted within its lease is taken for a new run: its 
   REQUIRE(domain.call("app.release", Json{{"app", "Healthy"}}).has_value());
   domain.require_clean(pids_of(app));
 }
+
+TEST_CASE("a release while a node is lost says its processes there end when the node is back, "
+          "and they do then",
+          "[integration][domain]") {
+  TestDomain domain(2);
+  const Json app = domain.create("Healthy"); // first fit: every component on node1
+  const auto pids = pids_of(app);
+  for (const auto &c : app.at("components"))
+    REQUIRE(c.at("node") == "node1");
+  FrozenNode frozen(domain, 1);
+  REQUIRE(TestDomain::wait_for([&] {
+    auto nodes = domain.call("domain.nodes");
+    return nodes && nodes->at("lost").size() == 1;
+  }));
+  auto [rc, out] = domain.cli({"release", "Healthy"});
+  INFO(out);
+  CHECK(rc == 0);
+  CHECK_THAT(out, Catch::Contains("to be ended when its node node1 is back"));
+  CHECK_THAT(out, !Catch::Contains("terminated by its node"));
+  for (const long pid : pids)
+    CHECK(process_exists(pid)); // the node, frozen, ended none of them
+  frozen.resume();
+  domain.require_clean(pids);
+}
