@@ -7,6 +7,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <set>
+#include <string_view>
 
 #include <fmt/format.h>
 
@@ -128,6 +130,19 @@ void commit(DomainState &state, const Plan &plan) {
 
 void release(DomainState &state, const Plan &plan) {
   apply_plan(state, plan, -1);
+}
+
+std::optional<std::string>
+unknown_assignment(const profile::ResolvedApplication &application,
+                   const std::map<std::string, std::string> &assignments) {
+  std::set<std::string_view> ids;
+  for (const auto &placement : application.sad->placements)
+    for (const auto &ci : placement.instantiations)
+      ids.insert(ci.id);
+  for (const auto &[id, device] : assignments)
+    if (!ids.contains(id))
+      return id;
+  return std::nullopt;
 }
 
 PlanRequest plan_request_of(const profile::ResolvedApplication &application,

@@ -151,5 +151,10 @@ void release(DomainState &state, const Plan &plan);
 // devicerequires; connections as affinities; `assignments` are explicit devices by instance.
 PlanRequest plan_request_of(const profile::ResolvedApplication &application,
                             const std::map<std::string, std::string> &assignments = {});
+// The first of `assignments` that names no instantiation of `application`: such an entry would be
+// ignored, and a request of half a million of them was kept whole (issue 37, defect 8).
+std::optional<std::string>
+unknown_assignment(const profile::ResolvedApplication &application,
+                   const std::map<std::string, std::string> &assignments);
 
 } // namespace rsca::allocator

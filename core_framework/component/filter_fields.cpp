@@ -2,6 +2,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "protocol/json_text.hpp"
+
 namespace rsca::component::detail {
 
 namespace {
@@ -41,7 +43,8 @@ std::optional<FilterValue> field_of(const port::PropertyEvent &e, std::string_vi
     return e.source;
   if (field == "timestamp_ns")
     return static_cast<double>(e.timestamp_ns);
-  const auto value = nlohmann::json::parse(e.value, nullptr, false);
+  const auto value =
+      protocol::parse_json(e.value).value_or(nlohmann::json(nlohmann::json::value_t::discarded));
   if (value.is_discarded())
     return std::nullopt;
   if (field == "value" || field == e.id)

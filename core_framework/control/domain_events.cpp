@@ -6,6 +6,7 @@
 #include <spdlog/spdlog.h>
 
 #include "ports.h" // generated from dds/ports.idl
+#include "protocol/json_text.hpp"
 #include "protocol/topics.hpp"
 
 namespace rsca::control {
@@ -75,9 +76,9 @@ std::optional<DomainEvent> DomainEventFollower::take() {
     std::optional<DomainEvent> event;
     if (info.valid_data) {
       const auto *e = static_cast<const rsca_port_PropertyEvent *>(samples[0]);
-      event = DomainEvent{
-          e->timestamp_ns, e->id != nullptr ? e->id : "",
-          nlohmann::json::parse(e->value != nullptr ? e->value : "null", nullptr, false)};
+      event = DomainEvent{e->timestamp_ns, e->id != nullptr ? e->id : "",
+                          protocol::parse_json(e->value != nullptr ? e->value : "null")
+                              .value_or(nlohmann::json(nlohmann::json::value_t::discarded))};
     }
     dds_return_loan(reader_.get(), samples, n);
     if (event)

@@ -72,7 +72,7 @@ Expected<void> Endpoint::Impl::create_entities() {
   if (!ok)
     return ok;
   request_ways = std::make_unique<PartitionWriters>(pp, request_topic.get(), qos.get());
-  reply_ways = std::make_unique<PartitionWriters>(pp, reply_topic.get(), qos.get());
+  reply_ways = std::make_unique<ReplyWays>(pp, reply_topic.get(), qos.get(), waitset.get());
   // Held requests stay in the reader, which wakes nobody until start_serving.
   serving = !options.hold_requests;
   dds_set_status_mask(request_reader.get(), serving ? DDS_DATA_AVAILABLE_STATUS : 0);
@@ -100,6 +100,12 @@ void Endpoint::Impl::receive_loop() {
       const auto now = Clock::now();
       if (!pending.empty())
         timeout = std::chrono::duration_cast<std::chrono::nanoseconds>(kDepartureCheck).count();
+      if (replies_due)
+        timeout = std::min<dds_duration_t>(
+            timeout,
+            std::max<dds_duration_t>(
+                0,
+                std::chrono::duration_cast<std::chrono::nanoseconds>(*replies_due - now).count()));
       for (const auto &[id, p] : pending)
         timeout = std::min<dds_duration_t>(
             timeout,
@@ -116,6 +122,7 @@ void Endpoint::Impl::receive_loop() {
       take_announcements();
     expire_calls();
     fail_calls_to_departed();
+    replies_due = reply_ways->flush();
   }
 }
 
@@ -134,7 +141,7 @@ void Endpoint::Impl::take_requests() {
                              Clock::now()};
       if (context.target.empty())
         context.target = address;
-      Json body = parse_body(r->body);
+      auto body = parse_body(r->body);
       handler_pool->post([this, context = std::move(context), body = std::move(body)]() mutable {
         serve(std::move(context), std::move(body));
       });
@@ -202,32 +209,21 @@ std::string reply_text(CallResult<Json> &result) {
 
 } // namespace
 
-void Endpoint::Impl::serve(RequestContext context, Json body) {
+void Endpoint::Impl::serve(RequestContext context, tl::expected<Json, std::string> body) {
   CallResult<Json> result =
-      body.is_discarded() ? call_error(Status::BadRequest, "the request body is not valid JSON")
-      : context.operation == kBatch ? run_batch(context, body)
-                                    : served.dispatch(context, body);
+      !body ? call_error(Status::BadRequest, fmt::format("the request body {}", body.error()))
+      : context.operation == kBatch ? run_batch(context, *body)
+                                    : served.dispatch(context, *body);
   auto payload = take_payload(result);
-  const std::string reply_body = reply_text(result);
-  const std::string error = result ? std::string() : result.error().message;
-  rsca_ctl_Reply reply{};
-  reply.id = const_cast<char *>(context.id.c_str());
-  reply.status = static_cast<std::int32_t>(result ? Status::Ok : result.error().status);
-  reply.error = const_cast<char *>(error.c_str());
-  reply.body = const_cast<char *>(reply_body.c_str());
-  reply.payload._buffer = payload.data();
-  reply.payload._length = static_cast<std::uint32_t>(payload.size());
-  reply.payload._maximum = reply.payload._length;
-  reply.payload._release = false;
-  auto writer =
-      reply_ways->matched_writer(context.sender, Clock::now() + std::chrono::seconds(5), stopping);
-  if (!writer) {
-    spdlog::warn("{}: cannot reply to {} for {}: {}", address, context.sender, context.operation,
-                 writer.error().message);
-    return;
-  }
-  if (dds_return_t rc = dds_write(*writer, &reply); rc < 0)
-    spdlog::warn("{}: reply to {} failed: {}", address, context.sender, dds_strretcode(rc));
+  std::string reply_body = reply_text(result);
+  ReplyWays::Reply reply{
+      context.id, static_cast<std::int32_t>(result ? Status::Ok : result.error().status),
+      result ? std::string() : result.error().message, std::move(reply_body), std::move(payload)};
+  // Sent, or held until the caller's reader comes: this thread goes on to the next request.
+  if (auto sent = reply_ways->post(context.sender, std::move(reply)); !sent)
+    if (auto unsaid = unsent_log.allow())
+      spdlog::warn("{}: cannot reply to {} for {}: {}{}", address, context.sender,
+                   context.operation, sent.error().message, LogLimiter::unsaid_note(*unsaid));
 }
 
 void Endpoint::Impl::take_replies() {
@@ -250,20 +246,21 @@ void Endpoint::Impl::take_replies() {
                          ? call_error(static_cast<Status>(r->status), str(r->error))
                          : call_error(Status::Failed,
                                       fmt::format("status {}: {}", r->status, str(r->error)));
-        const Json error_body = parse_body(r->body);
+        const Json error_body = parse_body(r->body).value_or(Json());
         error.value().details = protocol::details_of(error_body);
         error.value().maybe_received = protocol::maybe_received_of(error_body);
         complete(str(r->id), std::move(error));
         continue;
       }
-      Json body = parse_body(r->body);
-      if (r->payload._length > 0 && body.is_object())
-        body[protocol::kPayloadField] = Json::binary(protocol::Bytes::container_type(
+      auto body = parse_body(r->body);
+      if (!body) {
+        complete(str(r->id), call_error(Status::Failed, fmt::format("the reply {}", body.error())));
+        continue;
+      }
+      if (r->payload._length > 0 && body->is_object())
+        (*body)[protocol::kPayloadField] = Json::binary(protocol::Bytes::container_type(
             r->payload._buffer, r->payload._buffer + r->payload._length));
-      complete(str(r->id),
-               body.is_discarded()
-                   ? CallResult<Json>(call_error(Status::Failed, "the reply is not JSON"))
-                   : CallResult<Json>(std::move(body)));
+      complete(str(r->id), std::move(*body));
     }
     dds_return_loan(reply_reader.get(), samples, n);
   }
@@ -358,7 +355,7 @@ void Endpoint::prepare(const std::string &target) {
 }
 
 void Endpoint::prepare_replies(const std::string &caller) {
-  if (auto writer = impl_->reply_ways->writer_for(caller); !writer)
+  if (auto writer = impl_->reply_ways->prepare(caller); !writer)
     spdlog::debug("preparing replies to {}: {}", caller, writer.error().message);
 }
 

@@ -33,7 +33,7 @@ void Endpoint::Impl::take_announcements() {
         event.kind = AnnouncementEvent::Kind::Alive;
         event.address = str(a->address);
         event.endpoint_kind = str(a->kind);
-        event.body = parse_body(a->body);
+        event.body = parse_body(a->body).value_or(Json(Json::value_t::discarded));
         // The slot held another address: that one was withdrawn, its disposal overwritten.
         if (auto before = heard_slots.heard(announcer, a->slot, event.address))
           handler(AnnouncementEvent{AnnouncementEvent::Kind::Gone,

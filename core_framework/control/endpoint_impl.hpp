@@ -23,8 +23,10 @@
 #include "control/endpoint.hpp"
 #include "control/handler_table.hpp"
 #include "control/partition_writers.hpp"
+#include "control/reply_ways.hpp"
 #include "control/worker_pool.hpp"
 #include "dds/entity.hpp"
+#include "protocol/json_text.hpp"
 #include "protocol/topics.hpp"
 
 namespace rsca::control {
@@ -88,10 +90,12 @@ inline CallResult<Json> result_of(const Json &reply) {
   return failed;
 }
 
-inline Json parse_body(const char *text) {
+// A body that came over DDS, untrusted: its value (none is {}), or why it is refused
+// (protocol/json_text.hpp: not JSON, or nested too deep to be copied safely).
+inline tl::expected<Json, std::string> parse_body(const char *text) {
   if (text == nullptr || *text == '\0')
     return Json::object();
-  return Json::parse(text, nullptr, /*allow_exceptions=*/false);
+  return protocol::parse_json(text);
 }
 
 // A call's id: "<caller's address>#<sequence>", unique per caller.
@@ -133,7 +137,10 @@ struct Endpoint::Impl {
   AnnouncerSlots announcer_slots;
   HeardSlots heard_slots; // receive thread only
 
-  std::unique_ptr<PartitionWriters> request_ways, reply_ways;
+  std::unique_ptr<PartitionWriters> request_ways;
+  std::unique_ptr<ReplyWays> reply_ways;
+  std::optional<Clock::time_point> replies_due; // receive thread only: a held reply's deadline
+  LogLimiter unsent_log;                        // replies that have no way to their caller
   std::mutex routes_mutex;
   std::map<std::string, std::string> routes; // target → the endpoint that serves it
   Clock::time_point departures_checked;      // receive thread only
@@ -158,7 +165,7 @@ struct Endpoint::Impl {
   void take_announcements();
   void expire_calls();
   void fail_calls_to_departed();
-  void serve(RequestContext context, Json body);
+  void serve(RequestContext context, tl::expected<Json, std::string> body);
 
   CallResult<Json> run_batch(const RequestContext &context, const Json &body);
   std::string route_of(const std::string &target);

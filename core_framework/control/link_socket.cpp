@@ -2,18 +2,28 @@
 
 #include <cerrno>
 #include <cstring>
+#include <utility>
 
 #include <fcntl.h>
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
 #include <sys/time.h>
 #include <sys/un.h>
 #include <unistd.h>
 
+#include "protocol/json_text.hpp"
+
 namespace rsca::control {
 
 namespace link = protocol::link;
+using protocol::Json;
+
+namespace {
+// A frame's body sits two levels down ({"request": {"body": …}}): the bound is the body's.
+constexpr std::size_t kFrameDepth = protocol::kMaxJsonDepth + 2;
+} // namespace
 
 protocol::CallResult<nlohmann::json> reply_result(const link::Reply &reply) {
   using protocol::call_error;
@@ -122,6 +132,16 @@ tl::expected<process::Fd, std::string> connect_link(const std::string &path) {
   return std::move(s->fd);
 }
 
+std::string wire_of(std::string_view text) {
+  const auto size = static_cast<std::uint32_t>(text.size());
+  std::string wire;
+  wire.reserve(4 + text.size());
+  for (int shift = 24; shift >= 0; shift -= 8)
+    wire.push_back(static_cast<char>((size >> static_cast<unsigned>(shift)) & 0xffU));
+  wire += text;
+  return wire;
+}
+
 LinkWriter::LinkWriter(int fd, std::chrono::milliseconds timeout) : fd_(fd) {
   timeval tv{};
   tv.tv_sec = static_cast<time_t>(timeout.count() / 1000);
@@ -139,12 +159,7 @@ tl::expected<void, std::string> LinkWriter::send(const link::Frame &frame) {
   if (text.size() > link::kMaxLinkFrame)
     return tl::unexpected(fmt::format("a frame of {} bytes is over the link's limit of {}",
                                       text.size(), link::kMaxLinkFrame));
-  const auto size = static_cast<std::uint32_t>(text.size());
-  std::string wire;
-  wire.reserve(4 + text.size());
-  for (int shift = 24; shift >= 0; shift -= 8)
-    wire.push_back(static_cast<char>((size >> static_cast<unsigned>(shift)) & 0xffU));
-  wire += text;
+  const std::string wire = wire_of(text);
   std::lock_guard lock(mutex_);
   std::size_t sent = 0;
   while (sent < wire.size()) {
@@ -196,23 +211,55 @@ bool FrameReader::cut(std::vector<link::Frame> &frames, std::string &why) {
     }
     if (buffer_.size() - at - 4 < size)
       break;
-    auto json = nlohmann::json::parse(buffer_.begin() + static_cast<std::ptrdiff_t>(at + 4),
-                                      buffer_.begin() + static_cast<std::ptrdiff_t>(at + 4 + size),
-                                      nullptr, false);
-    if (json.is_discarded()) {
-      why = "a frame is not JSON";
+    const std::string_view text(buffer_.data() + at + 4, size);
+    at += 4 + size;
+    auto json = protocol::parse_json(text, kFrameDepth);
+    if (!json && protocol::nests_deeper(text, kFrameDepth)) {
+      if (!refuse_deep(text, frames, why))
+        return false;
+      continue;
+    }
+    if (!json) {
+      why = fmt::format("a frame is {}", json.error());
       return false;
     }
-    auto frame = link::decode_frame(json);
+    auto frame = link::decode_frame(*json);
     if (!frame) {
       why = frame.error();
       return false;
     }
     frames.push_back(std::move(*frame));
-    at += 4 + size;
   }
   buffer_.erase(0, at);
   return true;
+}
+
+bool FrameReader::refuse_deep(std::string_view text, std::vector<link::Frame> &frames,
+                              std::string &why) {
+  auto frame = link::decode_frame(protocol::parse_json_pruned(text, kFrameDepth));
+  if (!frame) {
+    why = frame.error();
+    return false;
+  }
+  const std::string what =
+      fmt::format("the body nests deeper than {} levels", protocol::kMaxJsonDepth);
+  if (const auto *request = std::get_if<link::Request>(&*frame)) {
+    answers_.push_back(
+        link_reply(request->id, protocol::call_error(protocol::Status::BadRequest,
+                                                     fmt::format("{} to {}: {}", request->operation,
+                                                                 request->target, what))));
+  } else if (const auto *reply = std::get_if<link::Reply>(&*frame)) {
+    frames.emplace_back(link::Reply{reply->id,
+                                    static_cast<std::int32_t>(protocol::Status::BadRequest),
+                                    fmt::format("a reply refused: {}", what), Json::object()});
+  } else {
+    spdlog::warn("a link's frame refused: {}", what);
+  }
+  return true;
+}
+
+std::vector<link::Reply> FrameReader::answers() {
+  return std::exchange(answers_, {});
 }
 
 } // namespace rsca::control

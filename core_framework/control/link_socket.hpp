@@ -6,6 +6,7 @@
 #include <chrono>
 #include <mutex>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <sys/types.h>
@@ -41,6 +42,9 @@ namespace detail {
 tl::expected<process::Fd, std::string> bind_unix_socket(const std::string &path, mode_t mode);
 } // namespace detail
 
+// A frame's bytes on a link: its text's length, 4 bytes big-endian, then the text.
+std::string wire_of(std::string_view text);
+
 // Writes frames to a link, whole, from any thread. The socket is blocking with a send timeout:
 // a peer that stops reading fails a write after `timeout`, never holds its writer forever; a
 // frame cut by that ends the link (shutdown), since the stream can no longer be read.
@@ -55,16 +59,27 @@ private:
 };
 
 // Collects the bytes read from a link and cuts them into frames.
+//
+// A frame whose body nests deeper than protocol::kMaxJsonDepth is refused without ending the link
+// (its body is never built): a request is answered bad request (answers()), a reply becomes a
+// failed one for the call it answers, an announcement is dropped.
 class FrameReader {
 public:
   // Reads what the socket has (once, without waiting: call it when poll says it is readable) and
   // appends the whole frames it completes to `frames`. False, with why, at the end of the link (the
   // peer closed it or died) or on a frame that breaks the protocol; the link is then to be closed.
   bool read_from(int fd, std::vector<protocol::link::Frame> &frames, std::string &why);
+  // The replies owed to the requests refused since the last call, for the caller to send.
+  std::vector<protocol::link::Reply> answers();
 
 private:
   bool cut(std::vector<protocol::link::Frame> &frames, std::string &why);
+  // A frame parse_json refused for its nesting: what is made of it, or false if it breaks the
+  // protocol all the same.
+  bool refuse_deep(std::string_view text, std::vector<protocol::link::Frame> &frames,
+                   std::string &why);
   std::string buffer_;
+  std::vector<protocol::link::Reply> answers_;
 };
 
 } // namespace rsca::control

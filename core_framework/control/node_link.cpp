@@ -74,6 +74,8 @@ void NodeLink::Impl::read_loop() {
       continue;
     frames.clear();
     const bool open = frames_in.read_from(fd.get(), frames, why);
+    for (const auto &answer : frames_in.answers())
+      (void)writer->send(answer);
     for (auto &f : frames)
       take(std::move(f));
     if (!open) {

@@ -75,8 +75,8 @@ constexpr std::int32_t kSharedReplyHistory = 64;
 } // namespace
 
 PartitionWriters::PartitionWriters(dds_entity_t participant, dds_entity_t topic,
-                                   const dds_qos_t *qos)
-    : participant_(participant), topic_(topic), qos_(copy_of(qos)) {}
+                                   const dds_qos_t *qos, std::size_t max_ways)
+    : participant_(participant), topic_(topic), qos_(copy_of(qos)), max_ways_(max_ways) {}
 
 CallResult<dds_entity_t> PartitionWriters::writer_for(const std::string &partition) {
   if (!protocol::is_plain_address(partition))
@@ -85,9 +85,11 @@ CallResult<dds_entity_t> PartitionWriters::writer_for(const std::string &partiti
   const auto shared = protocol::cli_clients_partition(partition);
   const std::string &way = shared ? *shared : partition;
   std::lock_guard lock(mutex_);
-  if (auto it = ways_.find(way); it != ways_.end())
+  if (auto it = ways_.find(way); it != ways_.end()) {
+    it->second.used = Clock::now();
     return it->second.writer.get();
-  drop_departed_locked();
+  }
+  make_room_locked();
   auto pqos = partition_qos(way);
   auto publisher =
       dds::checked(dds_create_publisher(participant_, pqos.get(), nullptr), "creating a publisher");
@@ -147,10 +149,44 @@ std::size_t PartitionWriters::size() const {
   return ways_.size();
 }
 
-void PartitionWriters::drop_departed_locked() {
+std::optional<dds_entity_t> PartitionWriters::matched_way(const std::string &partition) {
+  const auto shared = protocol::cli_clients_partition(partition);
+  std::lock_guard lock(mutex_);
+  auto it = ways_.find(shared ? *shared : partition);
+  if (it == ways_.end() || !matched(it->second.writer.get(), partition, shared.has_value()))
+    return std::nullopt;
+  it->second.used = Clock::now();
+  return it->second.writer.get();
+}
+
+std::size_t PartitionWriters::drop_unmatched(Clock::time_point unused_since,
+                                             const std::set<std::string> &kept) {
+  std::lock_guard lock(mutex_);
+  return std::erase_if(ways_, [&](const auto &entry) {
+    const auto &[partition, way] = entry;
+    if (way.shared || way.used >= unused_since || kept.contains(partition))
+      return false;
+    dds_publication_matched_status_t status{};
+    return dds_get_publication_matched_status(way.writer.get(), &status) == 0 &&
+           status.total_count == 0;
+  });
+}
+
+void PartitionWriters::make_room_locked() {
   std::erase_if(ways_, [](const auto &entry) {
     return !entry.second.shared && readers_left(entry.second.writer.get());
   });
+  if (max_ways_ == 0 || ways_.size() < max_ways_)
+    return;
+  // The least recently used is a caller long gone or one that never read: a way of a caller
+  // still calling was used a moment ago, so the one a handler is about to write through is
+  // never the one dropped.
+  auto oldest = ways_.end();
+  for (auto it = ways_.begin(); it != ways_.end(); ++it)
+    if (!it->second.shared && (oldest == ways_.end() || it->second.used < oldest->second.used))
+      oldest = it;
+  if (oldest != ways_.end())
+    ways_.erase(oldest);
 }
 
 } // namespace rsca::control

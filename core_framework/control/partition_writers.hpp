@@ -21,6 +21,7 @@
 #include <chrono>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <string>
 
@@ -33,8 +34,10 @@ class PartitionWriters {
 public:
   using Clock = std::chrono::steady_clock;
 
-  // Writers of `topic` with QoS `qos` (copied), under publishers of `participant`.
-  PartitionWriters(dds_entity_t participant, dds_entity_t topic, const dds_qos_t *qos);
+  // Writers of `topic` with QoS `qos` (copied), under publishers of `participant`. At most
+  // `max_ways` (0: no bound): to make one more, the least recently used is dropped.
+  PartitionWriters(dds_entity_t participant, dds_entity_t topic, const dds_qos_t *qos,
+                   std::size_t max_ways = 0);
 
   // The writer into `partition` (the shared one for a CLI client's), made when there is none yet
   // (and then the ways whose readers left are dropped). BadRequest for a partition with
@@ -46,6 +49,12 @@ public:
   CallResult<dds_entity_t> matched_writer(const std::string &partition, Clock::time_point deadline,
                                           const std::atomic<bool> &stopping);
   void erase(const std::string &partition);
+  // The writer into `partition` if there is one already and the reader there is matched (as
+  // matched_writer says it); nothing else, and never a new way. It counts as a use.
+  std::optional<dds_entity_t> matched_way(const std::string &partition);
+  // Drops the ways never matched and not used since `unused_since` (a caller that never read its
+  // replies), but those in `kept`; how many went.
+  std::size_t drop_unmatched(Clock::time_point unused_since, const std::set<std::string> &kept);
 
   // The partitions whose writer was matched and is matched no longer.
   std::set<std::string> departed() const;
@@ -56,14 +65,17 @@ private:
     dds::Entity publisher; // carries the partition
     dds::Entity writer;
     bool shared = false; // the CLI clients' way: never dropped
+    Clock::time_point used = Clock::now();
   };
 
-  // Drops the ways whose readers left. Called with mutex_ held.
-  void drop_departed_locked();
+  // Drops the ways whose readers left, then, at the bound, the least recently used. Called with
+  // mutex_ held, before a way is made.
+  void make_room_locked();
 
   dds_entity_t participant_;
   dds_entity_t topic_;
   dds::Qos qos_;
+  std::size_t max_ways_;
   mutable std::mutex mutex_;
   std::map<std::string, Way> ways_;
 };

@@ -13,6 +13,7 @@
 #include "profile/property_binding.hpp"
 #include "profile/property_json.hpp"
 #include "protocol/component_ops.hpp"
+#include "protocol/json_text.hpp"
 
 namespace rsca::domain {
 namespace {
@@ -79,9 +80,8 @@ Json json_values(const TextValues &values) {
   Json out = Json::object();
   for (const auto &[id, v] : values) {
     const std::string text = v.is_string() ? v.get<std::string>() : v.dump();
-    const Json parsed = Json::parse(text, nullptr, false);
-    out[id] =
-        !parsed.is_discarded() && (parsed.is_boolean() || parsed.is_number()) ? parsed : Json(text);
+    const auto parsed = protocol::parse_json(text);
+    out[id] = parsed && (parsed->is_boolean() || parsed->is_number()) ? *parsed : Json(text);
   }
   return out;
 }

@@ -133,6 +133,17 @@ CallResult<domain_ops::InstalledReply> DomainManager::Impl::list_installed() {
   return reply;
 }
 
+namespace {
+
+tl::unexpected<control::CallError> unknown_assignment_error(const std::string &application,
+                                                            const std::string &component) {
+  return control::call_error(Status::BadRequest,
+                             fmt::format("assign names {}, which is no component of {}",
+                                         excerpt(component), excerpt(application)));
+}
+
+} // namespace
+
 CallResult<app_ops::CreateReply>
 DomainManager::Impl::create_application(const app_ops::CreateRequest &wire) {
   if (wire.name)
@@ -148,6 +159,8 @@ DomainManager::Impl::create_application(const app_ops::CreateRequest &wire) {
     if (!installed)
       return control::call_error(Status::NotFound, fmt::format("no application {} is installed",
                                                                excerpt(wire.application)));
+    if (auto stray = allocator::unknown_assignment(*installed->profile, wire.assign))
+      return unknown_assignment_error(wire.application, *stray);
     auto name = applications.reserve(wire.name.value_or(wire.application), wire.name.has_value(),
                                      wire.application);
     if (!name)
@@ -342,6 +355,8 @@ DomainManager::Impl::plan_application(const app_ops::PlanRequest &request) {
   const allocator::PlanOptions plan_options{strategy->value_or(options.strategy)};
   auto plan =
       allocator.plan(allocator::plan_request_of(*installed->profile, request.assign), plan_options);
+  if (auto stray = allocator::unknown_assignment(*installed->profile, request.assign))
+    return unknown_assignment_error(request.application, *stray);
   return allocator::plan_reply(plan, plan_options.strategy);
 }
 

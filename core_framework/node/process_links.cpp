@@ -1,4 +1,5 @@
 #include "node/process_links.hpp"
+#include "node/process_links_impl.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -26,97 +27,6 @@
 #include "protocol/component_ops.hpp"
 
 namespace rsca::node {
-
-namespace link = protocol::link;
-using control::call_error;
-using control::CallResult;
-using control::Json;
-using control::Status;
-
-namespace {
-
-// How long a relayed request may take, at most: the longest a component operation is given
-// (await_matched, a component's own configure) with room to spare. A dead process fails its
-// requests at once, not at this bound.
-constexpr std::chrono::seconds kRelayBound{60};
-// A process's own call is given what it asks for, up to this.
-constexpr std::chrono::seconds kCallBound{30};
-// A client's (a CLI's launch waits six times its --timeout-ms), up to this.
-constexpr std::chrono::hours kClientCallBound{1};
-// Clients connected at once, at most: one more is closed at once.
-constexpr std::size_t kMaxClients = 64;
-// Calls one client has under way, at most: more are refused at once.
-constexpr int kMaxClientCalls = 8;
-// Threads that wait for clients' calls: apart from the processes' own, so that clients (a launch
-// waits for minutes) never hold up a component's call.
-constexpr std::size_t kClientCallThreads = 4;
-
-} // namespace
-
-// One process the node started, and its link; or a client on the control socket (a CLI), which
-// may only make calls.
-struct LinkedProcess {
-  pid_t pid = 0;
-  bool client = false;
-  process::Fd fd;
-  std::unique_ptr<control::LinkWriter> writer;
-  control::FrameReader reader;
-  std::vector<std::string> addresses;
-  std::set<std::string> announced;
-  std::atomic<bool> ended{false};
-  std::atomic<int> calls{0}; // a client's calls under way
-  std::string why;           // why it ended
-};
-
-struct ProcessLinks::Impl {
-  control::Endpoint *endpoint = nullptr;
-  HostData *host_data = nullptr;
-  process::Fd epoll;
-  process::Fd wake;
-  process::Fd listener; // the control socket, when the node has one
-  std::string listener_path;
-  std::thread thread;
-  std::unique_ptr<control::WorkerPool> outgoing;               // the processes' own calls
-  std::unique_ptr<control::WorkerPool> client_calls;           // the clients'
-  std::atomic<int> listener_fd{-1};                            // read by the poll thread
-  std::chrono::steady_clock::time_point accept_paused_until{}; // poll thread only
-  std::atomic<bool> stopping{false};
-
-  std::mutex mutex; // guards what follows
-  std::map<pid_t, std::shared_ptr<LinkedProcess>> by_pid;
-  std::map<int, std::shared_ptr<LinkedProcess>> by_fd; // processes and clients
-  std::size_t clients = 0;
-  std::map<std::string, std::shared_ptr<LinkedProcess>> by_address;
-  struct Relayed {
-    pid_t pid = 0;
-    std::promise<CallResult<Json>> promise;
-    std::chrono::steady_clock::time_point deadline;
-    std::function<void(bool ok)> after; // runs with the reply's outcome, outside the lock
-  };
-  std::map<std::string, Relayed> relayed; // requests under way, by id
-  std::uint64_t next_id = 0;
-  bool closed = false;
-
-  // Hands a request on to the process that serves its target; its reply to come.
-  std::future<CallResult<Json>> relay(const Json &body, const control::RequestContext &context);
-  // What the host's data makes of a relayed request on its way (a connect's ring), and what it
-  // does once the reply is known.
-  CallResult<Json> prepare(pid_t pid, const Json &body, const control::RequestContext &context,
-                           std::function<void(bool ok)> &after);
-  void complete(const std::string &id, pid_t pid, CallResult<Json> result);
-  void expire();
-  void poll_loop();
-  void accept_clients();
-  // Out of descriptors, the listener stays readable: it leaves the poll for a second.
-  void pause_accepting();
-  void resume_accepting();
-  void read(int fd);
-  void take(const std::shared_ptr<LinkedProcess> &process, link::Frame frame);
-  void make_call(const std::shared_ptr<LinkedProcess> &process, link::Request request);
-  void announce(LinkedProcess &process, const link::Announce &a);
-  // The link ended: its relayed requests fail, its announcements go. Called with the mutex held.
-  void end(LinkedProcess &process, const std::string &why);
-};
 
 namespace {
 
@@ -252,6 +162,7 @@ void ProcessLinks::Impl::poll_loop() {
     const int n = ::epoll_wait(epoll.get(), events, kEvents, 1000);
     expire();
     resume_accepting();
+    drop_idle_clients();
     if (n < 0 && errno != EINTR) {
       spdlog::error("process links: epoll_wait: {}", std::strerror(errno));
       return;
@@ -266,60 +177,6 @@ void ProcessLinks::Impl::poll_loop() {
   }
 }
 
-void ProcessLinks::Impl::accept_clients() {
-  for (;;) {
-    process::Fd fd(::accept4(listener_fd.load(), nullptr, nullptr, SOCK_CLOEXEC));
-    if (!fd) {
-      if (errno == EMFILE || errno == ENFILE || errno == ENOBUFS || errno == ENOMEM) {
-        spdlog::warn("control socket {}: accept: {}; clients wait a second", listener_path,
-                     std::strerror(errno));
-        pause_accepting();
-      } else if (errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR) {
-        spdlog::warn("control socket {}: accept: {}", listener_path, std::strerror(errno));
-      }
-      return;
-    }
-    ucred peer{};
-    socklen_t size = sizeof(peer);
-    ::getsockopt(fd.get(), SOL_SOCKET, SO_PEERCRED, &peer, &size);
-    auto client = std::make_shared<LinkedProcess>();
-    client->pid = peer.pid;
-    client->client = true;
-    client->writer = std::make_unique<control::LinkWriter>(fd.get());
-    const int number = fd.get();
-    client->fd = std::move(fd);
-    std::lock_guard lock(mutex);
-    if (closed || clients >= kMaxClients) {
-      spdlog::warn("control socket {}: a client (pid {}) refused: {} connected already",
-                   listener_path, peer.pid, clients);
-      continue; // closed as it goes
-    }
-    ++clients;
-    by_fd[number] = client;
-    epoll_event event{};
-    event.events = EPOLLIN;
-    event.data.fd = number;
-    ::epoll_ctl(epoll.get(), EPOLL_CTL_ADD, number, &event);
-    spdlog::debug("control socket: client pid {} (uid {}) connected", peer.pid, peer.uid);
-  }
-}
-
-void ProcessLinks::Impl::pause_accepting() {
-  ::epoll_ctl(epoll.get(), EPOLL_CTL_DEL, listener_fd.load(), nullptr);
-  accept_paused_until = std::chrono::steady_clock::now() + std::chrono::seconds(1);
-}
-
-void ProcessLinks::Impl::resume_accepting() {
-  if (accept_paused_until == std::chrono::steady_clock::time_point{} ||
-      std::chrono::steady_clock::now() < accept_paused_until)
-    return;
-  accept_paused_until = {};
-  epoll_event event{};
-  event.events = EPOLLIN;
-  event.data.fd = listener_fd.load();
-  ::epoll_ctl(epoll.get(), EPOLL_CTL_ADD, listener_fd.load(), &event);
-}
-
 void ProcessLinks::Impl::read(int fd) {
   std::shared_ptr<LinkedProcess> process;
   {
@@ -332,6 +189,10 @@ void ProcessLinks::Impl::read(int fd) {
   std::vector<link::Frame> frames;
   std::string why;
   const bool open = process->reader.read_from(fd, frames, why);
+  if (!frames.empty())
+    process->heard = std::chrono::steady_clock::now();
+  for (const auto &answer : process->reader.answers())
+    (void)process->writer->send(answer);
   for (auto &f : frames)
     take(process, std::move(f));
   if (open)
@@ -372,6 +233,7 @@ void ProcessLinks::Impl::take(const std::shared_ptr<LinkedProcess> &process, lin
     }
     client_calls->post([this, process, r = std::move(*request)]() mutable {
       make_call(process, std::move(r));
+      process->heard = std::chrono::steady_clock::now(); // before the count: never idle between
       process->calls.fetch_sub(1);
     });
   } else if (auto *a = std::get_if<link::Announce>(&frame)) {
@@ -478,25 +340,6 @@ Expected<std::unique_ptr<ProcessLinks>> ProcessLinks::start(control::Endpoint &e
 
 ProcessLinks::~ProcessLinks() {
   close();
-}
-
-Expected<void> ProcessLinks::listen(const std::string &path) {
-  std::lock_guard lock(impl_->mutex);
-  if (impl_->listener)
-    return make_error({"node", 0, 0}, "control-socket",
-                      fmt::format("listening at {} already", impl_->listener_path));
-  auto fd = control::listen_for_links(path);
-  if (!fd)
-    return make_error({"node", 0, 0}, "control-socket", fd.error());
-  impl_->listener = std::move(*fd);
-  impl_->listener_path = path;
-  impl_->listener_fd = impl_->listener.get();
-  epoll_event event{};
-  event.events = EPOLLIN;
-  event.data.fd = impl_->listener.get();
-  ::epoll_ctl(impl_->epoll.get(), EPOLL_CTL_ADD, impl_->listener.get(), &event);
-  spdlog::info("control socket: local clients connect at {}", path);
-  return {};
 }
 
 void ProcessLinks::attach(pid_t pid, process::Fd link, std::vector<std::string> addresses) {

@@ -19,6 +19,11 @@
 // A message may also say what its fields alone cannot (a bound, a range) in a `check()`, which
 // decode() runs on the message read (checked() below).
 //
+// Every string, list and map read is bounded: kMaxStringBytes and kMaxItems unless its field says
+// otherwise (`required("content", &F::content).at_most(n)`, for the field's own value). A request
+// of half a million entries was kept whole before its handler saw it (issue 37, defect 8); the
+// body as a whole is bounded where it arrives (protocol/json_text.hpp).
+//
 // Bytes are a JSON binary value: never text. The one field of a reply named kPayloadField may
 // hold them; the control plane carries it beside the reply's JSON (control.idl, Reply.payload).
 #pragma once
@@ -62,11 +67,22 @@ struct DecodeError {
 };
 using DecodeResult = tl::expected<void, DecodeError>;
 
+// What a field may hold at most, when it does not say: bytes of a string, items of a list or map.
+inline constexpr std::size_t kMaxStringBytes = 1U << 20U;
+inline constexpr std::size_t kMaxItems = 1U << 16U;
+
 template <typename Message, typename T>
 struct Field {
   std::string_view key;
   T Message::*member;
   bool required;
+  std::size_t most = 0; // of the string's bytes or the list's items; 0: the default above
+  // The same field, holding at most `n` (bytes of a string, items of a list or map).
+  constexpr Field at_most(std::size_t n) const {
+    Field bounded = *this;
+    bounded.most = n;
+    return bounded;
+  }
 };
 
 template <typename Message, typename T>
@@ -144,12 +160,22 @@ inline tl::unexpected<DecodeError> invalid(std::string what) {
   return tl::unexpected(DecodeError{{}, std::move(what)});
 }
 
+// Refused when `size` is over `most` (0: `otherwise`).
+inline DecodeResult bounded(std::size_t size, std::size_t most, std::size_t otherwise,
+                            std::string_view unit) {
+  const std::size_t bound = most != 0 ? most : otherwise;
+  if (size > bound)
+    return invalid(fmt::format("{} {}, over the limit of {}", size, unit, bound));
+  return {};
+}
+
 } // namespace detail
 
 template <typename T>
 Json encode(const T &value);
+// `most`: the bound of a string's bytes or a list's items (0: kMaxStringBytes, kMaxItems).
 template <typename T>
-DecodeResult decode_into(const Json &json, T &out);
+DecodeResult decode_into(const Json &json, T &out, std::size_t most = 0);
 
 template <MessageType M>
 Json encode_message(const M &message) {
@@ -203,7 +229,7 @@ DecodeResult decode_message(const Json &json, M &out) {
                 return;
               }
               ++known;
-              if (auto ok = decode_into(*it, out.*(field.member)); !ok)
+              if (auto ok = decode_into(*it, out.*(field.member), field.most); !ok)
                 result = tl::unexpected(ok.error().within(field.key));
             }(),
             ...);
@@ -249,7 +275,7 @@ Json encode(const T &value) {
 }
 
 template <typename T>
-DecodeResult decode_into(const Json &json, T &out) {
+DecodeResult decode_into(const Json &json, T &out, std::size_t most) {
   if constexpr (MessageType<T>) {
     return decode_message(json, out);
   } else if constexpr (std::is_same_v<T, Json>) {
@@ -292,7 +318,10 @@ DecodeResult decode_into(const Json &json, T &out) {
   } else if constexpr (std::is_same_v<T, std::string>) {
     if (!json.is_string())
       return detail::wrong(json, "a string");
-    out = json.get<std::string>();
+    const auto &text = json.get_ref<const std::string &>();
+    if (auto ok = detail::bounded(text.size(), most, kMaxStringBytes, "bytes"); !ok)
+      return ok;
+    out = text;
     return {};
   } else if constexpr (NamedEnum<T>) {
     if (!json.is_string())
@@ -305,13 +334,15 @@ DecodeResult decode_into(const Json &json, T &out) {
     return {};
   } else if constexpr (detail::IsOptional<T>::value) {
     typename T::value_type inner{};
-    if (auto ok = decode_into(json, inner); !ok)
+    if (auto ok = decode_into(json, inner, most); !ok)
       return ok;
     out = std::move(inner);
     return {};
   } else if constexpr (detail::IsVector<T>::value) {
     if (!json.is_array())
       return detail::wrong(json, "an array");
+    if (auto ok = detail::bounded(json.size(), most, kMaxItems, "items"); !ok)
+      return ok;
     out.clear();
     out.reserve(json.size());
     for (std::size_t i = 0; i < json.size(); ++i) {
@@ -324,8 +355,12 @@ DecodeResult decode_into(const Json &json, T &out) {
   } else if constexpr (detail::IsStringMap<T>::value) {
     if (!json.is_object())
       return detail::wrong(json, "an object");
+    if (auto ok = detail::bounded(json.size(), most, kMaxItems, "entries"); !ok)
+      return ok;
     out.clear();
     for (const auto &[key, item] : json.items()) {
+      if (auto ok = detail::bounded(key.size(), 0, kMaxStringBytes, "bytes in a key"); !ok)
+        return ok;
       typename T::mapped_type value{};
       if (auto ok = decode_into(item, value); !ok)
         return tl::unexpected(ok.error().within(fmt::format("[\"{}\"]", key)));

@@ -91,10 +91,12 @@ struct InstallFile {
   std::optional<FileEncoding> encoding; // absent: text
   std::optional<bool> executable;       // absent: false; the file is made executable
   static constexpr auto fields() {
-    return std::tuple{required("path", &InstallFile::path),
-                      required("content", &InstallFile::content),
-                      optional("encoding", &InstallFile::encoding),
-                      optional("executable", &InstallFile::executable)};
+    return std::tuple{
+        required("path", &InstallFile::path),
+        // base64 makes 4 bytes of 3
+        required("content", &InstallFile::content).at_most(kMaxInstallBytes / 3 * 4 + 4),
+        optional("encoding", &InstallFile::encoding),
+        optional("executable", &InstallFile::executable)};
   }
 };
 

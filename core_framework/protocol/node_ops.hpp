@@ -370,7 +370,8 @@ struct LogsReply {
   static constexpr auto fields() {
     using R = LogsReply;
     return std::tuple{required("log", &R::log), required("offset", &R::offset),
-                      required("next", &R::next), required("text", &R::text)};
+                      required("next", &R::next),
+                      required("text", &R::text).at_most(LogsRequest::kMaxBytes * 3)};
   }
   std::optional<DecodeError> check() const {
     if (text.size() > LogsRequest::kMaxBytes * 3) // each invalid byte may become 3 (U+FFFD)

@@ -3,6 +3,8 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "protocol/json_text.hpp"
+
 namespace rsca::protocol {
 
 std::string_view to_string(Status status) {
@@ -74,7 +76,7 @@ bool maybe_received_of(const nlohmann::json &body) {
 std::vector<std::string> details_of_text(std::string_view body) {
   if (body.empty())
     return {};
-  return details_of(nlohmann::json::parse(body, nullptr, /*allow_exceptions=*/false));
+  return details_of(parse_json(body).value_or(nlohmann::json()));
 }
 
 // Bounded: the reply is untrusted.

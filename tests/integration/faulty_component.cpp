@@ -11,6 +11,8 @@
 #include <thread>
 
 #include "component/runtime.hpp"
+#include "control/link_socket.hpp"
+#include "protocol/node_link.hpp"
 
 namespace {
 
@@ -57,6 +59,10 @@ public:
     // fills a log past a small rotation bound when it chooses (the rotation test's).
     property("chatter", chatter_,
              [this](const std::uint32_t &, const std::uint32_t &lines) { chatter(lines); });
+    // "deep_frame": a configure of N writes the node a request whose body nests N deep, as a
+    // hostile component could (issue 37): the node must refuse it and live on.
+    property("deep_frame", deep_frame_,
+             [](const std::uint32_t &, const std::uint32_t &depth) { write_deep_frame(depth); });
     property("level", level_, [](const std::uint32_t &, const std::uint32_t &) {
       if (g_fault == "hang_at_configure")
         std::this_thread::sleep_for(std::chrono::hours(1)); // the fault itself: never answer
@@ -66,6 +72,24 @@ public:
   }
 
 private:
+  // Straight on the link's descriptor, whole: the runtime writes nothing else meanwhile, its
+  // reply to this configure going after the setter returns.
+  static void write_deep_frame(std::uint32_t depth) {
+    const std::string text =
+        R"({"request": {"id": "deep", "target": "rsca/domain", "operation": "app.list", )"
+        R"("sender": "x", "timeout_ms": 1000, "body": )" +
+        std::string(depth, '[') + std::string(depth, ']') + "}}";
+    const std::string wire = rsca::control::wire_of(text);
+    std::size_t sent = 0;
+    while (sent < wire.size()) {
+      const ssize_t n =
+          ::write(rsca::protocol::link::kNodeLinkFd, wire.data() + sent, wire.size() - sent);
+      if (n <= 0)
+        return;
+      sent += static_cast<std::size_t>(n);
+    }
+  }
+
   void chatter(std::uint32_t lines) {
     const std::string padding(160, '.');
     for (std::uint32_t i = 0; i < lines; ++i)
@@ -83,6 +107,7 @@ private:
   std::string fault_ = "none";
   std::uint32_t level_ = 1;
   std::uint32_t chatter_ = 0;
+  std::uint32_t deep_frame_ = 0;
   std::uint64_t chattered_ = 0; // lines logged so far, numbering the next
   std::uint64_t received_ = 0;
 };
