@@ -101,11 +101,15 @@ TEST_CASE("a process forked from a fork server has what spawn would have given i
   CHECK_THAT(log, Catch::Contains("parent: " + std::to_string(::getpid()) + "\n"));
   CHECK_THAT(log, Catch::Contains("cpus: 1\n"));
   CHECK_THAT(log, Catch::Contains("stdin: empty\n"));
-  CHECK_THAT(log, Catch::Contains("fd 4: closed\n")); // the server's socket did not leak
+  CHECK_THAT(log, Catch::Contains("fd 4: closed\n"));         // the server's socket did not leak
+  CHECK_THAT(log, Catch::Contains("descriptors: 0 1 2 3\n")); // only those it was given
   CHECK(server.alive());
 }
 
-TEST_CASE("a process forked with no descriptor to inherit has none of the server's",
+// As spawn gives a child (spawn_test): whatever the server has open, blocks or ignores, the
+// started process gets none of it.
+TEST_CASE("a process forked with no descriptor to inherit has none of the server's, every "
+          "signal's default action and none blocked",
           "[process][fork_server]") {
   TempDir dir;
   auto server = started_server();
@@ -116,7 +120,10 @@ TEST_CASE("a process forked with no descriptor to inherit has none of the server
   const std::string log = slurp(dir.path() / "log");
   INFO(log);
   CHECK_THAT(log, Catch::Contains("fd 4: closed\n"));
-  CHECK_THAT(log, Catch::Contains("fd 3: closed\n")); // the server's socket
+  CHECK_THAT(log, Catch::Contains("fd 3: closed\n"));       // the server's socket
+  CHECK_THAT(log, Catch::Contains("descriptors: 0 1 2\n")); // none of the server's, however high
+  CHECK_THAT(log, Catch::Contains("ignored signals: none\n"));
+  CHECK_THAT(log, Catch::Contains("blocked signals: none\n"));
 }
 
 TEST_CASE("a fork server works under a low limit of descriptors", "[process][fork_server]") {

@@ -2,8 +2,10 @@
 // folder, and an install that fails leaves the repository as it was.
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <random>
 
 #include <catch2/catch.hpp>
@@ -40,19 +42,38 @@ InstallRequest request_for(const std::string &application) {
   return request;
 }
 
-// A folder with a repository (and its store) inside and a victim beside it, removed with it.
+// Every file and folder under `dir` (its path relative to `dir`) with a file's content, but the
+// store's files, which a request may write to.
+std::map<std::string, std::string> tree_of(const fs::path &dir) {
+  std::map<std::string, std::string> tree;
+  for (const auto &e : fs::recursive_directory_iterator(dir)) {
+    const auto name = e.path().filename().string();
+    if (name.rfind("domain.sqlite", 0) == 0)
+      continue;
+    tree[e.path().lexically_relative(dir).string()] =
+        e.is_regular_file() ? read(e.path()) : std::string("(folder)");
+  }
+  return tree;
+}
+
+// A folder with a repository (and its store) inside, and a victim where each name or path a
+// test sends would land if it escaped: the installs' folder is root/applications, so
+// "../victim" lands in root, "../../victim" beside root. Removed with it.
 struct Sandbox {
   fs::path top = fs::temp_directory_path() / ("rsca-repository-test-" + std::to_string(::getpid()) +
                                               "-" + std::to_string(std::random_device{}()));
   fs::path root = top / "a/b/repository";
-  fs::path victim = top / "a/victim";
+  std::vector<fs::path> victims = {root / "victim", root.parent_path() / "victim",
+                                   root.parent_path().parent_path() / "victim"};
   std::optional<DomainStore> store;
   std::optional<InstalledRepository> repository;
 
   Sandbox() {
     fs::create_directories(root);
-    fs::create_directories(victim);
-    std::ofstream(victim / "precious") << "keep me";
+    for (const auto &victim : victims) {
+      fs::create_directories(victim);
+      std::ofstream(victim / "precious") << "keep me";
+    }
     open();
   }
   ~Sandbox() {
@@ -73,7 +94,13 @@ struct Sandbox {
     repository.emplace(root, *store);
     repository->load();
   }
-  bool victim_intact() const { return read(victim / "precious") == "keep me"; }
+  bool victim_intact() const {
+    return std::all_of(victims.begin(), victims.end(), [](const fs::path &victim) {
+      return read(victim / "precious") == "keep me" && tree_of(victim).size() == 1;
+    });
+  }
+  // Everything in the sandbox, in and around the repository, but the store.
+  std::map<std::string, std::string> tree() const { return tree_of(top); }
   // Folders or files in the repository other than the store and the installs.
   std::vector<std::string> leftovers() const {
     std::vector<std::string> found;
@@ -91,6 +118,7 @@ struct Sandbox {
 TEST_CASE("an install name that is a path is refused and nothing outside the repository changes",
           "[unit][installed-repository]") {
   Sandbox box;
+  const auto before = box.tree();
   for (const std::string name : {"../../victim", "../victim", ".", "..", "a/b", ""}) {
     INFO(name);
     auto request = request_for("Healthy");
@@ -110,6 +138,7 @@ TEST_CASE("an install name that is a path is refused and nothing outside the rep
     CHECK(box.victim_intact());
     CHECK(fs::exists(box.root / "domain.sqlite"));
   }
+  CHECK(box.tree() == before); // nothing anywhere changed, inside the repository or out
 }
 
 TEST_CASE("an install goes into a folder of its own and its uninstall removes only that",
@@ -134,6 +163,7 @@ TEST_CASE("a failed install leaves no staging copy and keeps what was installed 
   REQUIRE(box.repository->install(good).has_value());
   const auto before = box.repository->find("Healthy");
   REQUIRE(before.has_value());
+  const auto tree_before = box.tree();
 
   SECTION("a profile that does not load") {
     auto broken = good;
@@ -149,7 +179,7 @@ TEST_CASE("a failed install leaves no staging copy and keeps what was installed 
     outside.files.push_back({"../../escape.xml", "x", {}, {}});
     auto installed = box.repository->install(outside);
     REQUIRE_FALSE(installed.has_value());
-    CHECK_FALSE(fs::exists(box.root.parent_path() / "escape.xml"));
+    CHECK(installed.error().status == Status::BadRequest);
   }
   SECTION("code whose content is not base64") {
     auto bad = good;
@@ -185,6 +215,9 @@ TEST_CASE("a failed install leaves no staging copy and keeps what was installed 
     CHECK(installed.error().message.size() < 4096); // a bounded excerpt, not the name
   }
   CHECK(box.leftovers().empty());
+  // Nothing written anywhere: an escaped file ("../../escape.xml" from a staging folder lands in
+  // the repository's root), a staging copy, a change to the install.
+  CHECK(box.tree() == tree_before);
   auto after = box.repository->find("Healthy");
   REQUIRE(after.has_value());
   CHECK(fs::exists(after->sad));

@@ -15,12 +15,32 @@
 #include "protocol/node_ops.hpp"
 
 using namespace rsca;
-using namespace rsca::domain;
+// Names, not the namespace: this file shares a translation unit with others (unity build), where
+// all of rsca::domain would clash with their names (component::Delivery).
 using control::Json;
+using rsca::domain::Application;
+using rsca::domain::ApplicationFactory;
+using rsca::domain::ComponentRegistry;
+using rsca::domain::DomainServices;
+using rsca::domain::EventChannelManager;
+using rsca::domain::LaunchIdentity;
+using rsca::domain::LaunchRequest;
+using rsca::domain::LaunchStep;
+using rsca::domain::Saga;
 
 namespace {
 
 const std::filesystem::path kSdr = std::filesystem::path(RSCA_SOURCE_DIR) / "profiles";
+// Events (tests/data/integration): a producer publishing on channel Ticks, two consumers
+// subscribed, three processes; ProducerConsumer has no channel.
+const std::filesystem::path kIntegrationSdr =
+    std::filesystem::path(RSCA_TEST_DATA_DIR) / "integration";
+
+// An application of an SDR root, by name: dom/waveforms/NAME/NAME.sad.xml.
+struct AppFile {
+  std::filesystem::path sdr = kSdr;
+  std::string name = "ProducerConsumer";
+};
 
 // Answers every call as the node and the components would, registering each component whose
 // process it "starts"; fails every call of `fail_operation` from its `fail_from`th on.
@@ -125,13 +145,15 @@ struct Domain {
     services.registration_timeout = std::chrono::milliseconds(300);
   }
 
-  control::CallResult<std::shared_ptr<Application>> launch(std::vector<LaunchStep> &steps) {
-    profile::ProfileLoader loader(kSdr);
+  control::CallResult<std::shared_ptr<Application>> launch(std::vector<LaunchStep> &steps,
+                                                           const AppFile &file = {}) {
+    profile::ProfileLoader loader(file.sdr);
     auto app =
-        loader.load_application(kSdr / "dom/waveforms/ProducerConsumer/ProducerConsumer.sad.xml");
+        loader.load_application(file.sdr / "dom/waveforms" / file.name / (file.name + ".sad.xml"));
+    INFO((app ? std::string() : app.error().to_string()));
     REQUIRE(app.has_value());
     request.name = "PC";
-    request.installed = "ProducerConsumer";
+    request.installed = file.name;
     request.profile = std::make_shared<profile::ResolvedApplication>(std::move(*app));
     return ApplicationFactory(services).create(
         request, [&steps](const LaunchStep &step) { steps.push_back(step); });
@@ -236,6 +258,34 @@ TEST_CASE("launch: a failure at any step leaves nothing behind and says what was
       CHECK_THAT(message, Catch::Contains(c.undone));
       REQUIRE_FALSE(steps.empty());
       CHECK(steps.back().detail == "failed");
+      d.require_nothing_left();
+    }
+  }
+}
+
+TEST_CASE("launch: a failure after an application joined its event channel leaves no member of "
+          "it",
+          "[launch]") {
+  const AppFile events{kIntegrationSdr, "Events"};
+  {
+    Domain d; // launched, its three members are in the channel
+    std::vector<LaunchStep> steps;
+    auto app = d.launch(steps, events);
+    INFO((app ? std::string() : app.error().message));
+    REQUIRE(app.has_value());
+    const auto channels = d.channels.list();
+    REQUIRE(channels.size() == 1);
+    CHECK(channels.front().name == "Ticks");
+    CHECK(channels.front().members.size() == 3);
+  }
+  for (const char *operation : {"node.execute", "component.connect", "component.start"}) {
+    DYNAMIC_SECTION(operation << " failing") {
+      Domain d;
+      d.caller.fail_operation = operation;
+      std::vector<LaunchStep> steps;
+      auto app = d.launch(steps, events);
+      REQUIRE_FALSE(app.has_value());
+      CHECK_THAT(app.error().message, Catch::Contains("event channels Ticks destroyed"));
       d.require_nothing_left();
     }
   }

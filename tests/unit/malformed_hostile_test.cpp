@@ -6,7 +6,14 @@
 #include "profile/profile_loader.hpp"
 #include "profile/xml_document.hpp"
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
 #include <catch2/catch.hpp>
+#include <fmt/format.h>
 
 #include <algorithm>
 #include <chrono>
@@ -18,6 +25,7 @@
 #include <vector>
 
 #include "malformed_fixture.hpp"
+#include "test_files.hpp"
 
 namespace fs = std::filesystem;
 using namespace rsca;
@@ -103,11 +111,66 @@ TEST_CASE("a billion laughs entity bomb fails fast", "[malformed][entities]") {
   CHECK(elapsed < std::chrono::seconds(5));
 }
 
+namespace {
+
+// A TCP listener on 127.0.0.1, never accepting: a connection made to it waits in its backlog,
+// so whether anyone connected can be asked afterwards.
+class DtdServer {
+public:
+  DtdServer() : fd_(::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0)) {
+    REQUIRE(fd_ >= 0);
+    sockaddr_in address{};
+    address.sin_family = AF_INET;
+    address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    REQUIRE(::bind(fd_, reinterpret_cast<sockaddr *>(&address), sizeof address) == 0);
+    REQUIRE(::listen(fd_, 16) == 0);
+    socklen_t size = sizeof address;
+    REQUIRE(::getsockname(fd_, reinterpret_cast<sockaddr *>(&address), &size) == 0);
+    port_ = ntohs(address.sin_port);
+  }
+  ~DtdServer() { ::close(fd_); }
+  DtdServer(const DtdServer &) = delete;
+  DtdServer &operator=(const DtdServer &) = delete;
+
+  int port() const { return port_; }
+  // Whether a connection is waiting to be accepted.
+  bool connected() const {
+    pollfd p{fd_, POLLIN, 0};
+    return ::poll(&p, 1, 0) == 1;
+  }
+
+private:
+  int fd_;
+  int port_ = 0;
+};
+
+// The files of the fixture `from`, copied into `to` with every text `what` replaced by `with`.
+void copy_fixture_replacing(const fs::path &from, const fs::path &to, const std::string &what,
+                            const std::string &with) {
+  for (const auto &e : fs::recursive_directory_iterator(from)) {
+    if (!e.is_regular_file())
+      continue;
+    std::ifstream in(e.path(), std::ios::binary);
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at))
+      text.replace(at, what.size(), with);
+    const fs::path target = to / e.path().lexically_relative(from);
+    fs::create_directories(target.parent_path());
+    write_file(target, text);
+  }
+}
+
+} // namespace
+
 TEST_CASE("a DOCTYPE naming a remote DTD is never fetched", "[malformed][entities]") {
-  // example.invalid cannot resolve: if any DTD were fetched, these files would fail.
-  const fs::path root = fixture("entities/remote_dtd");
-  const fs::path sad = root / "dom/waveforms/app/app.sad.xml";
-  ProfileLoader loader(root);
+  // Each file's DOCTYPE names a DTD on a server of the test's own: a fetch would connect to it.
+  DtdServer server;
+  TempDir dir;
+  const std::string url = fmt::format("http://127.0.0.1:{}", server.port());
+  copy_fixture_replacing(fixture("entities/remote_dtd"), dir.path(), "http://example.invalid", url);
+  const fs::path sad = dir.path() / "dom/waveforms/app/app.sad.xml";
+  REQUIRE_THAT(slurp(sad), Contains(url + "/sad.dtd"));
+  ProfileLoader loader(dir.path());
   auto result = loader.load_application(sad);
   INFO((result ? std::string() : result.error().to_string()));
   REQUIRE(result.has_value());
@@ -116,15 +179,23 @@ TEST_CASE("a DOCTYPE naming a remote DTD is never fetched", "[malformed][entitie
   const auto &pkg = result->component_files.at("comp_spd");
   REQUIRE(pkg->properties != nullptr);
   CHECK(pkg->find_property("count") != nullptr);
+  CHECK_FALSE(server.connected()); // nothing asked for a DTD
 }
 
 TEST_CASE("an external entity is never read", "[malformed][entities]") {
   const fs::path file = fixture("entities/external_entity.sad.xml");
-  REQUIRE(fs::is_regular_file(fixture("entities/secret.txt")));
+  const std::string secret = slurp(fixture("entities/secret.txt"));
+  REQUIRE_THAT(secret, Contains("SECRET"));
   auto result = read_descriptor(file);
-  // Refusing the file would be fine too; what must not happen is the secret in the model.
-  if (result)
-    CHECK(std::get<SoftwareAssembly>(*result).description.find("SECRET") == std::string::npos);
+  // The DOCTYPE that declares the entity is never read: the entity is undefined where the
+  // description uses it, which refuses the file, and nothing of the secret is in the error.
+  const Error &error = error_of(result);
+  INFO(error.to_string());
+  const Diagnostic &d = error.diagnostics().front();
+  CHECK(d.rule == "xml");
+  CHECK(d.where.line == 7);
+  CHECK_THAT(d.message, Contains("secret"));
+  CHECK_THAT(error.to_string(), !Contains("SECRET"));
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -120,6 +120,9 @@ struct Fixture {
     return entries(dir.path() / "cache" / "incoming") == 0 &&
            entries(dir.path() / "cache" / "packages") == cache->counts().packages;
   }
+  // The packages on disk, counted by the folder alone: a package kept half written and counted
+  // by the cache too would leave nothing_left() true.
+  std::size_t packages_on_disk() const { return entries(dir.path() / "cache" / "packages"); }
 };
 
 } // namespace
@@ -173,6 +176,7 @@ TEST_CASE("package cache: bytes that do not hash to the package's hash are refus
   CHECK_THAT(lease.error().message, Contains("verification failed"));
   CHECK(f.cache->counts().packages == 0);
   CHECK(f.nothing_left());
+  CHECK(f.packages_on_disk() == 0);
 }
 
 TEST_CASE("package cache: a transfer cut off (fewer bytes, no reply) fails and keeps nothing",
@@ -185,6 +189,8 @@ TEST_CASE("package cache: a transfer cut off (fewer bytes, no reply) fails and k
     REQUIRE_FALSE(lease.has_value());
     CHECK_THAT(lease.error().message, Contains("transfer cut off"));
     CHECK(f.nothing_left());
+    CHECK(f.packages_on_disk() == 0); // none was there before
+    CHECK(f.cache->counts().packages == 0);
     // The domain is fine again: the next launch fetches it whole.
     f.domain.fault(FakeDomain::Fault::None);
     CHECK(f.cache->acquire(f.package(100000, 'c'), "").has_value());
