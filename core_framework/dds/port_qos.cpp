@@ -54,7 +54,8 @@ ConnectionQos with_defaults(ConnectionQos qos) {
   qos.lease = qos.lease.value_or(Duration{});
   qos.ownership = qos.ownership.value_or(Ownership::Shared);
   qos.strength = qos.strength.value_or(0);
-  qos.transport = qos.transport.value_or(Transport::Node);
+  // Not named: the nodes' when they honour the rest, else direct DDS (profile/connection_qos.hpp).
+  qos.transport = qos.transport.value_or(profile::transport_for(qos));
   return qos;
 }
 

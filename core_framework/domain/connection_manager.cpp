@@ -8,6 +8,7 @@
 #include "control/operation.hpp"
 #include "dds/port_qos.hpp"
 #include "domain/wiring.hpp"
+#include "profile/connection_qos.hpp"
 #include "protocol/topics.hpp"
 
 namespace rsca::domain {
@@ -152,6 +153,9 @@ CallResult<RuntimeConnection> ConnectionManager::connect(Request request) {
   auto qos = dds::connection_qos_from_json(request.qos);
   if (!qos)
     return control::call_error(Status::BadRequest, qos.error().to_string());
+  // A transport named that cannot carry the QoS asked for is refused, never silently weaker.
+  if (auto why = profile::not_honoured(*qos, *qos->transport))
+    return control::call_error(Status::BadRequest, *why);
   // A filter that does not parse would fail only when both ends are there: refused now.
   if (!request.filter.empty())
     if (auto filter = ContentFilter::parse(request.filter); !filter)

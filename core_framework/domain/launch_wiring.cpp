@@ -12,6 +12,7 @@
 #include "dds/port_qos.hpp"
 #include "domain/launch.hpp"
 #include "domain/wiring.hpp"
+#include "profile/connection_qos.hpp"
 #include "profile/property_binding.hpp"
 #include "profile/property_json.hpp"
 #include "protocol/component_ops.hpp"
@@ -258,7 +259,9 @@ bool ApplicationFactory::Launch::joins_dds(const ComponentInstance &c) const {
     };
     if (!is_end(conn.uses.target) && !(provides_port && is_end(conn.provides.target)))
       continue;
-    if (conn.qos && conn.qos->transport == profile::Transport::Direct)
+    // Named, or taken by the domain for a QoS the nodes cannot honour (dds/port_qos.cpp).
+    if (conn.qos && conn.qos->transport.value_or(profile::transport_for(*conn.qos)) ==
+                        profile::Transport::Direct)
       return true;
   }
   return false;

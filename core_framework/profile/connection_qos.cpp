@@ -98,7 +98,47 @@ std::optional<std::string> qos_inconsistency(const ConnectionQos &qos) {
   // A TCP stream tells a closed connection, not a writer that stopped asserting itself.
   if (qos.transport == Transport::Tcp && qos.lease && !qos.lease->infinite())
     return "transport=\"tcp\" carries no liveliness lease: use transport=\"node\" or \"direct\"";
+  if (qos.transport)
+    return not_honoured(qos, *qos.transport);
   return std::nullopt;
+}
+
+TransportHonours honours(Transport transport) {
+  switch (transport) {
+  case Transport::Direct:
+    return {Durability::Persistent, true, true};
+  case Transport::Node: // a reader replays the ring's last records (shm/ring.hpp)
+    return {Durability::TransientLocal, false, false};
+  case Transport::Tcp: // a stream keeps nothing for a later stream
+    return {Durability::Volatile, false, false};
+  }
+  return {Durability::Volatile, false, false};
+}
+
+std::optional<std::string> not_honoured(const ConnectionQos &qos, Transport transport) {
+  const TransportHonours can = honours(transport);
+  const auto refused = [transport](std::string_view asked, std::string_view why) {
+    return fmt::format("transport=\"{}\" does not honour {} ({}): leave transport out (the "
+                       "domain then takes direct DDS) or give transport=\"direct\"",
+                       to_string(transport), asked, why);
+  };
+  const Durability durability = qos.durability.value_or(Durability::Volatile);
+  if (durability > can.durability)
+    return refused(fmt::format("durability=\"{}\"", to_string(durability)),
+                   can.durability == Durability::Volatile
+                       ? "it keeps nothing for a reader that joins later"
+                       : "its history goes with the writer's node");
+  if (qos.ownership == Ownership::Exclusive && !can.exclusive_ownership)
+    return refused("ownership=\"exclusive\"", "it delivers every writer");
+  if (qos.reliability.value_or(Reliability::Reliable) == Reliability::Reliable &&
+      qos.history == History::KeepAll && !can.reliable_keep_all)
+    return refused("reliability=\"reliable\" with history=\"keepall\"",
+                   "a reader that falls behind would lose the oldest samples");
+  return std::nullopt;
+}
+
+Transport transport_for(const ConnectionQos &qos) {
+  return not_honoured(qos, Transport::Node) ? Transport::Direct : Transport::Node;
 }
 
 } // namespace rsca::profile

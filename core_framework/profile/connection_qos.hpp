@@ -32,4 +32,22 @@ tl::expected<void, std::string> set_qos_attribute(ConnectionQos &qos, std::strin
 // without exclusive ownership.
 std::optional<std::string> qos_inconsistency(const ConnectionQos &qos);
 
+// What a transport delivers of the QoS a connection can ask for: the one table that both the
+// check of a transport named (SAD, rsca connect) and the choice of one not named read. Direct DDS
+// honours all that DDS does; the nodes' rings and relays, and a TCP stream, what is listed.
+struct TransportHonours {
+  Durability durability;    // the most durable it keeps for a late joiner
+  bool exclusive_ownership; // delivers the strongest live writer only
+  bool reliable_keep_all;   // a reliable keep-all writer waits for, or reports, a slow reader
+};
+TransportHonours honours(Transport transport);
+
+// Why `transport` cannot carry a connection of `qos` (absent fields taken as their defaults),
+// or nothing when it honours every policy asked for.
+std::optional<std::string> not_honoured(const ConnectionQos &qos, Transport transport);
+
+// The transport of a connection that names none: the nodes' when they honour its QoS, else
+// direct DDS.
+Transport transport_for(const ConnectionQos &qos);
+
 } // namespace rsca::profile

@@ -98,3 +98,38 @@ TEST_CASE("connection QoS: inconsistent values are named", "[connection_qos]") {
         "depth applies only to history=\"keeplast\", not to keepall");
   CHECK_FALSE(profile::set_qos_attribute(qos, "nope", "1").has_value());
 }
+
+TEST_CASE("connection QoS: each transport honours what its table says, and a connection that "
+          "names none gets one that honours its QoS",
+          "[connection_qos][qos]") {
+  using profile::Transport;
+  auto qos_of = [](std::initializer_list<std::pair<const char *, const char *>> attributes) {
+    ConnectionQos qos;
+    for (auto [name, text] : attributes)
+      REQUIRE(profile::set_qos_attribute(qos, name, text).has_value());
+    return qos;
+  };
+  // The defaults, transient-local and best-effort keep-all travel through the nodes.
+  for (const auto &qos : {qos_of({}), qos_of({{"durability", "transientlocal"}}),
+                          qos_of({{"reliability", "besteffort"}, {"history", "keepall"}})}) {
+    CHECK(profile::transport_for(qos) == Transport::Node);
+    CHECK_FALSE(profile::not_honoured(qos, Transport::Node).has_value());
+    CHECK(dds::connection_qos_from_json(dds::qos_to_json(qos))->transport == Transport::Node);
+  }
+  // What the rings and relays cannot honour goes on direct DDS, or is refused when named.
+  for (const auto &qos : {qos_of({{"ownership", "exclusive"}}), qos_of({{"history", "keepall"}}),
+                          qos_of({{"durability", "transient"}})}) {
+    CHECK(profile::transport_for(qos) == Transport::Direct);
+    CHECK_FALSE(profile::not_honoured(qos, Transport::Direct).has_value());
+    CHECK(dds::qos_to_json(qos).at("transport") == "direct");
+    CHECK(profile::not_honoured(qos, Transport::Node).has_value());
+  }
+  auto exclusive = qos_of({{"ownership", "exclusive"}, {"transport", "node"}});
+  CHECK(profile::qos_inconsistency(exclusive) ==
+        "transport=\"node\" does not honour ownership=\"exclusive\" (it delivers every "
+        "writer): leave transport out (the domain then takes direct DDS) or give "
+        "transport=\"direct\"");
+  auto late = qos_of({{"durability", "transientlocal"}, {"transport", "tcp"}});
+  CHECK_THAT(profile::qos_inconsistency(late).value_or(""),
+             Catch::Contains("transport=\"tcp\" does not honour durability=\"transientlocal\""));
+}

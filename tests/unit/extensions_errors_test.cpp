@@ -41,6 +41,37 @@ TEST_CASE("qos strength without exclusive ownership is an error", "[extensions][
   }
 }
 
+TEST_CASE("a transport named that cannot honour the connection's QoS is an error, with the reason",
+          "[extensions][errors][qos]") {
+  struct Case {
+    std::string_view qos;
+    std::string_view says;
+  };
+  for (const Case &c :
+       {Case{
+            R"(<qos ownership="exclusive" strength="2" transport="node"/>)",
+            R"(transport="node" does not honour ownership="exclusive" (it delivers every writer))"},
+        Case{R"(<qos history="keepall" transport="node"/>)",
+             R"(does not honour reliability="reliable" with history="keepall")"},
+        Case{R"(<qos durability="transientlocal" transport="tcp"/>)",
+             R"(transport="tcp" does not honour durability="transientlocal")"},
+        Case{R"(<qos durability="persistent" transport="node"/>)",
+             R"(transport="node" does not honour durability="persistent")"}}) {
+    INFO(c.qos);
+    const std::string text = sad_text("", port_connection("c", c.qos));
+    const Diagnostic d = sad_error(text);
+    CHECK(d.rule == "qos");
+    CHECK(d.where.file == "extensions.sad.xml");
+    CHECK(d.where.line == line_of(text, "<qos "));
+    CHECK(d.where.column > 0);
+    CHECK_THAT(d.message, Contains(std::string(c.says)) && Contains("transport=\"direct\""));
+  }
+  // The same QoS without a transport is read: the domain takes one that honours it.
+  const std::string text = sad_text(
+      "", port_connection("c", R"(<qos ownership="exclusive" strength="2" history="keepall"/>)"));
+  CHECK(sad_of(text).connections.size() == 1);
+}
+
 TEST_CASE("a TCP stream with a liveliness lease, or to an event channel, is an error",
           "[extensions][errors][qos]") {
   // A stream tells a closed connection, not a writer that stopped asserting itself.
