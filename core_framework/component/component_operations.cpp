@@ -270,6 +270,7 @@ CallResult<protocol::Empty> Host::op_start(const Empty &, const Context &) {
       return tl::unexpected(ok.error());
   }
   loop_->set_delivering(true);
+  loop_->wake_in_host(); // what durable readers kept before the start is delivered now
   start_service();
   set_state(State::Started);
   return Empty{};
@@ -303,6 +304,8 @@ CallResult<op::StatusReply> Host::op_status(const Empty &, const Context &) {
       connection.samples = s.samples;
       connection.filtered = s.filtered;
       connection.deadline_missed = s.deadline_missed;
+      if (s.deadline_ns > 0)
+        connection.deadline_ns = s.deadline_ns;
       connection.in_host = s.in_host;
       if (s.same_host)
         connection.same_host = true;

@@ -47,6 +47,7 @@ struct DataConnection {
   std::uint32_t deadline_periods_reported = 0; // provides: of the current gap (receive thread)
   std::int64_t deadline_gap_ns = 0; // provides: the last_sample_ns that gap began at (same)
   bool watched = false; // a reader with a deadline or a liveliness lease: problems to look for
+  bool durable = false; // a transient-local reader: what arrives before the start is kept
 
   // Same-host: the ring's writer or reader; the deadline as in-host. Lost writers already
   // reported (provides, receive thread).

@@ -104,6 +104,15 @@ std::pair<std::chrono::nanoseconds, bool> liveliness_lease(const dds_qos_t *qos)
   return {std::chrono::nanoseconds{lease}, kind == DDS_LIVELINESS_AUTOMATIC};
 }
 
+// Transient-local or more durable: the reader is owed the writer's history, and keeps what
+// arrives before its component starts (DDS keeps it in the reader's history until taken).
+bool durable(const dds_qos_t *qos) {
+  dds_durability_kind_t kind = DDS_DURABILITY_VOLATILE;
+  if (qos != nullptr)
+    dds_qget_durability(qos, &kind);
+  return kind != DDS_DURABILITY_VOLATILE;
+}
+
 // Whether a reader with this QoS can have problems to report (take_problems).
 bool has_problems_to_watch(const dds_qos_t *qos) {
   return requested_deadline(qos).count() > 0 || liveliness_lease(qos).first.count() > 0;
@@ -156,6 +165,8 @@ Expected<void> PortBase::connect(dds_entity_t participant, detail::ReceiveLoop *
   c->topic_name = topic;
   c->filter = std::move(filter);
   c->watched = direction_ == profile::PortDirection::Provides && has_problems_to_watch(qos);
+  c->durable = direction_ == profile::PortDirection::Provides && durable(qos);
+  c->deadline = requested_deadline(qos); // what status reports; DDS counts its own misses
   if (local || ring) {
     auto opened = local ? open_local(loop, std::move(c), qos)
                         : open_same_host(loop, std::move(c), qos, *ring);
@@ -228,8 +239,10 @@ PortBase::open_same_host(detail::ReceiveLoop *loop, std::unique_ptr<DataConnecti
   if (loop == nullptr || !loop->doorbell())
     return make_error({"port", 0, 0}, "port", "no receive loop in the host's arena to ring");
   const auto depth = static_cast<std::uint32_t>(history_depth(qos));
-  auto reader =
-      shm::RingReader::open(arena->arena(), ring.offset, ring.slot, *loop->doorbell(), depth);
+  // A transient-local reader starts at the last `depth` records the ring holds (all, keepall).
+  const std::uint32_t history = c->durable ? (depth == 0 ? ~0U : depth) : 0;
+  auto reader = shm::RingReader::open(arena->arena(), ring.offset, ring.slot, *loop->doorbell(),
+                                      depth, /*skip_relayed=*/false, history);
   if (!reader)
     return make_error({"port", 0, 0}, "port", reader.error());
   c->ring_reader.emplace(std::move(*reader));
@@ -254,8 +267,8 @@ std::vector<ConnectionStatus> PortBase::status() const {
   out.reserve(connections_.size());
   for (const auto &[id, c] : connections_)
     out.push_back({id, c->topic_name, matched_count(*c, direction_), c->samples.load(),
-                   c->filtered.load(), deadline_misses(*c, direction_), c->in_host(),
-                   c->same_host(), c->relayed, c->tcp()});
+                   c->filtered.load(), deadline_misses(*c, direction_), c->deadline.count(),
+                   c->in_host(), c->same_host(), c->relayed, c->tcp()});
   return out;
 }
 
@@ -380,6 +393,8 @@ template <typename T>
 void ProvidesPort<T>::take_all(bool deliver) {
   std::shared_lock lock(mutex_);
   for (const auto &[id, c] : connections_) {
+    if (!deliver && c->durable)
+      continue; // kept for the component's start: it may be the history it is owed
     if (c->in_host() || c->tcp_in)
       take_local(*c, deliver);
     else if (c->ring_reader)

@@ -41,6 +41,7 @@ struct ConnectionStatus {
   std::uint64_t samples = 0;         // written (uses) or received (provides)
   std::uint64_t filtered = 0;        // provides: received but not delivered (the content filter)
   std::uint32_t deadline_missed = 0; // the connection's deadline, missed (offered or requested)
+  std::int64_t deadline_ns = 0;      // the deadline the end was made with (0: none)
   bool in_host = false;              // both ends in one process: no DDS entities
   bool same_host = false;            // both ends on one host: a ring in shared memory
   bool relayed = false;              // a ring the node relays to and from the ends on other hosts

@@ -38,14 +38,17 @@ Json end_state(const StatusOf &status_of, const std::string &address, const std:
         continue;
       if (c.calls)
         return Json{{"calls", *c.calls}}; // a caller of a supported interface
-      return Json{{"matched", c.matched.value_or(0)},
-                  {"samples", c.samples.value_or(0)},
-                  {"filtered", c.filtered.value_or(0)},
-                  {"deadline_missed", c.deadline_missed.value_or(0)},
-                  {"in_host", c.in_host.value_or(false)},
-                  {"same_host", c.same_host.value_or(false)},
-                  {"relayed", c.relayed.value_or(false)},
-                  {"tcp", c.tcp.value_or(false)}};
+      Json state{{"matched", c.matched.value_or(0)},
+                 {"samples", c.samples.value_or(0)},
+                 {"filtered", c.filtered.value_or(0)},
+                 {"deadline_missed", c.deadline_missed.value_or(0)},
+                 {"in_host", c.in_host.value_or(false)},
+                 {"same_host", c.same_host.value_or(false)},
+                 {"relayed", c.relayed.value_or(false)},
+                 {"tcp", c.tcp.value_or(false)}};
+      if (c.deadline_ns)
+        state["deadline_ns"] = *c.deadline_ns; // the deadline the end applies
+      return state;
     }
   }
   return nullptr;

@@ -112,6 +112,7 @@ struct ConnectionStatus {
   std::optional<std::uint64_t> samples;
   std::optional<std::uint64_t> filtered;
   std::optional<std::uint64_t> deadline_missed;
+  std::optional<std::int64_t> deadline_ns; // the end's deadline; absent: none
   std::optional<bool> in_host;
   std::optional<bool> same_host;
   std::optional<bool> relayed;       // same_host, and the node relays it to other hosts
@@ -121,12 +122,13 @@ struct ConnectionStatus {
   static constexpr auto fields() {
     using R = ConnectionStatus;
     return std::tuple{
-        required("connection", &R::connection), optional("topic", &R::topic),
-        optional("matched", &R::matched),       optional("samples", &R::samples),
-        optional("filtered", &R::filtered),     optional("deadline_missed", &R::deadline_missed),
-        optional("in_host", &R::in_host),       optional("same_host", &R::same_host),
-        optional("relayed", &R::relayed),       optional("tcp", &R::tcp),
-        optional("target", &R::target),         optional("calls", &R::calls)};
+        required("connection", &R::connection),  optional("topic", &R::topic),
+        optional("matched", &R::matched),        optional("samples", &R::samples),
+        optional("filtered", &R::filtered),      optional("deadline_missed", &R::deadline_missed),
+        optional("in_host", &R::in_host),        optional("same_host", &R::same_host),
+        optional("relayed", &R::relayed),        optional("tcp", &R::tcp),
+        optional("target", &R::target),          optional("calls", &R::calls),
+        optional("deadline_ns", &R::deadline_ns)};
   }
 };
 

@@ -147,7 +147,7 @@ struct CreateReply : ConnectionView {
 
 // One connection in connection.list, with each end's live state as its owner reports it
 // ({"matched", "samples", "filtered", "deadline_missed", "in_host", "same_host",
-// "relayed", "tcp"}, or {"calls"}
+// "relayed", "tcp", and "deadline_ns" when the end has a deadline}, or {"calls"}
 // for a caller of a supported interface), null when the end shows none: JSON, so that null stays
 // null.
 struct ListedConnection : ConnectionView {

@@ -1,5 +1,6 @@
 #include "shm/ring.hpp"
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <new>
@@ -227,7 +228,8 @@ void RingWriter::ring_readers() const {
 
 tl::expected<RingReader, std::string> RingReader::open(const Arena &arena, std::uint64_t offset,
                                                        std::uint32_t slot, std::uint64_t doorbell,
-                                                       std::uint32_t depth, bool skip_relayed) {
+                                                       std::uint32_t depth, bool skip_relayed,
+                                                       std::uint32_t history) {
   auto view = RingView::open(arena, offset);
   if (!view)
     return tl::unexpected(view.error());
@@ -243,7 +245,10 @@ tl::expected<RingReader, std::string> RingReader::open(const Arena &arena, std::
   s.state.store(detail::kSlotActive, std::memory_order_seq_cst);
   // After the slot is active (publish() says why the order matters): what is published from
   // here on either is read from this cursor or rings the doorbell.
-  reader.cursor_ = view->header->next_seq.load(std::memory_order_seq_cst);
+  // History starts at the oldest record the ring still holds, at most `history` back.
+  const std::uint64_t next = view->header->next_seq.load(std::memory_order_seq_cst);
+  const std::uint64_t oldest = view->header->oldest.load(std::memory_order_acquire);
+  reader.cursor_ = std::max(oldest, next - std::min<std::uint64_t>(next, history));
   return reader;
 }
 

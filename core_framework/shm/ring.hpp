@@ -3,10 +3,11 @@
 // robust process-shared lock) and up to kMaxRingReaders readers, each with its own cursor.
 //
 // A writer never waits for a reader: a record that does not fit overwrites the oldest, and a
-// reader that fell behind loses what was overwritten and counts it. Within that bound delivery is
-// reliable and in order; a reader of history depth n takes only the newest n records at each take
-// (KEEP_LAST). Records are copied out by the reader; one that a writer overwrote while it was
-// read is found (the ring's `oldest` passed it: a sequence lock) and dropped, never delivered.
+// reader that fell behind loses what was overwritten and counts it. The records a ring still
+// holds are the topic's history: a transient-local reader starts among them. Within that bound
+// delivery is reliable and in order; a reader of history depth n takes only the newest n records at
+// each take (KEEP_LAST). Records are copied out by the reader; one that a writer overwrote while it
+// was read is found (the ring's `oldest` passed it: a sequence lock) and dropped, never delivered.
 //
 // The parties, each with what it may do (as iceoryx splits a port): the node makes the ring and
 // owns its bookkeeping (RingOwner: slots, writer counts); a writer (RingWriter) and a reader
@@ -173,11 +174,14 @@ private:
 class RingReader {
 public:
   // Activates `slot`, whose writers from now on ring `doorbell` (an offset in the arena). It
-  // reads what is written from now on; `depth` 0 keeps all (up to the ring's records).
-  // `skip_relayed`: records of Origin::Relayed are passed over (the node's relay to DDS).
+  // reads what is written from now on and, with `history` n, the last n records the ring still
+  // holds (a transient-local late joiner: DDS replays a writer's last samples to it); `depth` 0
+  // keeps all (up to the ring's records). `skip_relayed`: records of Origin::Relayed are passed
+  // over (the node's relay to DDS).
   static tl::expected<RingReader, std::string> open(const Arena &arena, std::uint64_t offset,
                                                     std::uint32_t slot, std::uint64_t doorbell,
-                                                    std::uint32_t depth, bool skip_relayed = false);
+                                                    std::uint32_t depth, bool skip_relayed = false,
+                                                    std::uint32_t history = 0);
   RingReader(RingReader &&other) noexcept;
   RingReader &operator=(RingReader &&) = delete;
   RingReader(const RingReader &) = delete;

@@ -44,6 +44,17 @@ std::vector<std::uint64_t> take_numbers(shm::RingReader &reader) {
   return out;
 }
 
+// What a reader of a ring of `most` records took after a writer wrote up to `last`: the newest
+// records, in order, ending at `last`, none torn or repeated.
+void check_newest_in_order(const std::vector<std::uint64_t> &got, std::uint64_t last,
+                           std::size_t most) {
+  REQUIRE_FALSE(got.empty());
+  CHECK(got.size() <= most);
+  CHECK(got.back() == last);
+  for (std::size_t i = 1; i < got.size(); ++i)
+    CHECK(got[i] == got[i - 1] + 1);
+}
+
 struct RingFixture {
   shm::Arena arena = shm::Arena::create(8 << 20).value();
   shm::ArenaAllocator allocator{arena.size()};
@@ -153,6 +164,29 @@ TEST_CASE("shm: a reader of depth n takes the newest n and counts the rest dropp
   CHECK(reader.dropped() == 3);
 }
 
+TEST_CASE("shm: a transient-local reader starts at the last records the ring still holds",
+          "[shm][qos]") {
+  RingFixture f;
+  auto [owner, at] = f.make({4096, 16});
+  auto writer = shm::RingWriter::open(f.arena, at).value();
+  for (std::uint64_t i = 0; i < 5; ++i)
+    REQUIRE(write_number(writer, i));
+  // History 3 of 5 written: the last three, then what comes.
+  auto late = shm::RingReader::open(f.arena, at, owner.claim_reader().value(), f.bell_at, 0,
+                                    /*skip_relayed=*/false, /*history=*/3)
+                  .value();
+  REQUIRE(write_number(writer, 5));
+  CHECK(take_numbers(late) == std::vector<std::uint64_t>{2, 3, 4, 5});
+  CHECK(late.dropped() == 0);
+  // More history than the ring holds: what it holds (16 records), none overwritten delivered.
+  for (std::uint64_t i = 6; i < 40; ++i)
+    REQUIRE(write_number(writer, i));
+  auto all = shm::RingReader::open(f.arena, at, owner.claim_reader().value(), f.bell_at, 0,
+                                   /*skip_relayed=*/false, /*history=*/1000)
+                 .value();
+  check_newest_in_order(take_numbers(all), 39, 16);
+}
+
 TEST_CASE("shm: a writer never waits: a reader that fell behind loses the oldest, never a torn "
           "one",
           "[shm]") {
@@ -163,11 +197,7 @@ TEST_CASE("shm: a writer never waits: a reader that fell behind loses the oldest
   for (std::uint64_t i = 0; i < 100; ++i)
     REQUIRE(write_number(writer, i));
   const auto got = take_numbers(reader);
-  REQUIRE_FALSE(got.empty());
-  CHECK(got.size() <= 16);
-  CHECK(got.back() == 99);
-  for (std::size_t i = 1; i < got.size(); ++i)
-    CHECK(got[i] == got[i - 1] + 1);
+  check_newest_in_order(got, 99, 16);
   CHECK(reader.dropped() + got.size() == 100);
   // A record larger than half the ring is refused, and nothing is published.
   CHECK_FALSE(writer.write(4096, [](std::byte *) {}).has_value());
