@@ -112,6 +112,12 @@ int first_free_number(const Command &command) {
   return above;
 }
 
+// Whether the child is given a descriptor as `fd` (Command::inherit).
+bool given_as(const std::vector<Command::Inherited> &inherit, int fd) {
+  return std::any_of(inherit.begin(), inherit.end(),
+                     [fd](const Command::Inherited &i) { return i.as == fd; });
+}
+
 // A copy of `fd` at `above` or higher, close-on-exec; an empty Fd on failure (errno says why).
 Fd copy_above(int fd, int above) {
   return Fd{::fcntl(fd, F_DUPFD_CLOEXEC, above)};
@@ -160,6 +166,13 @@ int prepare_files(SpawnActions &actions, const Command &command, int log_fd,
   for (std::size_t i = 0; rc == 0 && i < command.inherit.size(); ++i) {
     rc = ::posix_spawn_file_actions_adddup2(actions.get(), inherited[i].get(),
                                             command.inherit[i].as);
+  }
+  // Between stderr and the numbers given, those not given are closed too (an open one is not
+  // an error: glibc ignores a descriptor that is not open).
+  for (int fd = STDERR_FILENO + 1; rc == 0 && fd < first_free_number(command); ++fd) {
+    if (!given_as(command.inherit, fd)) {
+      rc = ::posix_spawn_file_actions_addclose(actions.get(), fd);
+    }
   }
   if (rc == 0) {
     rc = ::posix_spawn_file_actions_addclosefrom_np(actions.get(), first_free_number(command));
@@ -258,6 +271,19 @@ Expected<std::vector<Fd>> copy_inherited(const Command &command) {
   return inherited;
 }
 
+// The child's argv and envp, and the strings they point into (neither copied nor moved).
+struct ExecStrings {
+  explicit ExecStrings(const Command &command)
+      : arguments(child_arguments(command)), environment(child_environment(command)),
+        argv(c_strings(arguments)), envp(c_strings(environment)) {}
+  ExecStrings(const ExecStrings &) = delete;
+  ExecStrings &operator=(const ExecStrings &) = delete;
+  std::vector<std::string> arguments;
+  std::vector<std::string> environment;
+  std::vector<char *> argv;
+  std::vector<char *> envp;
+};
+
 // Runs the program in a new process; exec failures come back from posix_spawn itself (glibc
 // reaps the child that failed to exec).
 Expected<pid_t> start(const Command &command, Group group, int log_fd) {
@@ -276,21 +302,18 @@ Expected<pid_t> start(const Command &command, Group group, int log_fd) {
     return spawn_error(command, fmt::format("cannot prepare to execute {}: {}",
                                             command.program.string(), errno_text(rc)));
   }
-  auto arguments = child_arguments(command);
-  auto environment = child_environment(command);
-  auto argv = c_strings(arguments);
-  auto envp = c_strings(environment);
+  ExecStrings strings(command);
   pid_t pid = 0;
-  rc = ::posix_spawn(&pid, command.program.c_str(), actions.get(), attributes.get(), argv.data(),
-                     envp.data());
+  rc = ::posix_spawn(&pid, command.program.c_str(), actions.get(), attributes.get(),
+                     strings.argv.data(), strings.envp.data());
   // ETXTBSY: a file this process has just written (a node's package) is still open for writing
   // in a child another thread cloned while it was being written, until that child closes its
   // descriptors on its way to exec: a few milliseconds at most on a loaded host. Seen in CI: two
   // packages fetched at once, one executed while the other's child was starting.
   for (int delay_ms = 1; rc == ETXTBSY && delay_ms <= 64; delay_ms *= 2) {
     std::this_thread::sleep_for(std::chrono::milliseconds(delay_ms));
-    rc = ::posix_spawn(&pid, command.program.c_str(), actions.get(), attributes.get(), argv.data(),
-                       envp.data());
+    rc = ::posix_spawn(&pid, command.program.c_str(), actions.get(), attributes.get(),
+                       strings.argv.data(), strings.envp.data());
   }
   if (rc != 0) {
     return spawn_error(
@@ -364,6 +387,11 @@ const char *hand_descriptors(const ForkPlan &plan) {
   for (std::size_t i = 0; i < plan.inherit->size(); ++i) {
     if (::dup2((*plan.inherited)[i].get(), (*plan.inherit)[i].as) < 0) {
       return "dup2";
+    }
+  }
+  for (int fd = STDERR_FILENO + 1; fd < plan.first_closed; ++fd) {
+    if (!given_as(*plan.inherit, fd)) {
+      ::close(fd); // one that is not open: nothing to do
     }
   }
   const auto report = static_cast<unsigned>(plan.report_fd);
@@ -456,13 +484,10 @@ Expected<pid_t> start_forked(const Command &command, Group group, int log_fd) {
     return spawn_error(command, fmt::format("cannot prepare to execute {}: {}",
                                             command.program.string(), errno_text(errno)));
   }
-  auto arguments = child_arguments(command);
-  auto environment = child_environment(command);
-  auto argv = c_strings(arguments);
-  auto envp = c_strings(environment);
+  ExecStrings strings(command);
   const ForkPlan plan{.program = command.program.c_str(),
-                      .argv = argv.data(),
-                      .envp = envp.data(),
+                      .argv = strings.argv.data(),
+                      .envp = strings.envp.data(),
                       .working_dir =
                           command.working_dir.empty() ? nullptr : command.working_dir.c_str(),
                       .null_fd = null.get(),

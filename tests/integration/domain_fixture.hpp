@@ -406,6 +406,16 @@ cached_package_of(const TestDomain &domain, const std::string &node, const std::
   throw std::logic_error("unreachable");
 }
 
+// The package of `program` (a component of Healthy) that node1 took from its cache for Healthy,
+// launched then released, and the program's folder in it: a node runs only programs of a
+// package its domain delivered, which a test's own node.execute names too.
+inline std::pair<Json, std::string> delivered_package_of(TestDomain &domain,
+                                                         const std::string &program) {
+  domain.create("Healthy");
+  REQUIRE(domain.call("app.release", Json{{"app", "Healthy"}}).has_value());
+  return cached_package_of(domain, "node1", program);
+}
+
 // Node daemon `index` frozen (SIGSTOP), as a hung node is: it answers no call and, past its DDS
 // lease, the domain loses it. Resumed however the test ends, so that the domain can stop it.
 class FrozenNode {

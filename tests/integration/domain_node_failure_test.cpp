@@ -43,14 +43,6 @@ std::vector<long> pids_on_node(TestDomain &domain, int index) {
   return pids;
 }
 
-// The package of rsca-test-faulty that node1 took from its cache for Healthy (launched, then
-// released): a node runs only programs of a package its domain delivered.
-std::pair<Json, std::string> delivered_faulty(TestDomain &domain) {
-  domain.create("Healthy");
-  REQUIRE(domain.call("app.release", Json{{"app", "Healthy"}}).has_value());
-  return cached_package_of(domain, "node1", "rsca-test-faulty");
-}
-
 // Launches HangAtConfigure with the CLI going through `socket` (node1's or node2's): Victim_1 on
 // node1, Producer_1 on node2; the launch hangs in configure, and node1 is killed.
 KilledDuringLaunch kill_node1_during_launch(TestDomain &domain, const std::string &socket) {
@@ -237,7 +229,7 @@ TEST_CASE("a node does not start a process whose caller has stopped waiting, and
   auto nodes = domain.call("domain.nodes");
   REQUIRE(nodes.has_value());
   const std::string node = nodes->at("nodes")[0].at("address");
-  const auto [package, spd_dir] = delivered_faulty(domain);
+  const auto [package, spd_dir] = delivered_package_of(domain, "rsca-test-faulty");
   // A process that waits for its signal (and marks it in a file of this test's).
   const fs::path marker = fs::temp_directory_path() / fmt::format("rsca-it-budget-{}", ::getpid());
   auto execute = [&](std::int64_t budget_ms) {
@@ -304,7 +296,7 @@ TEST_CASE("a node daemon stopped after or while it ends a process exits cleanly,
     if (d.at("kind") == "gpp")
       gpp = d.at("id");
   REQUIRE_FALSE(gpp.empty());
-  const auto [package, spd_dir] = delivered_faulty(domain);
+  const auto [package, spd_dir] = delivered_package_of(domain, "rsca-test-faulty");
   const fs::path marker =
       fs::temp_directory_path() / fmt::format("rsca-it-signalled-{}", ::getpid());
   fs::remove(marker);

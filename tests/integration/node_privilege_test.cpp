@@ -69,10 +69,8 @@ TEST_CASE("node.execute runs no program but one of a package in its cache: a she
           "peer is refused with the reason and never runs",
           "[integration][hostile]") {
   TestDomain domain(1);
-  domain.create("Healthy");
   // A real package, as the domain delivered it: a hostile peer may name one too.
-  const Json package = cached_package_of(domain, "node1", "rsca-test-faulty").first;
-  REQUIRE(domain.call("app.release", Json{{"app", "Healthy"}}).has_value());
+  const Json package = delivered_package_of(domain, "rsca-test-faulty").first;
   const fs::path proof = domain.run_dir() / "proof";
   const Json evil = evil_request(proof);
   const std::vector<std::pair<Json, std::string>> refused{
@@ -96,10 +94,8 @@ TEST_CASE("names that would be paths on a node are refused by the node, and noth
           "outside its log folder",
           "[integration][hostile]") {
   TestDomain domain(1);
-  domain.create("Healthy");
   // A real package, as the domain delivered it: a hostile peer may name one too.
-  const Json package = cached_package_of(domain, "node1", "rsca-test-faulty").first;
-  REQUIRE(domain.call("app.release", Json{{"app", "Healthy"}}).has_value());
+  const Json package = delivered_package_of(domain, "rsca-test-faulty").first;
   const Json host = {
       {"entrypoint", "rsca-component-host"}, {"args", Json::array()}, {"package", package}};
   for (const auto &[application, component] :

@@ -306,8 +306,9 @@ TEST_CASE("a child given a user runs as that user, with its groups and nothing e
   CHECK(signals_in(status_field(status, "SigIgn")).empty());
   CHECK(signals_in(status_field(status, "SigBlk")).empty());
   // Its descriptors are a spawned child's: stdin, its log, the one it is given.
+  const TempDir other; // a log of its own
   const auto listed = output_of(
-      dir,
+      other,
       {.program = "/bin/ls", .args = {"/proc/self/fd"}, .inherit = {{leaky, 5}}, .user = nobody});
   ::close(leaky);
   CHECK(listed == "0\n1\n2\n3\n5\n");
