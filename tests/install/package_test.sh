@@ -77,6 +77,10 @@ for tool in systemctl deb-systemd-invoke deb-systemd-helper; do
   printf '#!/bin/sh\necho "%s $*" >>"%s"\n' "$tool" "$calls" >"$stubs/$tool"
   chmod +x "$stubs/$tool"
 done
+# adduser too, in a record of its own: the test makes no user on its host.
+users="$work/adduser.calls"
+printf '#!/bin/sh\necho "adduser $*" >>"%s"\n' "$users" >"$stubs/adduser"
+chmod +x "$stubs/adduser"
 for run in "postinst configure" "prerm upgrade 0.1.0" "postinst configure 0.1.0" \
            "prerm remove" "postrm remove"; do
   # shellcheck disable=SC2086 # a script's name, then its arguments
@@ -84,6 +88,9 @@ for run in "postinst configure" "prerm upgrade 0.1.0" "postinst configure 0.1.0"
   PATH="$stubs:$PATH" sh "$control/$1" "${@:2}" >"$work/script.log" 2>&1 ||
     { cat "$work/script.log"; fail "$run exits with $?"; }
 done
+# The system user the nodes run components as (the GPP's run_as), made where it is missing.
+getent passwd rsca >/dev/null || grep -q 'adduser --system --group .* rsca$' "$users" ||
+  fail "postinst configure does not make the system user rsca"
 if [ -d /run/systemd/system ]; then
   grep -q 'systemctl --system daemon-reload' "$calls" || fail "no daemon-reload under systemd"
   grep -q 'stop rsca-domaind.service' "$calls" || fail "prerm remove does not stop rsca-domaind"
