@@ -6,6 +6,7 @@
 // children.
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <set>
 #include <string>
 
@@ -58,11 +59,23 @@ std::set<std::string> served_files() {
   return files;
 }
 
-// Forks `program` through the pool, which must fork it, and reaps what it started.
-void fork_through(ForkServers &pool, const fs::path &program) {
+// The real uid of process `pid`.
+long uid_of(pid_t pid) {
+  std::ifstream status(fs::path("/proc") / std::to_string(pid) / "status");
+  for (std::string line; std::getline(status, line);)
+    if (line.rfind("Uid:", 0) == 0)
+      return std::stol(line.substr(4));
+  return -1;
+}
+
+// Forks `program` through the pool, which must fork it, as `user` (none: as this process), and
+// reaps what it started.
+void fork_through(ForkServers &pool, const fs::path &program,
+                  const std::optional<rsca::process::Credentials> &user = std::nullopt) {
   ExecRequest request;
   request.program = program;
   request.args = {"0"};
+  request.user = user;
   auto child = pool.fork(request);
   INFO(program.string());
   REQUIRE(child.has_value());
@@ -150,4 +163,29 @@ TEST_CASE("the GPP's fork servers: the least recently used goes past the limit, 
   CHECK(files.count(deleted.string() + " (deleted)") == 0);
   CHECK(files.count(programs[2].string()) == 1);
   CHECK(files.count(fresh.string()) == 1);
+}
+
+TEST_CASE("the GPP's fork servers: one per user, each running as its user",
+          "[process][fork_server]") {
+  INFO("only root may start a process as another user: the tests run as root");
+  REQUIRE(::geteuid() == 0);
+  REQUIRE(::prctl(PR_SET_CHILD_SUBREAPER, 1) == 0);
+  auto nobody = rsca::process::credentials_of("nobody");
+  REQUIRE(nobody.has_value());
+  {
+    ForkServers pool;
+    fork_through(pool, kForkedProgram, *nobody);
+    const auto as_nobody = fork_servers_here();
+    REQUIRE(as_nobody.size() == 1);
+    CHECK(uid_of(*as_nobody.begin()) == static_cast<long>(nobody->uid));
+    fork_through(pool, kForkedProgram); // the same file, as this process: a server of its own
+    const auto both = fork_servers_here();
+    CHECK(both.size() == 2);
+    for (const pid_t server : both)
+      if (as_nobody.count(server) == 0)
+        CHECK(uid_of(server) == static_cast<long>(::geteuid()));
+    fork_through(pool, kForkedProgram, *nobody);
+    CHECK(fork_servers_here() == both);
+  }
+  CHECK(fork_servers_here().empty());
 }
