@@ -158,10 +158,16 @@ Qos make_dds_qos(const ConnectionQos &qos) {
   dds_qos_t *q = out.get();
   dds_qset_reliability(q, dds_kind(*qos.reliability), kMaxBlockingTime);
   dds_qset_durability(q, dds_kind(*qos.durability));
-  if (qos.history == History::KeepAll)
-    dds_qset_history(q, DDS_HISTORY_KEEP_ALL, DDS_LENGTH_UNLIMITED);
-  else
-    dds_qset_history(q, DDS_HISTORY_KEEP_LAST, static_cast<std::int32_t>(*qos.depth));
+  const bool keep_all = qos.history == History::KeepAll;
+  const auto kind = keep_all ? DDS_HISTORY_KEEP_ALL : DDS_HISTORY_KEEP_LAST;
+  const std::int32_t depth =
+      keep_all ? DDS_LENGTH_UNLIMITED : static_cast<std::int32_t>(*qos.depth);
+  dds_qset_history(q, kind, depth);
+  // What a late joiner is replayed: Cyclone keeps the durability service's depth (1 by default),
+  // not the history's, for a transient-local writer.
+  if (*qos.durability != Durability::Volatile)
+    dds_qset_durability_service(q, 0, kind, depth, DDS_LENGTH_UNLIMITED, DDS_LENGTH_UNLIMITED,
+                                DDS_LENGTH_UNLIMITED);
   dds_qset_deadline(q, dds_duration(*qos.deadline));
   dds_qset_latency_budget(q, dds_duration(*qos.latency_budget));
   dds_qset_transport_priority(q, *qos.transport_priority);

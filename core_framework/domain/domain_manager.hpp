@@ -16,6 +16,7 @@
 #include "control/endpoint.hpp"
 #include "domain/application_factory.hpp"
 #include "domain/component_registry.hpp"
+#include "domain/delivered_code.hpp"
 #include "domain/domain_store.hpp"
 
 namespace rsca::domain {
@@ -26,6 +27,7 @@ struct DomainOptions {
   // Where code an SPD names that its install did not carry is found, by file name (executables;
   // libraries also in the lib folder beside each): rsca's own component folders.
   std::vector<std::filesystem::path> exec_path;
+  CodeDelivery delivery = CodeDelivery::Stripped; // what nodes get of code files (file_manager.hpp)
   std::chrono::milliseconds registration_timeout{10000};
   std::chrono::milliseconds call_timeout{5000};
   allocator::Strategy strategy = allocator::Strategy::Pack; // placement, unless a launch says

@@ -10,7 +10,9 @@
 
 #include <fmt/format.h>
 
+#include "common/names.hpp"
 #include "content/sha256.hpp"
+#include "content/zstd.hpp"
 #include "process/fd.hpp"
 #include "profile/runtime_model.hpp"
 
@@ -28,16 +30,18 @@ CallResult<void> fail(Status status, std::string message) {
   return protocol::call_error(status, std::move(message));
 }
 
-// Drops the least recently used entry of `map` once it holds more than kMaxKept.
+// Drops the least recently used entry of `map` once it holds more than kMaxKept; returns it.
 template <typename Map>
-void bound(Map &map) {
+std::optional<typename Map::mapped_type> bound(Map &map) {
   if (map.size() <= kMaxKept)
-    return;
+    return std::nullopt;
   auto oldest = map.begin();
   for (auto it = map.begin(); it != map.end(); ++it)
     if (it->second.last_use < oldest->second.last_use)
       oldest = it;
+  auto dropped = std::move(oldest->second);
   map.erase(oldest);
+  return dropped;
 }
 
 bool is_executable_file(const fs::path &file) {
@@ -47,8 +51,10 @@ bool is_executable_file(const fs::path &file) {
 
 } // namespace
 
-FileManager::FileManager(fs::path repository, std::vector<fs::path> exec_path)
-    : repository_(fs::weakly_canonical(repository)), exec_path_(std::move(exec_path)) {}
+FileManager::FileManager(fs::path repository, std::vector<fs::path> exec_path,
+                         CodeDelivery delivery)
+    : repository_(fs::weakly_canonical(repository)), exec_path_(std::move(exec_path)),
+      delivery_(delivery), code_(repository_) {}
 
 std::string FileManager::package_path(const fs::path &file) const {
   const fs::path relative = file.lexically_normal().lexically_relative(repository_);
@@ -141,6 +147,9 @@ CallResult<void> FileManager::add_code(const profile::ResolvedSoftPkg &softpkg,
   const auto &code = implementation.implementation->code;
   if (code.file.name.empty())
     return {};
+  // REDHAWK allows code installed on the node itself; a node runs only code of its package
+  // (gpp/gpp_device.cpp), the control plane not being authenticated: refused here, before any
+  // node is asked.
   if (fs::path(code.file.name).is_absolute())
     return fail(Status::BadRequest,
                 fmt::format("{}: code file {} is an absolute path: a node runs only code the "
@@ -150,9 +159,6 @@ CallResult<void> FileManager::add_code(const profile::ResolvedSoftPkg &softpkg,
   const std::string path = package_path(spd_dir / code.file.name);
   if (path.empty())
     return fail(Status::BadRequest,
-  // REDHAWK allows code installed on the node itself; a node runs only code of its package
-  // (gpp/gpp_device.cpp), the control plane not being authenticated: refused here, before any
-  // node is asked.
                 fmt::format("{}: code file {} lies outside the application's folder",
                             softpkg.spd_path.string(), code.file.name));
   auto found = find_code(spd_dir, code.file.name);
@@ -208,37 +214,56 @@ CallResult<void> FileManager::add_file(const fs::path &file, const std::string &
   return {};
 }
 
-// The file's hash (computed again only when its stamp changed), and its name in the package. It
-// is served from now on.
+// What is delivered of the file (itself, or its copy without debug information) and its hash,
+// both made again only when the file's stamp changed, and its name in the package. It is served
+// from now on.
 CallResult<protocol::PackageFile> FileManager::describe(const fs::path &file,
                                                         const std::string &path) {
   const auto stamp = profile::stamp_of(file);
   if (!stamp)
     return protocol::call_error(Status::NotFound, fmt::format("{} cannot be read", file.string()));
   std::string sha256;
+  fs::path delivered;
   {
     std::lock_guard lock(mutex_);
-    if (auto it = hashes_.find(file); it != hashes_.end() && it->second.stamp == *stamp)
+    if (auto it = hashes_.find(file); it != hashes_.end() && it->second.stamp == *stamp) {
       sha256 = it->second.sha256;
+      delivered = it->second.delivered;
+    }
   }
-  if (sha256.empty()) {
-    auto hashed = content::sha256_of_file(file);
-    if (!hashed)
-      return protocol::call_error(Status::Failed, hashed.error().to_string());
+  auto delivered_stamp = profile::stamp_of(delivered); // none: a copy forgotten since
+  if (sha256.empty() || !delivered_stamp) {
+    delivered = delivery_ == CodeDelivery::Stripped ? code_.deliverable(file) : file;
+    auto hashed = content::sha256_of_file(delivered);
+    delivered_stamp = profile::stamp_of(delivered);
+    if (!hashed || !delivered_stamp)
+      return protocol::call_error(Status::Failed,
+                                  hashed ? fmt::format("{} cannot be read", delivered.string())
+                                         : hashed.error().to_string());
     sha256 = std::move(*hashed);
   }
-  std::lock_guard lock(mutex_);
-  hashes_[file] = {*stamp, sha256, ++uses_};
-  served_[sha256] = {file, *stamp, uses_};
-  bound(hashes_);
-  bound(served_);
-  return protocol::PackageFile{path, sha256, stamp->size, is_executable_file(file)};
+  std::optional<Served> forgotten;
+  {
+    std::lock_guard lock(mutex_);
+    hashes_[file] = {*stamp, sha256, delivered, ++uses_};
+    served_[sha256] = {delivered, *delivered_stamp, uses_};
+    bound(hashes_);
+    forgotten = bound(served_);
+  }
+  if (forgotten)
+    code_.forget(forgotten->file);
+  return protocol::PackageFile{path, sha256, delivered_stamp->size, is_executable_file(file)};
 }
 
 CallResult<protocol::file::ReadReply>
 FileManager::read(const protocol::file::ReadRequest &request) {
   if (!protocol::is_sha256_hex(request.sha256))
     return protocol::call_error(Status::BadRequest, "sha256: not a SHA-256 in lowercase hex");
+  if (request.compression && *request.compression != protocol::file::kZstd)
+    return protocol::call_error(Status::BadRequest,
+                                fmt::format("compression: \"{}\" is not one the domain makes (it "
+                                            "makes {})",
+                                            excerpt(*request.compression), protocol::file::kZstd));
   if (request.length > protocol::file::kMaxReadBytes)
     return protocol::call_error(
         Status::BadRequest,
@@ -281,16 +306,26 @@ FileManager::read(const protocol::file::ReadRequest &request) {
     got += static_cast<std::size_t>(n);
   }
   bytes.resize(got);
-  count(request.launch, got);
-  return protocol::file::ReadReply{protocol::Bytes(std::move(bytes)), hashed_as->size};
+  protocol::file::ReadReply reply{protocol::Bytes{}, hashed_as->size, std::nullopt};
+  if (request.compression && delivery_ == CodeDelivery::Stripped && got > 0) {
+    auto frame = content::zstd_compress(bytes.data(), bytes.size());
+    if (!frame.empty() && frame.size() < bytes.size()) {
+      bytes = std::move(frame);
+      reply.compression = std::string(protocol::file::kZstd);
+    }
+  }
+  count(request.launch, {got, bytes.size()});
+  reply.payload = protocol::Bytes(std::move(bytes));
+  return reply;
 }
 
-void FileManager::count(const std::optional<std::string> &launch, std::uint64_t bytes) {
+void FileManager::count(const std::optional<std::string> &launch, protocol::file::Delivered bytes) {
   if (!launch)
     return;
   std::lock_guard lock(mutex_);
-  auto [it, fresh] = delivered_.try_emplace(*launch, 0);
-  it->second += bytes;
+  auto [it, fresh] = delivered_.try_emplace(*launch);
+  it->second.bytes += bytes.bytes;
+  it->second.wire_bytes += bytes.wire_bytes;
   if (!fresh)
     return;
   launches_.push_back(*launch);
@@ -300,10 +335,10 @@ void FileManager::count(const std::optional<std::string> &launch, std::uint64_t 
   }
 }
 
-std::uint64_t FileManager::delivered(const std::string &launch) const {
+protocol::file::Delivered FileManager::delivered(const std::string &launch) const {
   std::lock_guard lock(mutex_);
   auto it = delivered_.find(launch);
-  return it == delivered_.end() ? 0 : it->second;
+  return it == delivered_.end() ? protocol::file::Delivered{} : it->second;
 }
 
 } // namespace rsca::domain

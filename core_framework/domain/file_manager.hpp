@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "domain/delivered_code.hpp"
 #include "profile/file_stamp.hpp"
 #include "profile/profile_loader.hpp"
 #include "protocol/file_ops.hpp"
@@ -39,7 +40,8 @@ struct PackagedComponent {
 
 class FileManager {
 public:
-  FileManager(std::filesystem::path repository, std::vector<std::filesystem::path> exec_path);
+  FileManager(std::filesystem::path repository, std::vector<std::filesystem::path> exec_path,
+              CodeDelivery delivery = CodeDelivery::Stripped);
 
   // The package of a process that runs `components` (one, or a component host's several). An
   // error (Failed: the launch fails at execute) names the component and the file.
@@ -48,13 +50,14 @@ public:
   std::string package_path(const std::filesystem::path &file) const;
 
   CallResult<protocol::file::ReadReply> read(const protocol::file::ReadRequest &request);
-  // Bytes served so far for `launch` (file.read's launch field).
-  std::uint64_t delivered(const std::string &launch) const;
+  // Bytes served so far for `launch` (file.read's launch field): of the files, and on the wire.
+  protocol::file::Delivered delivered(const std::string &launch) const;
 
 private:
   struct Hashed {
     profile::FileStamp stamp;
-    std::string sha256;
+    std::string sha256;              // of what is delivered
+    std::filesystem::path delivered; // the file, or its copy without debug information
     std::uint64_t last_use = 0;
   };
   struct Served {
@@ -83,17 +86,19 @@ private:
                                                  const std::string &name) const;
   CallResult<protocol::PackageFile> describe(const std::filesystem::path &file,
                                              const std::string &path);
-  void count(const std::optional<std::string> &launch, std::uint64_t bytes);
+  void count(const std::optional<std::string> &launch, protocol::file::Delivered bytes);
 
   std::filesystem::path repository_;
   std::vector<std::filesystem::path> exec_path_;
+  CodeDelivery delivery_;
+  DeliveredCode code_;
   mutable std::mutex mutex_; // guards what follows
   // Both bounded: past 4096 entries, the least recently used goes.
   std::map<std::filesystem::path, Hashed> hashes_; // by file
   std::map<std::string, Served> served_;           // by hash: the file put into a package
   std::uint64_t uses_ = 0;
-  std::map<std::string, std::uint64_t> delivered_; // by launch
-  std::deque<std::string> launches_;               // of delivered_, oldest first
+  std::map<std::string, protocol::file::Delivered> delivered_; // by launch
+  std::deque<std::string> launches_;                           // of delivered_, oldest first
 };
 
 } // namespace rsca::domain

@@ -276,8 +276,10 @@ CallResult<void> ApplicationFactory::Launch::execute() {
     return ok;
   detail_ = fmt::format("{} processes for {} components", calls.size(), app_->components.size());
   if (s_.files != nullptr)
-    if (const auto delivered = s_.files->delivered(request_.id); delivered > 0)
-      detail_ += fmt::format("; {:.1f} MB of their files delivered", delivered / 1e6);
+    if (const auto delivered = s_.files->delivered(request_.id); delivered.bytes > 0)
+      detail_ += fmt::format("; {:.1f} MB of their files delivered ({:.1f} MB on the wire)",
+                             static_cast<double>(delivered.bytes) / 1e6,
+                             static_cast<double>(delivered.wire_bytes) / 1e6);
   return {};
 }
 

@@ -43,6 +43,13 @@ int main(int argc, char **argv) {
                  "Folders where code an SPD names is looked for when its install did not carry it "
                  "(default: this program's folder and where an install puts rsca's components; "
                  "libraries also in ../lib beside each)");
+  std::string delivery = "stripped";
+  app.add_option("--delivery", delivery,
+                 "What nodes get of code files: stripped (without debug information, which the "
+                 "domain keeps in <repository>/.build-id; compressed on the wire) or as-is (the "
+                 "files themselves, uncompressed)")
+      ->check(CLI::IsMember({"stripped", "as-is"}))
+      ->capture_default_str();
   std::string strategy = "pack";
   app.add_option("--strategy", strategy,
                  "Placement: pack (fewest devices) or spread (balance load)")
@@ -59,6 +66,8 @@ int main(int argc, char **argv) {
   options.registration_timeout = std::chrono::milliseconds(registration_ms);
   options.call_timeout = std::chrono::milliseconds(call_ms);
   options.strategy = *rsca::allocator::parse_strategy(strategy);
+  options.delivery =
+      delivery == "as-is" ? rsca::domain::CodeDelivery::AsIs : rsca::domain::CodeDelivery::Stripped;
   for (const auto &p : exec_path)
     options.exec_path.emplace_back(p);
   if (options.exec_path.empty())

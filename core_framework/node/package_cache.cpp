@@ -13,6 +13,7 @@
 #include <spdlog/spdlog.h>
 
 #include "content/sha256.hpp"
+#include "node/cache_seals.hpp"
 #include "node/package_fetch.hpp"
 #include "profile/runtime_model.hpp"
 
@@ -51,8 +52,8 @@ bool alive(pid_t pid) {
   return pid > 0 && (::kill(pid, 0) == 0 || errno == EPERM);
 }
 
-// A package's folders are read-only (package_fetch.cpp): writable again first, as removing what
-// they hold needs.
+// A package's folders are read-only (package_fetch.cpp): writable again first,
+// as removing what they hold needs.
 void remove_folder(const fs::path &folder) {
   std::error_code ec;
   if (!fs::exists(folder, ec))
@@ -68,8 +69,8 @@ void remove_folder(const fs::path &folder) {
     spdlog::warn("package cache: cannot remove {}: {}", folder.string(), ec.message());
 }
 
-// Whether the files the manifest lists are there, with their sizes: a package a node crashed
-// while writing, or that someone changed, is not trusted.
+// Whether the files the manifest lists are there, with their sizes: a package a
+// node crashed while writing, or that someone changed, is not trusted.
 bool complete(const fs::path &root, const protocol::Package &manifest) {
   std::error_code ec;
   for (const auto &f : manifest.files)
@@ -79,11 +80,24 @@ bool complete(const fs::path &root, const protocol::Package &manifest) {
   return true;
 }
 
+// The runtime models as the node rewrote them (relocate_runtime_model): not the
+// package's hashes, so their own, taken when they are written or found at
+// start.
+std::map<std::string, std::string> model_hashes(const fs::path &root,
+                                                const protocol::Package &manifest) {
+  std::map<std::string, std::string> hashes;
+  for (const auto &f : manifest.files)
+    if (profile::is_runtime_model_path(f.path))
+      hashes[f.path] = content::sha256_of_file(root / f.path).value_or("");
+  return hashes;
+}
+
 } // namespace
 
 struct PackageCache::State {
   struct Entry {
     protocol::Package manifest;
+    std::map<std::string, std::string> models; // path → the hash of the model as rewritten
     std::uint64_t bytes = 0;
     std::uint64_t last_use = 0; // a counter: larger is more recent
     unsigned leases = 0;
@@ -96,6 +110,7 @@ struct PackageCache::State {
   std::map<std::string, Entry> packages;     // by id
   std::map<std::string, bool> fetching;      // ids being fetched
   std::map<std::string, std::string> copies; // file hash → a package holding it, by id
+  detail::CacheSeals seals;                  // its own lock
   std::uint64_t uses = 0;
   std::uint64_t incoming = 0;
   CacheCounts counts;
@@ -106,9 +121,16 @@ struct PackageCache::State {
   fs::path root_of(const std::string &id) const { return packages_dir() / id; }
 
   void load();
-  void add_locked(const std::string &id, protocol::Package manifest);
+  void add_locked(const std::string &id, protocol::Package manifest,
+                  std::map<std::string, std::string> models);
   void evict_locked();
+  void drop_locked(const std::string &id);
+  void seal(const std::string &id, const protocol::Package &package,
+            const std::map<std::string, std::string> &models);
+  CallResult<void> verify(const std::string &id, const protocol::Package &package,
+                          const std::map<std::string, std::string> &models);
   std::optional<fs::path> copy_of(const protocol::PackageFile &file) const;
+  std::optional<fs::path> verified_copy(const protocol::PackageFile &file);
   CallResult<void> fetch_into_place(const std::string &id, const protocol::Package &package,
                                     const std::string &launch);
   CallResult<void> write_manifest(const std::string &id, const protocol::Package &package) const;
@@ -118,8 +140,9 @@ class CachedPackage final : public PackageLease {
 public:
   CachedPackage(std::shared_ptr<PackageCache::State> state, std::string id)
       : state_(std::move(state)), id_(std::move(id)), root_(state_->root_of(id_)) {}
-  // Only counts: a package kept over the cache's size goes at the next acquire, not here on
-  // the thread that saw its process exit (the GPP's reaper, which must not block).
+  // Only counts: a package kept over the cache's size goes at the next acquire,
+  // not here on the thread that saw its process exit (the GPP's reaper, which
+  // must not block).
   ~CachedPackage() override {
     std::lock_guard lock(state_->mutex);
     if (auto it = state_->packages.find(id_); it != state_->packages.end() && it->second.leases > 0)
@@ -133,12 +156,14 @@ private:
   fs::path root_;
 };
 
-// What a node left: folders it was fetching into (when it is gone), packages without their
-// manifest (it stopped before writing it) and manifests without their package.
+// What a node left: folders it was fetching into (when it is gone), packages
+// without their manifest (it stopped before writing it) and manifests without
+// their package.
 void PackageCache::State::load() {
   std::error_code ec;
   for (const auto &entry : fs::directory_iterator(incoming_dir(), ec)) {
-    // One of this pid is of an earlier node that had it (a container's node is often pid 1).
+    // One of this pid is of an earlier node that had it (a container's node is
+    // often pid 1).
     const auto maker = maker_of(entry.path().filename().string());
     if (!maker || !alive(*maker) || *maker == ::getpid())
       remove_folder(entry.path());
@@ -155,25 +180,28 @@ void PackageCache::State::load() {
       fs::remove(manifests_dir() / (id + ".json"), ec);
       continue;
     }
-    add_locked(id, std::move(*manifest));
+    auto models = model_hashes(entry.path(), *manifest);
+    add_locked(id, std::move(*manifest), std::move(models));
   }
   for (const auto &entry : fs::directory_iterator(manifests_dir(), ec))
     if (!fs::exists(packages_dir() / entry.path().stem(), ec))
       fs::remove(entry.path(), ec);
 }
 
-void PackageCache::State::add_locked(const std::string &id, protocol::Package manifest) {
+void PackageCache::State::add_locked(const std::string &id, protocol::Package manifest,
+                                     std::map<std::string, std::string> models) {
   for (const auto &f : manifest.files)
     if (!profile::is_runtime_model_path(f.path)) // rewritten here: not the hash's content
       copies[f.sha256] = id;
-  Entry entry{std::move(manifest), 0, ++uses, 0};
+  Entry entry{std::move(manifest), std::move(models), 0, ++uses, 0};
   entry.bytes = bytes_of(entry.manifest);
   counts.bytes += entry.bytes;
   ++counts.packages;
   packages[id] = std::move(entry);
 }
 
-// Least recently used first, until the cache fits its size; a package in use stays.
+// Least recently used first, until the cache fits its size; a package in use
+// stays.
 void PackageCache::State::evict_locked() {
   while (counts.bytes > options.max_bytes) {
     auto victim = packages.end();
@@ -185,15 +213,56 @@ void PackageCache::State::evict_locked() {
       return; // everything left is in use
     spdlog::info("package cache: evicting {} ({} bytes) to stay under {} bytes", victim->first,
                  victim->second.bytes, options.max_bytes);
-    std::error_code ec;
-    fs::remove(manifests_dir() / (victim->first + ".json"), ec);
-    remove_folder(root_of(victim->first));
-    for (auto it = copies.begin(); it != copies.end();)
-      it = it->second == victim->first ? copies.erase(it) : std::next(it);
-    counts.bytes -= victim->second.bytes;
-    --counts.packages;
-    packages.erase(victim);
+    drop_locked(victim->first);
   }
+}
+
+// Out of the cache. A package a process still runs inside is moved aside into
+// incoming/ under this node's pid (its processes keep their folder), and
+// removed when the node next starts.
+void PackageCache::State::drop_locked(const std::string &id) {
+  auto it = packages.find(id);
+  if (it == packages.end())
+    return;
+  std::error_code ec;
+  fs::remove(manifests_dir() / (id + ".json"), ec);
+  if (it->second.leases == 0) {
+    remove_folder(root_of(id));
+  } else {
+    fs::rename(root_of(id), incoming_dir() / fmt::format("{}.{}.{}", id, ::getpid(), ++incoming),
+               ec);
+    if (ec)
+      remove_folder(root_of(id));
+  }
+  for (auto c = copies.begin(); c != copies.end();)
+    c = c->second == id ? copies.erase(c) : std::next(c);
+  counts.bytes -= it->second.bytes;
+  --counts.packages;
+  packages.erase(it);
+}
+
+// The files of a package just laid out are what was verified: their stamps are
+// recorded.
+void PackageCache::State::seal(const std::string &id, const protocol::Package &package,
+                               const std::map<std::string, std::string> &models) {
+  for (const auto &f : package.files) {
+    const auto model = models.find(f.path);
+    seals.record(root_of(id) / f.path, model == models.end() ? f.sha256 : model->second);
+  }
+}
+
+// Each file of a cached package still is what was verified (its stat, or its
+// hash when the stat changed): a process runs only what the package says.
+CallResult<void> PackageCache::State::verify(const std::string &id,
+                                             const protocol::Package &package,
+                                             const std::map<std::string, std::string> &models) {
+  for (const auto &f : package.files) {
+    const auto model = models.find(f.path);
+    const std::string &sha256 = model == models.end() ? f.sha256 : model->second;
+    if (auto ok = seals.verify(root_of(id) / f.path, sha256, f.path); !ok)
+      return ok;
+  }
+  return {};
 }
 
 std::optional<fs::path> PackageCache::State::copy_of(const protocol::PackageFile &file) const {
@@ -204,10 +273,24 @@ std::optional<fs::path> PackageCache::State::copy_of(const protocol::PackageFile
   auto package = packages.find(it->second);
   if (package == packages.end())
     return std::nullopt;
+  std::optional<fs::path> copy;
   for (const auto &f : package->second.manifest.files)
     if (f.sha256 == file.sha256)
-      return root_of(it->second) / f.path;
-  return std::nullopt;
+      copy = root_of(it->second) / f.path;
+  return copy;
+}
+
+// A copy to link only while it still is what was verified; one that is not is
+// fetched instead, and its own package is refused at its next use.
+std::optional<fs::path> PackageCache::State::verified_copy(const protocol::PackageFile &file) {
+  auto copy = copy_of(file);
+  if (!copy)
+    return std::nullopt;
+  if (auto ok = seals.verify(*copy, file.sha256, copy->string()); !ok) {
+    spdlog::warn("package cache: not linking {}: {}", file.path, ok.error().message);
+    return std::nullopt;
+  }
+  return copy;
 }
 
 CallResult<void> PackageCache::State::write_manifest(const std::string &id,
@@ -228,8 +311,8 @@ CallResult<void> PackageCache::State::write_manifest(const std::string &id,
   return {};
 }
 
-// Fetched into a folder of its own in incoming/, then renamed into place; on failure nothing of
-// it is left.
+// Fetched into a folder of its own in incoming/, then renamed into place; on
+// failure nothing of it is left.
 CallResult<void> PackageCache::State::fetch_into_place(const std::string &id,
                                                        const protocol::Package &package,
                                                        const std::string &launch) {
@@ -239,7 +322,7 @@ CallResult<void> PackageCache::State::fetch_into_place(const std::string &id,
     folder = incoming_dir() / fmt::format("{}.{}.{}", id, ::getpid(), ++incoming);
   }
   detail::FetchContext context{fetch, &options, launch,
-                               [this](const protocol::PackageFile &f) { return copy_of(f); }};
+                               [this](const protocol::PackageFile &f) { return verified_copy(f); }};
   auto fetched = detail::lay_out(context, package, folder);
   std::error_code ec;
   if (fetched) {
@@ -305,11 +388,29 @@ PackageCache::acquire(const protocol::Package &package, const std::string &launc
     it->second.last_use = ++s.uses;
     ++it->second.leases;
     ++s.counts.reused;
+    auto lease = std::make_shared<CachedPackage>(state_, id);
+    const auto models = it->second.models;
     s.evict_locked(); // what leases ended since kept over the size
-    return std::make_shared<CachedPackage>(state_, id);
+    lock.unlock();
+    // Outside the lock: a file whose stat changed is hashed again.
+    if (auto ok = s.verify(id, package, models); !ok) {
+      lease.reset();
+      spdlog::error("package {}: refused for launch {}: {}; dropped from the "
+                    "cache, the next "
+                    "launch fetches it again",
+                    id, launch, ok.error().message);
+      lock.lock();
+      s.drop_locked(id);
+      return protocol::call_error(Status::Failed,
+                                  fmt::format("{}; dropped from the node's cache, the next "
+                                              "launch fetches it again",
+                                              ok.error().message));
+    }
+    return lease;
   }
   s.fetching[id] = true;
-  // Whatever becomes of the fetch, even an exception, the callers waiting for it go on.
+  // Whatever becomes of the fetch, even an exception, the callers waiting for
+  // it go on.
   struct Fetched {
     State &s;
     const std::string &id;
@@ -323,10 +424,15 @@ PackageCache::acquire(const protocol::Package &package, const std::string &launc
   } done{s, id, lock};
   lock.unlock();
   auto fetched = s.fetch_into_place(id, package, launch);
+  std::map<std::string, std::string> models;
+  if (fetched) {
+    models = model_hashes(s.root_of(id), package);
+    s.seal(id, package, models);
+  }
   lock.lock();
   if (!fetched)
     return tl::unexpected(fetched.error());
-  s.add_locked(id, package);
+  s.add_locked(id, package, std::move(models));
   ++s.packages[id].leases;
   s.evict_locked();
   return std::make_shared<CachedPackage>(state_, id);

@@ -12,6 +12,7 @@
 #include <spdlog/spdlog.h>
 
 #include "content/sha256.hpp"
+#include "content/zstd.hpp"
 #include "control/operation.hpp"
 #include "process/fd.hpp"
 #include "profile/runtime_model.hpp"
@@ -57,7 +58,8 @@ public:
     while (written < file_.size) {
       while (asked < file_.size && in_flight.size() < context_.options->pieces_in_flight) {
         const auto length = std::min(piece, file_.size - asked);
-        in_flight.push_back(context_.fetch({file_.sha256, asked, length, context_.launch}));
+        in_flight.push_back(context_.fetch(
+            {file_.sha256, asked, length, context_.launch, std::string(file_ops::kZstd)}));
         asked += length;
       }
       auto ok = take(in_flight.front(), written);
@@ -88,8 +90,19 @@ private:
       return failed(Status::Failed,
                     fmt::format("{}: the domain's file has {} bytes, the package says {}",
                                 file_.path, piece->size, file_.size));
-    const protocol::Bytes none;
-    const auto &bytes = piece->payload ? *piece->payload : none;
+    protocol::Bytes bytes = piece->payload ? std::move(*piece->payload) : protocol::Bytes{};
+    if (piece->compression) {
+      if (*piece->compression != file_ops::kZstd)
+        return cut_off(written, fmt::format("a piece compressed as \"{}\", which the node did "
+                                            "not ask for",
+                                            piece->compression->substr(0, 32)));
+      // Bounded by the piece asked for: a frame that holds or claims more is refused unread.
+      auto plain =
+          content::zstd_decompress(bytes.data(), bytes.size(), expected, file_ops::kMaxReadBytes);
+      if (!plain)
+        return cut_off(written, plain.error());
+      bytes = protocol::Bytes(std::move(*plain));
+    }
     if (bytes.size() != expected)
       return cut_off(written,
                      fmt::format("{} bytes where {} were asked for", bytes.size(), expected));

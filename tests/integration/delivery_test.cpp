@@ -2,6 +2,12 @@
 // fetched from the domain's FileManager into the node's cache when first needed, verified, and
 // reused by later launches; a file that fails verification fails the launch at execute, rolls it
 // back, and leaves nothing in the cache. Real daemons and processes; the files are the build's.
+// Issue 37: what a node gets of a component's code is the executable without its debug
+// information, compressed on the wire, yet the process runs, and the domain keeps the full file
+// where gdb finds it by build id (the ELF files are read here with <elf.h> alone, not with the
+// domain's reader); a cached executable that changed on its node is refused at the next launch
+// with the reason, nothing of that launch left running, and fetched again by the one after.
+#include <elf.h>
 #include <fcntl.h>
 #include <sys/stat.h>
 
@@ -37,6 +43,57 @@ Json cache_of(TestDomain &domain, int node) {
   return status->at("cache");
 }
 
+std::string content_of(const fs::path &file) {
+  std::ifstream in(file, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// The section names of a 64-bit ELF file, and its GNU build id (hex); empty when not one.
+struct Sections {
+  std::vector<std::string> names;
+  std::string build_id;
+  bool has(const std::string &name) const {
+    return std::find(names.begin(), names.end(), name) != names.end();
+  }
+};
+
+Sections sections_of(const fs::path &file) {
+  const std::string bytes = content_of(file);
+  Sections out;
+  Elf64_Ehdr header{};
+  if (bytes.size() < sizeof header)
+    return out;
+  std::memcpy(&header, bytes.data(), sizeof header);
+  if (std::memcmp(header.e_ident, ELFMAG, SELFMAG) != 0 ||
+      header.e_shoff + header.e_shnum * sizeof(Elf64_Shdr) > bytes.size())
+    return out;
+  std::vector<Elf64_Shdr> shdrs(header.e_shnum);
+  std::memcpy(shdrs.data(), bytes.data() + header.e_shoff, shdrs.size() * sizeof(Elf64_Shdr));
+  const auto &names = shdrs.at(header.e_shstrndx);
+  for (const auto &s : shdrs) {
+    out.names.emplace_back(bytes.data() + names.sh_offset + s.sh_name);
+    if (out.names.back() == ".note.gnu.build-id") {
+      Elf64_Nhdr note{};
+      std::memcpy(&note, bytes.data() + s.sh_offset, sizeof note);
+      const auto *id = bytes.data() + s.sh_offset + sizeof note + ((note.n_namesz + 3U) & ~3U);
+      for (std::size_t i = 0; i < note.n_descsz; ++i)
+        out.build_id += fmt::format("{:02x}", static_cast<unsigned char>(id[i]));
+    }
+  }
+  return out;
+}
+
+// The cached copy of `name` on `node`'s cache (the first found).
+fs::path cached(TestDomain &domain, const std::string &node, const std::string &name) {
+  const fs::path packages = domain.run_dir() / "cache" / node / "packages";
+  std::error_code ec;
+  for (auto it = fs::recursive_directory_iterator(packages, ec); !ec && it != fs::end(it);
+       it.increment(ec))
+    if (it->path().filename() == name && it->is_regular_file())
+      return it->path();
+  return {};
+}
+
 std::size_t entries(const fs::path &dir) {
   std::size_t n = 0;
   std::error_code ec;
@@ -58,8 +115,11 @@ TEST_CASE("a component's files are delivered to its node once: verified, run fro
   CHECK_THAT(execute_detail(out), Contains("delivered"));
   auto cache = cache_of(domain, 1);
   CHECK(cache.at("fetched") == 2); // both components placed on node1 (pack)
-  CHECK(cache.at("fetched_bytes").get<std::uint64_t>() >=
-        fs::file_size(kBin / "rsca-producer") + fs::file_size(kBin / "rsca-consumer"));
+  // What runs of the build's files (their debug information stays with the domain).
+  const auto built = fs::file_size(kBin / "rsca-producer") + fs::file_size(kBin / "rsca-consumer");
+  const auto fetched = cache.at("fetched_bytes").get<std::uint64_t>();
+  CHECK(fetched > 0);
+  CHECK(fetched <= built);
   CHECK(cache.at("reused") == 0);
 
   // Each process runs the copy in the node's cache, not the build's.
@@ -92,8 +152,9 @@ TEST_CASE("a component's files are delivered to its node once: verified, run fro
   REQUIRE(on_node2.has_value());
   auto progress = domain.call("app.progress", Json{{"launch_id", "delivery-test-node2"}});
   REQUIRE(progress.has_value());
-  CHECK(progress->value("delivered_bytes", std::uint64_t{0}) >=
-        fs::file_size(kBin / "rsca-producer") + fs::file_size(kBin / "rsca-consumer"));
+  CHECK(progress->value("delivered_bytes", std::uint64_t{0}) >= fetched);
+  // Compressed on the wire.
+  CHECK(progress->value("delivered_wire_bytes", fetched) < fetched);
 
   auto all = pids;
   for (const char *name : {"Again", "OnNode2"}) {
@@ -159,18 +220,26 @@ TEST_CASE("a file that fails verification on its node fails the launch at execut
   REQUIRE(rc == 0);
   REQUIRE(domain.call("app.release", Json{{"app", "ProducerConsumer"}}).has_value());
 
-  // The consumer's copy changes but keeps its size and modification time (as `cp -p` of another
-  // build of the same size would): the domain's stamp cannot tell, the node's hash does.
-  const fs::path consumer = bin / "rsca-consumer";
-  struct stat before {};
-  REQUIRE(::stat(consumer.c_str(), &before) == 0);
-  {
-    std::fstream f(consumer, std::ios::in | std::ios::out | std::ios::binary);
-    f.seekp(-1, std::ios::end);
-    f.put('\x5a');
+  // What the domain serves of the consumer changes but keeps its size and modification time (as
+  // `cp -p` of another build of the same size would): the domain's stamp cannot tell, the node's
+  // hash does. That is the copy without debug information the domain made (.delivered/) when the
+  // build has it, else the file itself; every copy there changes.
+  std::vector<fs::path> served{bin / "rsca-consumer"};
+  std::error_code ec;
+  for (auto it = fs::directory_iterator(domain.run_dir() / "repository" / ".delivered", ec);
+       !ec && it != fs::directory_iterator(); it.increment(ec))
+    served.push_back(it->path());
+  for (const auto &file : served) {
+    struct stat before {};
+    REQUIRE(::stat(file.c_str(), &before) == 0);
+    {
+      std::fstream f(file, std::ios::in | std::ios::out | std::ios::binary);
+      f.seekp(-1, std::ios::end);
+      f.put('\x5a');
+    }
+    const struct timespec times[2] = {before.st_atim, before.st_mtim};
+    REQUIRE(::utimensat(AT_FDCWD, file.c_str(), times, 0) == 0);
   }
-  const struct timespec times[2] = {before.st_atim, before.st_mtim};
-  REQUIRE(::utimensat(AT_FDCWD, consumer.c_str(), times, 0) == 0);
 
   auto [rc2, out2] = domain.cli(
       {"launch", "ProducerConsumer", "--name", "Altered", "--assign", "Consumer_1=node2:GPP_1"});
@@ -188,4 +257,99 @@ TEST_CASE("a file that fails verification on its node fails the launch at execut
   CHECK(entries(cache / "incoming") == 0);
   for (const auto &entry : fs::recursive_directory_iterator(cache))
     CHECK(entry.path().filename() != "rsca-consumer");
+}
+
+TEST_CASE("a delivered executable has no debug sections yet runs, the domain keeps its debug "
+          "file by build id, and the launch says the bytes delivered",
+          "[integration][delivery]") {
+  const auto built = sections_of(kBin / "rsca-producer");
+  REQUIRE(built.has(".debug_info")); // a build with debug information, as the issue's
+  REQUIRE_FALSE(built.build_id.empty());
+  TestDomain domain;
+  auto [rc, out] = domain.cli({"--json", "launch", kProducerConsumer});
+  INFO(out);
+  REQUIRE(rc == 0);
+  // "… MB of their files delivered (… MB on the wire)": far less than the build's files.
+  const std::string detail = execute_detail(out);
+  CHECK_THAT(detail, Contains("delivered") && Contains("on the wire"));
+
+  // Each process runs a copy without debug sections, of the build's code (the same build id).
+  auto shown = domain.call("app.show", Json{{"app", "ProducerConsumer"}});
+  REQUIRE(shown.has_value());
+  const auto pids = pids_of(*shown);
+  REQUIRE(pids.size() == 2);
+  for (long pid : pids) {
+    const fs::path exe = fs::read_symlink(fmt::format("/proc/{}/exe", pid));
+    INFO(exe);
+    const auto delivered = sections_of(exe);
+    CHECK(delivered.has(".text"));
+    CHECK_FALSE(delivered.has(".debug_info"));
+    CHECK(fs::file_size(exe) < fs::file_size(kBin / exe.filename()) / 4);
+    CHECK(delivered.build_id == sections_of(kBin / exe.filename()).build_id);
+  }
+  const auto cache = domain.call_node(1, "node.status");
+  REQUIRE(cache.has_value());
+  CHECK(cache->at("cache").at("fetched_bytes").get<std::uint64_t>() <
+        (fs::file_size(kBin / "rsca-producer") + fs::file_size(kBin / "rsca-consumer")) / 4);
+
+  // The full file, debug sections and all, where the docs say gdb finds it.
+  const fs::path debug = domain.run_dir() / "repository" / ".build-id" /
+                         built.build_id.substr(0, 2) / (built.build_id.substr(2) + ".debug");
+  INFO(debug);
+  REQUIRE(fs::exists(debug));
+  CHECK(sections_of(debug).has(".debug_info"));
+  CHECK(sections_of(debug).build_id == built.build_id);
+
+  REQUIRE(domain.call("app.release", Json{{"app", "ProducerConsumer"}}).has_value());
+  domain.require_clean(pids);
+}
+
+TEST_CASE("a cached executable changed on its node is refused at the next launch with the "
+          "reason, nothing of it left running, and fetched again by the launch after",
+          "[integration][delivery][failure]") {
+  TestDomain domain;
+  auto [rc, out] = domain.cli({"launch", kProducerConsumer});
+  INFO(out);
+  REQUIRE(rc == 0);
+  REQUIRE(domain.call("app.release", Json{{"app", "ProducerConsumer"}}).has_value());
+  REQUIRE(TestDomain::wait_for([&] { return domain.running_pids().empty(); }));
+
+  // The cached producer is replaced by one of its size and mode with one byte changed (in place
+  // it cannot be while its fork server runs it: ETXTBSY; the unit tests change bytes in place).
+  const fs::path producer = cached(domain, "node1", "rsca-producer");
+  REQUIRE_FALSE(producer.empty());
+  const std::string good = content_of(producer);
+  std::string changed = good;
+  changed[changed.size() / 2] = static_cast<char>(changed[changed.size() / 2] ^ 0x01);
+  const fs::path replacement = fs::path(producer).concat(".changed");
+  {
+    std::ofstream file(replacement, std::ios::binary);
+    file << changed;
+  }
+  fs::permissions(replacement, fs::status(producer).permissions(), fs::perm_options::replace);
+  fs::rename(replacement, producer);
+  REQUIRE(content_of(producer) == changed);
+
+  auto [rc2, out2] = domain.cli({"launch", "ProducerConsumer", "--name", "Changed"});
+  INFO(out2);
+  CHECK(rc2 == 6);
+  CHECK_THAT(out2, Contains("failed at step 'execute'") && Contains("rsca-producer") &&
+                       Contains("changed since it was verified") && Contains("hashes to") &&
+                       Contains("rolled back"));
+  CHECK(TestDomain::wait_for([&] { return domain.running_pids().empty(); }));
+  domain.require_clean({});
+
+  // The next launch fetches the producer again, and runs the domain's bytes.
+  auto [rc3, out3] = domain.cli({"--json", "launch", "ProducerConsumer", "--name", "Again"});
+  INFO(out3);
+  REQUIRE(rc3 == 0);
+  CHECK_THAT(execute_detail(out3), Contains("delivered"));
+  const fs::path again = cached(domain, "node1", "rsca-producer");
+  REQUIRE_FALSE(again.empty());
+  CHECK(content_of(again) == good);
+  auto shown = domain.call("app.show", Json{{"app", "Again"}});
+  REQUIRE(shown.has_value());
+  const auto pids = pids_of(*shown);
+  REQUIRE(domain.call("app.release", Json{{"app", "Again"}}).has_value());
+  domain.require_clean(pids);
 }

@@ -45,6 +45,9 @@ struct HostsOptions {
   // Node index → the size of a tmpfs (as mount's size=, "8m") its package cache is on: mounted in
   // the node's own mount namespace (ip netns exec makes one), gone with it.
   std::map<int, std::string> cache_tmpfs;
+  // More arguments of rsca-domaind, e.g. {"--delivery", "as-is"}: the build's files as they are,
+  // debug information and all, for a test that needs files larger than a tmpfs or a transfer.
+  std::vector<std::string> domaind_args;
 };
 
 class HostsDomain {
@@ -55,9 +58,12 @@ public:
             {"RSCA_DDS_TAG", isolated_tag()},
             {"RSCA_DDS_INTERFACE", hosts_.interface(1)},
             {"RSCA_RUN_DIR", run_.path.string()}};
-    domaind_ = start(1, "rsca-domaind",
-                     {"--dmd", (kSource / "profiles/dom/domain/DomainManager.dmd.xml").string(),
-                      "--repository", (run_ / "repository").string()});
+    std::vector<std::string> domaind_args{
+        "--dmd", (kSource / "profiles/dom/domain/DomainManager.dmd.xml").string(), "--repository",
+        (run_ / "repository").string()};
+    domaind_args.insert(domaind_args.end(), options.domaind_args.begin(),
+                        options.domaind_args.end());
+    domaind_ = start(1, "rsca-domaind", domaind_args);
     for (int i = 1; i <= nodes; ++i)
       nodes_.push_back(start_node(i, options));
     // Known to the domain once it lists them all, asked over DDS from the domain's host.

@@ -1,7 +1,10 @@
 // The domain's FileManager (domain/file_manager.hpp): the package of a component names its
 // profiles, runtime model and code by their path in the repository and their content hash, finds
 // code the install did not carry in the exec path, and serves file.read of exactly those files,
-// by hash, in bounded pieces, refusing one that changed since it was hashed.
+// by hash, in bounded pieces, refusing one that changed since it was hashed. What it delivers of
+// code (domain/delivered_code.hpp): an ELF executable with debug sections is served without them,
+// its full file kept by build id; pieces travel as zstd frames when the node asks; a file that is
+// not ELF is served as it is; and --delivery as-is serves the files themselves, uncompressed.
 #include "domain/file_manager.hpp"
 
 #include <catch2/catch.hpp>
@@ -11,7 +14,9 @@
 
 #include <fmt/format.h>
 
+#include "content/elf_facts.hpp"
 #include "content/sha256.hpp"
+#include "content/zstd.hpp"
 #include "profile/runtime_model.hpp"
 #include "temp_dir.hpp"
 
@@ -63,6 +68,41 @@ const protocol::PackageFile *file_named(const protocol::Package &p, const std::s
 // The Producer's executable in its package.
 const protocol::PackageFile *code_of(const protocol::Package &p) {
   return file_named(p, "applications/A/dom/components/Producer/rsca-producer");
+}
+
+// A program of this build, with its debug sections (RelWithDebInfo).
+const fs::path kBuilt = RSCA_TEST_FORKED;
+
+// The Producer's code in `repo`'s exec path replaced by `code`; its entry in a new package.
+protocol::PackageFile code_as(Repository &repo, domain::FileManager &files, const fs::path &code) {
+  if (!code.empty())
+    fs::copy_file(code, repo.bin / "rsca-producer", fs::copy_options::overwrite_existing);
+  auto package = files.package_of({repo.producer()});
+  REQUIRE(package.has_value());
+  REQUIRE(code_of(*package) != nullptr);
+  return *code_of(*package);
+}
+
+// The whole file as a node fetches it, decompressing what comes compressed.
+std::string fetch(domain::FileManager &files, const protocol::PackageFile &code, bool zstd) {
+  std::string whole;
+  for (std::uint64_t offset = 0; offset < code.size; offset += protocol::file::kMaxReadBytes) {
+    const auto length = std::min(protocol::file::kMaxReadBytes, code.size - offset);
+    auto piece = files.read({code.sha256, offset, protocol::file::kMaxReadBytes, "L1",
+                             zstd ? std::optional<std::string>("zstd") : std::nullopt});
+    REQUIRE(piece.has_value());
+    REQUIRE(piece->payload.has_value());
+    if (!piece->compression) {
+      whole.append(piece->payload->begin(), piece->payload->end());
+      continue;
+    }
+    REQUIRE(*piece->compression == "zstd");
+    auto plain = content::zstd_decompress(piece->payload->data(), piece->payload->size(), length,
+                                          protocol::file::kMaxReadBytes);
+    REQUIRE(plain.has_value());
+    whole.append(plain->begin(), plain->end());
+  }
+  return whole;
 }
 
 } // namespace
@@ -162,24 +202,26 @@ TEST_CASE("file manager: file.read serves the files of packages by hash, in boun
   REQUIRE(code != nullptr);
   std::string whole;
   for (std::uint64_t offset = 0; offset < code->size; offset += protocol::file::kMaxReadBytes) {
-    auto piece = files.read({code->sha256, offset, protocol::file::kMaxReadBytes, "L1"});
+    auto piece = files.read({code->sha256, offset, protocol::file::kMaxReadBytes, "L1", {}});
     REQUIRE(piece.has_value());
     CHECK(piece->size == code->size);
     REQUIRE(piece->payload.has_value());
     whole.append(piece->payload->begin(), piece->payload->end());
   }
   CHECK(content::sha256_hex(whole) == code->sha256);
-  CHECK(files.delivered("L1") == code->size);
-  CHECK(files.delivered("another") == 0);
+  CHECK(files.delivered("L1").bytes == code->size);
+  CHECK(files.delivered("L1").wire_bytes == code->size); // the node asked for no compression
+  CHECK(files.delivered("another").bytes == 0);
 
   // More than a piece, past the end, a hash it never put into a package, not a hash at all.
-  CHECK(files.read({code->sha256, 0, protocol::file::kMaxReadBytes + 1, {}}).error().status ==
+  CHECK(files.read({code->sha256, 0, protocol::file::kMaxReadBytes + 1, {}, {}}).error().status ==
         protocol::Status::BadRequest);
-  CHECK(files.read({code->sha256, code->size + 1, 10, {}}).error().status ==
+  CHECK(files.read({code->sha256, code->size + 1, 10, {}, {}}).error().status ==
         protocol::Status::BadRequest);
-  CHECK(files.read({content::sha256_hex("/etc/shadow"), 0, 10, {}}).error().status ==
+  CHECK(files.read({content::sha256_hex("/etc/shadow"), 0, 10, {}, {}}).error().status ==
         protocol::Status::NotFound);
-  CHECK(files.read({"../../etc/passwd", 0, 10, {}}).error().status == protocol::Status::BadRequest);
+  CHECK(files.read({"../../etc/passwd", 0, 10, {}, {}}).error().status ==
+        protocol::Status::BadRequest);
 }
 
 TEST_CASE("file manager: a file changed since it was put into a package is not served",
@@ -191,7 +233,7 @@ TEST_CASE("file manager: a file changed since it was put into a package is not s
   const auto *code = code_of(*package);
   REQUIRE(code != nullptr);
   write(repo.bin / "rsca-producer", "a new build");
-  auto piece = files.read({code->sha256, 0, 10, {}});
+  auto piece = files.read({code->sha256, 0, 10, {}, {}});
   REQUIRE_FALSE(piece.has_value());
   CHECK_THAT(piece.error().message, Contains("changed since"));
   // The next package has the new file's hash.
@@ -219,6 +261,78 @@ TEST_CASE("file manager: past the files it remembers it forgets the least recent
   REQUIRE(second.has_value());
   for (const auto &f : second->files) {
     INFO(f.path);
-    REQUIRE(files.read({f.sha256, 0, 16, {}}).has_value());
+    REQUIRE(files.read({f.sha256, 0, 16, {}, {}}).has_value());
+  }
+}
+
+TEST_CASE("delivered code: an executable with debug sections is served without them, compressed, "
+          "its full file kept by build id",
+          "[package][delivery]") {
+  const auto built = content::elf_facts(kBuilt);
+  REQUIRE(built.has_value());
+  REQUIRE_FALSE(built->debug_sections.empty()); // a build with debug information
+  REQUIRE(built->build_id.has_value());
+  Repository repo;
+  domain::FileManager files(repo.root, {repo.bin});
+  const auto code = code_as(repo, files, kBuilt);
+  CHECK(code.executable);
+  CHECK(code.size < fs::file_size(kBuilt));
+
+  const std::string whole = fetch(files, code, true);
+  CHECK(whole.size() == code.size);
+  CHECK(content::sha256_hex(whole) == code.sha256);
+  CHECK(files.delivered("L1").bytes == code.size);
+  CHECK(files.delivered("L1").wire_bytes < code.size); // compressed
+  // What was served is the build's code (same build id), without a debug section.
+  const fs::path served = repo.dir.path() / "served";
+  {
+    std::ofstream out(served, std::ios::binary);
+    out << whole;
+  }
+  const auto facts = content::elf_facts(served);
+  REQUIRE(facts.has_value());
+  CHECK(facts->debug_sections.empty());
+  CHECK(facts->build_id == built->build_id);
+  // The full file, where gdb looks for the build id's debug information.
+  const auto &id = *built->build_id;
+  const fs::path debug = repo.root / ".build-id" / id.substr(0, 2) / (id.substr(2) + ".debug");
+  REQUIRE(fs::exists(debug));
+  CHECK(content::sha256_of_file(debug).value() == content::sha256_of_file(kBuilt).value());
+
+  // Another launch: the same copy, not stripped again.
+  CHECK(code_as(repo, files, {}) == code);
+  // A domain that starts again removes the copies it served, and makes them again.
+  domain::FileManager restarted(repo.root, {repo.bin});
+  CHECK_FALSE(fs::exists(repo.root / ".delivered" / code.sha256));
+  CHECK(code_as(repo, restarted, {}) == code);
+  CHECK(fs::exists(repo.root / ".delivered" / code.sha256));
+}
+
+TEST_CASE("delivered code: a file that is not ELF is served as it is; --delivery as-is serves the "
+          "build's file itself, uncompressed",
+          "[package][delivery]") {
+  SECTION("not ELF") {
+    test::TempDir dir;
+    const fs::path script = dir.path() / "run.sh";
+    {
+      std::ofstream out(script);
+      out << "#!/bin/sh\necho hi\n";
+    }
+    CHECK_FALSE(content::elf_facts(script).has_value());
+    Repository repo;
+    domain::FileManager files(repo.root, {repo.bin});
+    const auto code = code_as(repo, files, script);
+    CHECK(code.sha256 == content::sha256_of_file(script).value());
+    CHECK(fetch(files, code, true) == "#!/bin/sh\necho hi\n");
+  }
+  SECTION("as-is") {
+    Repository repo;
+    domain::FileManager files(repo.root, {repo.bin}, domain::CodeDelivery::AsIs);
+    const auto code = code_as(repo, files, kBuilt);
+    CHECK(code.size == fs::file_size(kBuilt));
+    CHECK(code.sha256 == content::sha256_of_file(kBuilt).value());
+    CHECK(content::sha256_hex(fetch(files, code, true)) == code.sha256);
+    CHECK(files.delivered("L1").wire_bytes == code.size); // never compressed
+    CHECK_FALSE(fs::exists(repo.root / ".build-id"));
   }
 }

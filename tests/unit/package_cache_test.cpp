@@ -6,6 +6,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <atomic>
 #include <fstream>
 #include <map>
@@ -66,7 +67,7 @@ private:
       piece.pop_back();
     bytes_read_ += piece.size();
     return protocol::encode(protocol::file::ReadReply{
-        protocol::Bytes(protocol::Bytes::container_type(piece.begin(), piece.end())), size});
+        protocol::Bytes(protocol::Bytes::container_type(piece.begin(), piece.end())), size, {}});
   }
 
   std::mutex mutex_;
@@ -284,4 +285,79 @@ TEST_CASE("package cache: the same bytes executable in one package and not in an
   auto mode = [](const fs::path &p) { return fs::status(p).permissions() & fs::perms::owner_exec; };
   CHECK(mode((*a)->root() / "apps/A/data.sh") == fs::perms::none);
   CHECK(mode((*b)->root() / "apps/B/run.sh") != fs::perms::none);
+}
+
+namespace {
+
+// Changes one byte of a cached file in place, at the same size, as a disk fault or a hand would.
+void change_a_byte(const fs::path &file, std::size_t at) {
+  fs::permissions(file, fs::perms::owner_write, fs::perm_options::add);
+  std::fstream io(file, std::ios::in | std::ios::out | std::ios::binary);
+  io.seekg(static_cast<std::streamoff>(at));
+  const char was = static_cast<char>(io.get());
+  io.seekp(static_cast<std::streamoff>(at));
+  io.put(static_cast<char>(was ^ 0x01));
+}
+
+// The package's folder after one use that ended.
+fs::path used_once(Fixture &f, const protocol::Package &package) {
+  auto lease = f.cache->acquire(package, "launch-1");
+  REQUIRE(lease.has_value());
+  return (*lease)->root();
+}
+
+// A use refused names the file and both hashes, and drops the package: nothing of it is left, and
+// the next use fetches it again and gets the domain's bytes.
+void check_refused_then_fetched_again(Fixture &f, const protocol::Package &package,
+                                      const std::string &expected_bytes) {
+  const auto run = std::find_if(package.files.begin(), package.files.end(),
+                                [](const auto &file) { return file.path == "apps/A/C/run"; });
+  REQUIRE(run != package.files.end());
+  auto refused = f.cache->acquire(package, "launch-2");
+  REQUIRE_FALSE(refused.has_value());
+  CHECK_THAT(refused.error().message,
+             Contains("apps/A/C/run") && Contains(run->sha256) && Contains("hashes to"));
+  CHECK(f.cache->counts().packages == 0);
+  CHECK(f.nothing_left());
+  const auto before = f.domain.bytes_read();
+  auto again = f.cache->acquire(package, "launch-3");
+  REQUIRE(again.has_value());
+  CHECK(f.domain.bytes_read() - before == run->size);
+  CHECK(read((*again)->root() / "apps/A/C/run") == expected_bytes);
+}
+
+} // namespace
+
+TEST_CASE("package cache: a cached file changed in place at the same size is refused at its next "
+          "use, and fetched again after",
+          "[package]") {
+  Fixture f;
+  f.open();
+  const auto package = f.package(5000, 'm');
+  const fs::path root = used_once(f, package);
+  change_a_byte(root / "apps/A/C/run", 4321);
+  CHECK(fs::file_size(root / "apps/A/C/run") == 5000);
+  check_refused_then_fetched_again(f, package, bytes_of_size(5000, 'm'));
+}
+
+TEST_CASE("package cache: a cached file cut short is refused at its next use", "[package]") {
+  Fixture f;
+  f.open();
+  const auto package = f.package(5000, 't');
+  const fs::path root = used_once(f, package);
+  fs::permissions(root / "apps/A/C/run", fs::perms::owner_write, fs::perm_options::add);
+  fs::resize_file(root / "apps/A/C/run", 4000);
+  check_refused_then_fetched_again(f, package, bytes_of_size(5000, 't'));
+}
+
+TEST_CASE("package cache: a file changed while the node was down is refused at its first use",
+          "[package]") {
+  Fixture f;
+  f.open();
+  const auto package = f.package(5000, 'd');
+  const fs::path root = used_once(f, package);
+  f.cache.reset();
+  change_a_byte(root / "apps/A/C/run", 10);
+  f.open();
+  check_refused_then_fetched_again(f, package, bytes_of_size(5000, 'd'));
 }

@@ -19,7 +19,7 @@
 #include "commands.hpp"
 #include "domain_client.hpp"
 #include "exit_codes.hpp"
-#include "process/spawn.hpp"
+#include "process/run_program.hpp"
 #include "protocol/application_ops.hpp"
 
 namespace rsca::cli {
@@ -28,27 +28,15 @@ namespace {
 namespace fs = std::filesystem;
 using namespace std::chrono_literals;
 
-// dot lays out a picture of a hundred components in well under a second: past this it is stuck.
 constexpr auto kDotTimeout = 30s;
 
 tl::unexpected<Error> graphviz_error(std::string message) {
   return make_error({"dot", 0, 0}, "graphviz", std::move(message));
 }
 
-// Graphviz's dot in PATH (spawn runs a program as given, never looking it up).
 Expected<fs::path> find_dot() {
-  const char *path = std::getenv("PATH");
-  std::string_view dirs = path != nullptr ? path : "/usr/bin:/bin";
-  while (true) {
-    const auto colon = dirs.find(':');
-    const fs::path candidate = fs::path(dirs.substr(0, colon)) / "dot";
-    std::error_code ec;
-    if (fs::is_regular_file(candidate, ec) && ::access(candidate.c_str(), X_OK) == 0)
-      return candidate;
-    if (colon == std::string_view::npos)
-      break;
-    dirs.remove_prefix(colon + 1);
-  }
+  if (auto dot = process::find_program("dot"))
+    return *dot;
   return graphviz_error("no Graphviz dot in PATH: --graph svg needs it (install the Debian "
                         "package graphviz: apt-get install graphviz), or use --graph dot");
 }
@@ -90,23 +78,6 @@ Expected<void> write_file(const fs::path &file, const std::string &text) {
   return {};
 }
 
-// Waits for dot, killing it past kDotTimeout; an error unless it exited with 0.
-Expected<void> wait_for_dot(const process::Child &dot) {
-  int status = 0;
-  if (!process::wait_exited(dot.pidfd, kDotTimeout)) {
-    ::kill(dot.pid, SIGKILL);
-    ::waitpid(dot.pid, &status, 0);
-    return graphviz_error(fmt::format("dot did not finish within {} s and was killed",
-                                      std::chrono::seconds(kDotTimeout).count()));
-  }
-  ::waitpid(dot.pid, &status, 0);
-  if (WIFEXITED(status) && WEXITSTATUS(status) == 0)
-    return {};
-  return graphviz_error(WIFEXITED(status)
-                            ? fmt::format("dot failed with exit status {}", WEXITSTATUS(status))
-                            : fmt::format("dot ended by signal {}", WTERMSIG(status)));
-}
-
 // `dot_text` as SVG, by `dot`, into `output` (empty: this process's stdout).
 Expected<void> render_svg(const fs::path &dot, const std::string &dot_text,
                           const std::string &output) {
@@ -120,10 +91,10 @@ Expected<void> render_svg(const fs::path &dot, const std::string &dot_text,
     args.insert(args.end(), {"-o", output});
   args.push_back(input->path().string());
   std::fflush(stdout); // what this process printed comes before dot's output
-  auto child = process::spawn({.program = dot, .args = args}, process::Group::Caller);
-  if (!child)
-    return tl::unexpected(std::move(child.error()));
-  return wait_for_dot(*child);
+  // dot lays out a picture of a hundred components in well under a second: past this it is stuck.
+  if (auto ran = process::run_to_end({.program = dot, .args = args}, kDotTimeout); !ran)
+    return graphviz_error(ran.error());
+  return {};
 }
 
 } // namespace
