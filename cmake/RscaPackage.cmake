@@ -18,16 +18,19 @@ set(CPACK_STRIP_FILES ON) # the build's debug info stays in the build (RelWithDe
 
 set(CPACK_DEBIAN_RUNTIME_PACKAGE_NAME rsca)
 set(CPACK_DEBIAN_RUNTIME_PACKAGE_SHLIBDEPS ON)
+# Beside what its programs link: the domain runs binutils' objcopy to deliver code without its
+# debug information (domain/delivered_code.hpp).
+set(CPACK_DEBIAN_RUNTIME_PACKAGE_DEPENDS "binutils")
 set(CPACK_DEBIAN_RUNTIME_PACKAGE_RECOMMENDS "graphviz") # rsca show --graph svg
-set(CPACK_COMPONENT_RUNTIME_DESCRIPTION
-    "rsca's domain and node daemons, its CLI, the component host and runtime, the schemas and the default profiles")
-
 # postinst creates the user rsca, whom the nodes run component processes as.
 if(CPACK_DEBIAN_RUNTIME_PACKAGE_DEPENDS)
   string(APPEND CPACK_DEBIAN_RUNTIME_PACKAGE_DEPENDS ", adduser")
 else()
   set(CPACK_DEBIAN_RUNTIME_PACKAGE_DEPENDS "adduser")
 endif()
+set(CPACK_COMPONENT_RUNTIME_DESCRIPTION
+    "rsca's domain and node daemons, its CLI, the component host and runtime, the schemas and the default profiles")
+
 set(CPACK_DEBIAN_DEV_PACKAGE_NAME rsca-dev)
 set(CPACK_DEBIAN_DEV_PACKAGE_DEPENDS
     "rsca (= ${PROJECT_VERSION}), libexpected-dev, libfmt-dev, libspdlog-dev, nlohmann-json3-dev, cyclonedds-dev")

@@ -231,9 +231,12 @@ CallResult<app_ops::ProgressReply> DomainManager::Impl::progress(const app_ops::
   if (!progress)
     return control::call_error(Status::NotFound,
                                fmt::format("no launch {}", excerpt(request.launch_id)));
-  app_ops::ProgressReply reply{steps_of(progress->steps), progress->done, std::nullopt};
-  if (const auto bytes = files->delivered(request.launch_id); bytes > 0)
-    reply.delivered_bytes = bytes;
+  app_ops::ProgressReply reply{steps_of(progress->steps), progress->done, std::nullopt,
+                               std::nullopt};
+  if (const auto delivered = files->delivered(request.launch_id); delivered.bytes > 0) {
+    reply.delivered_bytes = delivered.bytes;
+    reply.delivered_wire_bytes = delivered.wire_bytes;
+  }
   return reply;
 }
 
@@ -352,11 +355,11 @@ DomainManager::Impl::plan_application(const app_ops::PlanRequest &request) {
   if (!installed)
     return control::call_error(Status::NotFound, fmt::format("no application {} is installed",
                                                              excerpt(request.application)));
+  if (auto stray = allocator::unknown_assignment(*installed->profile, request.assign))
+    return unknown_assignment_error(request.application, *stray);
   const allocator::PlanOptions plan_options{strategy->value_or(options.strategy)};
   auto plan =
       allocator.plan(allocator::plan_request_of(*installed->profile, request.assign), plan_options);
-  if (auto stray = allocator::unknown_assignment(*installed->profile, request.assign))
-    return unknown_assignment_error(request.application, *stray);
   return allocator::plan_reply(plan, plan_options.strategy);
 }
 
@@ -443,7 +446,8 @@ DomainManager::create(std::shared_ptr<dds::Participant> participant, DomainOptio
   impl->events = std::move(*events);
   impl->repository.emplace(impl->options.repository, *impl->store);
   impl->repository->load();
-  impl->files.emplace(impl->options.repository, impl->options.exec_path);
+  impl->files.emplace(impl->options.repository, impl->options.exec_path,
+                      impl->options.delivery);
   Impl *raw = impl.get();
   impl->runtime_connections.emplace(
       impl->options.name, impl->endpoint,

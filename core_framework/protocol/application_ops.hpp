@@ -216,11 +216,13 @@ struct LaunchId {
 struct ProgressReply {
   std::vector<StepView> steps;
   bool done = false;
-  std::optional<std::uint64_t> delivered_bytes; // files the nodes fetched for it so far
+  std::optional<std::uint64_t> delivered_bytes;      // files the nodes fetched for it so far
+  std::optional<std::uint64_t> delivered_wire_bytes; // what they took on the wire (compressed)
   static constexpr auto fields() {
     return std::tuple{required("steps", &ProgressReply::steps),
                       required("done", &ProgressReply::done),
-                      optional("delivered_bytes", &ProgressReply::delivered_bytes)};
+                      optional("delivered_bytes", &ProgressReply::delivered_bytes),
+                      optional("delivered_wire_bytes", &ProgressReply::delivered_wire_bytes)};
   }
 };
 
@@ -240,8 +242,6 @@ struct AppRequest {
   static constexpr auto fields() { return std::tuple{required("app", &AppRequest::app)}; }
 };
 
-struct ReleaseReply {
-  std::string name;
 // A component of a released application whose node is lost: its process could not be ended,
 // and is ended when its node is back.
 struct LostComponent {
@@ -253,12 +253,14 @@ struct LostComponent {
   }
 };
 
+struct ReleaseReply {
+  std::string name;
   std::vector<std::string> unconfirmed; // components its node terminated
-  static constexpr auto fields() {
-    return std::tuple{required("name", &ReleaseReply::name),
   // Components whose node is lost: to be ended when it is back. Absent when there are none: a
   // CLI of an earlier version, which refuses a field it does not know, still reads the reply.
   std::optional<std::vector<LostComponent>> to_end_later;
+  static constexpr auto fields() {
+    return std::tuple{required("name", &ReleaseReply::name),
                       required("unconfirmed", &ReleaseReply::unconfirmed),
                       optional("to_end_later", &ReleaseReply::to_end_later)};
   }

@@ -171,8 +171,10 @@ void print_progress(const DomainClient &client, const std::string &launch_id, Sh
     return;
   const auto delivered = progress->delivered_bytes.value_or(0);
   if (!progress->done && delivered >= shown.delivered_bytes + 1'000'000) {
-    fmt::print("  ~ {:<10} {:>8.1f} MB of files delivered to the nodes so far\n", "execute",
-               static_cast<double>(delivered) / 1e6);
+    fmt::print("  ~ {:<10} {:>8.1f} MB of files delivered to the nodes so far ({:.1f} MB on the "
+               "wire)\n",
+               "execute", static_cast<double>(delivered) / 1e6,
+               static_cast<double>(progress->delivered_wire_bytes.value_or(delivered)) / 1e6);
     shown.delivered_bytes = delivered;
   }
   const auto &steps = progress->steps;
@@ -401,12 +403,12 @@ void add_lifecycle_commands(CLI::App &app, const GlobalOptions &global, int &exi
         fmt::print("release: {}\n", r.name);
         for (const auto &id : r.unconfirmed)
           fmt::print("  {} did not confirm its release and was terminated by its node\n", id);
-      });
-}
         for (const auto &lost : r.to_end_later.value_or(std::vector<app_ops::LostComponent>{}))
           fmt::print("  {} could not be ended: its node {} is lost; to be ended when its node {} "
                      "is back\n",
                      lost.component, lost.node, lost.node);
+      });
+}
 int show_application(const std::string &name, const GlobalOptions &global) {
   return simple_call<app_ops::Show>(
       "show", {name}, global, [](const app_ops::ApplicationView &app) {
