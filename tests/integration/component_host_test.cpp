@@ -177,6 +177,31 @@ TEST_CASE("a component host that cannot load a library fails the launch, which r
           "everything",
           "[integration][host][failure]") {
   TestDomain domain;
+  // The library is delivered (it is there) but is text, not a shared object: the host starts
+  // and its dlopen fails.
+  domain.install("UnloadableLibrary");
+  auto [rc, out] = domain.cli({"launch", "UnloadableLibrary"});
+  INFO(out);
+  CHECK(rc == 6);
+  CHECK_THAT(out, Catch::Contains("failed at step 'register'"));
+  CHECK_THAT(out, Catch::Contains("Consumer_1 exited before registering"));
+  // The processes started (the host's, the producers') were ended.
+  CHECK_THAT(out, Catch::Contains("processes terminated"));
+  // The host said why, in its log.
+  std::string logs;
+  for (const auto &entry : fs::recursive_directory_iterator(domain.run_dir() / "logs"))
+    if (entry.is_regular_file()) {
+      std::ifstream in(entry.path());
+      logs.append(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    }
+  CHECK_THAT(logs, Catch::Contains("cannot load") && Catch::Contains("librsca-unloadable.so"));
+  domain.require_clean({});
+}
+
+TEST_CASE("a hosted component whose library is missing fails the launch before any process "
+          "starts",
+          "[integration][host][failure]") {
+  TestDomain domain;
   domain.install("MissingLibrary");
   auto [rc, out] = domain.cli({"launch", "MissingLibrary"});
   INFO(out);

@@ -9,12 +9,14 @@
 #include <string>
 #include <vector>
 
+#include <fcntl.h>
 #include <signal.h>
 #include <unistd.h>
 
 #include <catch2/catch.hpp>
 
 #include "domain_fixture.hpp"
+#include "process/fork_request.hpp"
 
 using namespace rsca::test;
 
@@ -26,9 +28,30 @@ struct ProcessFacts {
   long group = 0;
   std::string command_line; // NULs as spaces
   std::string executable;
-  std::string
-      first_mapping; // its lowest mapping's address range: a forked process's is its server's
+  // The environment the kernel shows (/proc/PID/environ): the one the process was executed with.
+  // A process forked from a fork server never executed: it shows its server's, which names the
+  // server's socket (process/fork_request.hpp's kForkServerVariable), whatever the process set
+  // afterwards. Unlike the memory layout, this holds without address randomisation too.
+  std::string exec_environment; // NULs as newlines
 };
+
+bool executed_as_fork_server(const ProcessFacts &facts) {
+  return facts.exec_environment.find(std::string("\n") + rsca::process::kForkServerVariable +
+                                     "=") != std::string::npos;
+}
+
+// A /proc file's bytes; what was read when the process ends meanwhile (an ifstream would throw).
+std::string proc_file(const fs::path &file) {
+  std::string text;
+  const int fd = ::open(file.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0)
+    return text;
+  char buffer[4096];
+  for (ssize_t n; (n = ::read(fd, buffer, sizeof buffer)) > 0;)
+    text.append(buffer, static_cast<std::size_t>(n));
+  ::close(fd);
+  return text;
+}
 
 ProcessFacts facts_of(long pid) {
   ProcessFacts facts{pid, 0, 0, {}, {}, {}};
@@ -48,8 +71,9 @@ ProcessFacts facts_of(long pid) {
     c = c == '\0' ? ' ' : c;
   std::error_code ec;
   facts.executable = fs::read_symlink(proc / "exe", ec).string();
-  std::ifstream maps(proc / "maps");
-  maps >> facts.first_mapping;
+  facts.exec_environment = "\n" + proc_file(proc / "environ");
+  for (auto &c : facts.exec_environment)
+    c = c == '\0' ? '\n' : c;
   return facts;
 }
 
@@ -100,10 +124,9 @@ TEST_CASE("a node forks the processes of an executable from a fork server of it,
     servers = fork_servers_of(node);
     REQUIRE(servers.size() == 2); // one per executable: the producer's, the consumer's
     std::set<std::string> served;
-    std::set<std::string> layouts; // where each server's executable is mapped
     for (const auto &server : servers) {
       served.insert(server.executable);
-      layouts.insert(server.first_mapping);
+      CHECK(executed_as_fork_server(server));
     }
     for (const long pid : pids) {
       const auto facts = facts_of(pid);
@@ -111,7 +134,7 @@ TEST_CASE("a node forks the processes of an executable from a fork server of it,
       CHECK(facts.parent == node);
       CHECK(facts.group == pid);
       CHECK(served.count(facts.executable) == 1);
-      CHECK(layouts.count(facts.first_mapping) == 1); // forked from one: an exec maps it anew
+      CHECK(executed_as_fork_server(facts)); // forked from one, never executed
       CHECK_THAT(facts.command_line, Catch::Contains("COMPONENT_IDENTIFIER"));
     }
     // A forked process that dies is reported as any: the application is degraded.
@@ -149,6 +172,7 @@ TEST_CASE("a node whose GPP's fork_server is false executes every process",
     CHECK(facts.parent == node);
     CHECK(facts.group == pid);
     CHECK_THAT(facts.command_line, Catch::Contains("COMPONENT_IDENTIFIER"));
+    CHECK_FALSE(executed_as_fork_server(facts)); // executed: its own environment
   }
   REQUIRE(domain.call("app.release", Json{{"app", "a"}}).has_value());
   domain.require_clean(pids);
