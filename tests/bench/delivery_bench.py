@@ -9,9 +9,17 @@ application is launched again: node2 finds the package in its cache. With root, 
 CLI's wall time from `rsca launch` to running and matched, the launch's execute step, and, as the
 baseline of the same run, a plain TCP copy of the same file between the same two hosts. Issue 21's
 target: the first launch under 1 s, the second from the cache.
+
+With --first-launch (issue 37): the build's own ProducerConsumer launched in a fresh domain (new
+repository, empty node cache), each round twice, once with the domain delivering the files as they
+are (rsca-domaind --delivery as-is: a RelWithDebInfo build's debug information and all,
+uncompressed, as before issue 37) and once as it does by default (stripped of debug information,
+compressed): the MB delivered (the files' and on the wire) and the CLI's time of the launch.
+Issue 37's target: at most 4 MB on the wire and under 300 ms.
 """
 import json
 import os
+import re
 import secrets
 import shutil
 import socket
@@ -106,8 +114,60 @@ def rounds(domain, bin_dir, folder, runs, tcp):
             "cached_execute_ms": summary(again_exec), "tcp_copy_ms": summary(copies)}
 
 
+def delivered_mb(detail):
+    """(MB of the files, MB on the wire) of an execute step's detail; (0, 0) when none."""
+    m = re.search(r"([0-9.]+) MB of their files delivered \(([0-9.]+) MB on the wire\)", detail)
+    return (float(m.group(1)), float(m.group(2))) if m else (0.0, 0.0)
+
+
+def first_launches(args, runs):
+    """Each round: a fresh domain per way of delivery, its first launch of ProducerConsumer."""
+    rsca = os.path.join(args.bin, "rsca")
+    results = {}
+    for delivery in ("as-is", "stripped"):
+        launch_ms, files_mb, wire_mb = [], [], []
+        for _ in range(runs):
+            fresh = Domain(rsca, nodes=1, sdrroot=args.sdrroot,
+                           domaind_args=["--delivery", delivery])
+            # The node runs components as the GPP's run_as user (nobody, run by root): they
+            # enter their package under the run folder, which mkdtemp makes 0700.
+            os.chmod(fresh.run_dir, 0o755)
+            with fresh as domain:
+                domain.cli("install", os.path.join(args.sdrroot, SAD))
+                reply, ms = domain.cli("launch", "ProducerConsumer")
+                step_ms, detail = execute_ms(reply)
+                files, wire = delivered_mb(detail)
+                if files == 0:
+                    raise RuntimeError(f"nothing delivered ({detail})")
+                launch_ms.append(ms)
+                files_mb.append(files)
+                wire_mb.append(wire)
+                domain.cli("release", "ProducerConsumer")
+        results[delivery] = {"launch_ms": summary(launch_ms), "files_mb": summary(files_mb),
+                             "wire_mb": summary(wire_mb)}
+    json.dump(results, open(args.out, "w"), indent=2)
+    print(f"First launch of ProducerConsumer in a fresh domain, from the build in {args.bin}, "
+          f"{runs} rounds:\n")
+    print("| delivery | launch (CLI) median | p95 | MB of files | MB on the wire |")
+    print("| --- | --- | --- | --- | --- |")
+    for delivery, label in (("as-is", "as-is (before issue 37)"),
+                            ("stripped", "stripped, compressed (default)")):
+        r = results[delivery]
+        print(f"| {label} | {r['launch_ms']['median']:.1f} ms | {r['launch_ms']['p95']:.1f} ms | "
+              f"{r['files_mb']['median']:.1f} | {r['wire_mb']['median']:.1f} |")
+    s = results["stripped"]
+    print(f"\nfirst launch delivered on the wire = {s['wire_mb']['median']:.1f} MB (target <= 4 MB), "
+          f"launch median = {s['launch_ms']['median']:.1f} ms (target < 300 ms)")
+    return 0
+
+
 def main():
-    args = bench_arguments(__doc__).parse_args()
+    parser = bench_arguments(__doc__)
+    parser.add_argument("--first-launch", action="store_true",
+                        help="the build's ProducerConsumer in a fresh domain, as-is and stripped")
+    args = parser.parse_args()
+    if args.first_launch:
+        return first_launches(args, 3 if args.quick else 5)
     runs = 3 if args.quick else 10
     rsca = os.path.join(args.bin, "rsca")
     folder = tempfile.mkdtemp(prefix="rsca-delivery-")
