@@ -9,12 +9,30 @@
 # The same function builds rsca's example components in its tree and a user's components against
 # an installed rsca (find_package(rsca)); both give it the targets rsca::runtime and
 # rsca::component_library.
+# What a node runs is the code, not the debug information (issue 37: a RelWithDebInfo example
+# executable was 63 MB, 1.9 MB of it code, and a fresh domain hashed and stripped all of it at its
+# first launch): the executable keeps its symbols and loses its debug sections to <file>.debug
+# beside it, which gdb finds through the executable's .gnu_debuglink, as Debian's dh_strip lays
+# out a -dbgsym package. Not under the sanitizers, whose reports read the debug information in
+# the executable itself.
+function(rsca_split_debug_info target)
+  if(RSCA_SANITIZE OR RSCA_SANITIZE_THREAD OR NOT CMAKE_OBJCOPY)
+    return()
+  endif()
+  add_custom_command(TARGET ${target} POST_BUILD
+    COMMAND ${CMAKE_OBJCOPY} --only-keep-debug $<TARGET_FILE:${target}> $<TARGET_FILE:${target}>.debug
+    COMMAND ${CMAKE_OBJCOPY} --strip-debug --add-gnu-debuglink=$<TARGET_FILE:${target}>.debug
+            $<TARGET_FILE:${target}>
+    VERBATIM)
+endfunction()
+
 function(rsca_add_component name)
   if(NOT ARGN)
     message(FATAL_ERROR "rsca_add_component(${name}): no sources given")
   endif()
   add_executable(${name} ${ARGN})
   target_link_libraries(${name} PRIVATE rsca::runtime)
+  rsca_split_debug_info(${name})
   add_library(${name}-library MODULE ${ARGN})
   set_target_properties(${name}-library PROPERTIES OUTPUT_NAME ${name} PREFIX lib)
   target_link_libraries(${name}-library PRIVATE rsca::component_library)

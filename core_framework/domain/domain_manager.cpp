@@ -446,8 +446,7 @@ DomainManager::create(std::shared_ptr<dds::Participant> participant, DomainOptio
   impl->events = std::move(*events);
   impl->repository.emplace(impl->options.repository, *impl->store);
   impl->repository->load();
-  impl->files.emplace(impl->options.repository, impl->options.exec_path,
-                      impl->options.delivery);
+  impl->files.emplace(impl->options.repository, impl->options.exec_path, impl->options.delivery);
   Impl *raw = impl.get();
   impl->runtime_connections.emplace(
       impl->options.name, impl->endpoint,

@@ -508,10 +508,17 @@ Expected<pid_t> start_forked(const Command &command, Group group, int log_fd) {
   }
   if (const auto *report = std::get_if<ForkReport>(&forked)) {
     const std::string step(report->step, ::strnlen(report->step, sizeof report->step));
-    return spawn_error(command,
-                       fmt::format("cannot execute {} as user {}: {}: {}", command.program.string(),
-                                   command.user ? command.user->user : "", step,
-                                   errno_text(report->error)));
+    // The usual cause on a first try: a cache or run folder under one only its owner may enter
+    // (a home folder, mktemp -d), which the user the process runs as cannot pass through.
+    const bool unreachable = report->error == EACCES && (step == "chdir" || step == "execve");
+    return spawn_error(
+        command,
+        fmt::format("cannot execute {} as user {}: {}: {}{}", command.program.string(),
+                    command.user ? command.user->user : "", step, errno_text(report->error),
+                    unreachable ? " (every folder above it must let that user pass: "
+                                  "chmod o+x, or a node --cache-dir elsewhere, or the "
+                                  "GPP's run_as in the node's DCD)"
+                                : ""));
   }
   return std::get<pid_t>(forked);
 }

@@ -14,6 +14,8 @@ build="$1"
 flags="$2"
 soname="$3"
 work="$(mktemp -d /tmp/rsca-sdk-test.XXXXXX)"
+# Open to the user component processes run as (the GPP's run_as): mktemp -d makes it 0700.
+chmod 755 "$work"
 usr="$work/root/usr"
 rsca="$usr/bin/rsca"
 sdr="$work/sdr"

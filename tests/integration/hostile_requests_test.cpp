@@ -211,8 +211,8 @@ TEST_CASE("requests whose reply address nobody reads hold no handler thread and 
   CHECK(wait_until([&] { return client.reply_writers_into(prefix) == 0; }, 30s, 200ms));
 }
 
-TEST_CASE("app.create with assign entries naming no component is refused, naming one; 500,000 of "
-          "them too, and the domain answers on",
+TEST_CASE("app.create with assign entries naming no component is refused and names one and so are "
+          "500,000 of them and the domain answers on",
           "[integration][hostile]") {
   TestDomain domain(1);
   domain.install("Healthy");
@@ -282,8 +282,8 @@ TEST_CASE("clients that connect to a node's control socket and send nothing are 
   CHECK(refusal_lines() <= 5);
 }
 
-TEST_CASE("a component that sends its node a frame nested 100,000 deep is answered bad request; "
-          "the node, and the component's link, go on",
+TEST_CASE("a component that sends its node a frame nested 100,000 deep is answered bad request "
+          "and the node and the component's link go on",
           "[integration][hostile]") {
   TestDomain domain(1);
   const Json app = domain.create("Chatty");

@@ -434,7 +434,9 @@ TEST_CASE("PRF: Consumer counters and GPP allocation properties", "[descriptors]
   CHECK(definition<SimpleProperty>(consumer, "log_every").type.type == SimpleType::ULong);
 
   const auto gpp = read<Properties>(kGpp / "GPP.prf.xml");
-  REQUIRE(gpp.properties.size() == 10);
+  REQUIRE(gpp.properties.size() == 11);
+  const auto &run_as = definition<SimpleProperty>(gpp, "run_as");
+  CHECK(run_as.type.type == SimpleType::String);
   const auto &pin = definition<SimpleProperty>(gpp, "pin_admitted_cpu");
   CHECK(pin.type.type == SimpleType::Boolean);
   CHECK(as<bool>(pin.value));

@@ -308,8 +308,8 @@ TEST_CASE("delivered code: an executable with debug sections is served without t
   CHECK(fs::exists(repo.root / ".delivered" / code.sha256));
 }
 
-TEST_CASE("delivered code: a file that is not ELF is served as it is; --delivery as-is serves the "
-          "build's file itself, uncompressed",
+TEST_CASE("delivered code: a file that is not ELF is served as it is and --delivery as-is serves "
+          "the build's file itself uncompressed",
           "[package][delivery]") {
   SECTION("not ELF") {
     test::TempDir dir;

@@ -183,12 +183,17 @@ TEST_CASE("a runtime model older than a file it came from is not used: the XML i
   INFO(changed);
   const fs::path file = copy.dir / changed;
   SECTION("its modification time") {
-    fs::last_write_time(file, fs::last_write_time(file) + std::chrono::seconds(1));
+    const auto before = fs::last_write_time(file);
+    fs::last_write_time(file, before + std::chrono::seconds(1));
+    REQUIRE(fs::last_write_time(file) > before);
   }
   SECTION("its size, at the same modification time") {
     const auto when = fs::last_write_time(file);
+    const auto size = fs::file_size(file);
     std::ofstream(file, std::ios::app) << "\n";
     fs::last_write_time(file, when);
+    REQUIRE(fs::file_size(file) == size + 1);
+    REQUIRE(fs::last_write_time(file) == when);
   }
 
   auto read = read_runtime_model(copy.spd);
