@@ -108,6 +108,7 @@ std::size_t entries(const fs::path &dir) {
 TEST_CASE("a component's files are delivered to its node once: verified, run from the node's "
           "cache, reused by the next launch",
           "[integration][delivery]") {
+  DefaultDelivery compressed; // also under the sanitizers
   TestDomain domain;
   auto [rc, out] = domain.cli({"--json", "launch", kProducerConsumer});
   INFO(out);
@@ -268,6 +269,7 @@ TEST_CASE("a delivered executable has no debug sections yet runs, the domain kee
   const auto built_faulty = sections_of(kBin / "rsca-test-faulty");
   REQUIRE(built_faulty.has(".debug_info")); // a build with debug information, as the issue's
   REQUIRE_FALSE(built_faulty.build_id.empty());
+  DefaultDelivery stripped; // also under the sanitizers
   TestDomain domain;
   const std::string healthy = (kTestSdr / "dom/waveforms/Healthy/Healthy.sad.xml").string();
   auto [rc, out] = domain.cli({"--json", "launch", "--sdrroot", kTestSdr.string(), healthy});

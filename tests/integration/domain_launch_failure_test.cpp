@@ -71,6 +71,18 @@ TEST_CASE("a launch the CLI stops waiting for is cancelled and rolled back",
   CHECK_THAT(out, Catch::Contains("the launch is cancelled"));
   CHECK_THAT(out, !Catch::Contains("rsca domain up"));
   CHECK(TestDomain::wait_for([&] { return domain.running_pids().empty(); }));
+  // The cancel ends the launch at its step's end: under the sanitizers the launch may still be
+  // fetching its code when the CLI gives up, and rolls back once that step has ended.
+  CHECK(TestDomain::wait_for([&] {
+    auto devices = domain.call("domain.devices");
+    if (!devices)
+      return false;
+    for (const auto &d : devices->at("devices"))
+      for (const auto &[name, c] : d.at("capacity").items())
+        if (c.at("allocated").get<double>() > 1e-9)
+          return false;
+    return true;
+  }));
   domain.require_clean({});
 }
 
