@@ -432,6 +432,10 @@ DeviceManager::~DeviceManager() {
   impl_->links->close(); // relays under way fail: the endpoint's handlers return
   // The endpoint goes first: closing it waits for the handlers still running, which use the
   // devices (a node.terminate still escalating while the devices went was a double free).
+  // Handlers under way (an execute fetching its package) call through impl_->endpoint, which
+  // reset() clears before the endpoint's destructor waits for them: UBSan saw a package fetch
+  // call through null as a node stopped. They are waited for here, the pointer still set.
+  impl_->endpoint->stop_serving();
   {
     std::lock_guard lock(impl_->endpoint_mutex);
     impl_->endpoint.reset();
