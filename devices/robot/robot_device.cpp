@@ -177,6 +177,9 @@ public:
     property("latency_p99_us", latency_p99_us_);
     property("latency_max_us", latency_max_us_);
     property("latency_samples", latency_samples_);
+    property("command_log_first", command_log_first_);
+    property("command_log_delay_us", command_log_delay_us_);
+    property("command_log_sim_time", command_log_sim_time_);
   }
 
 private:
@@ -193,8 +196,11 @@ private:
       auto lock = lock_properties();
       ++commands_;
       last_command_ = Clock::now();
-      if (c.timestamp_ns > 0 && now >= c.timestamp_ns)
-        record_latency(static_cast<double>(now - c.timestamp_ns) / 1e3);
+      if (c.timestamp_ns > 0 && now >= c.timestamp_ns) {
+        const double us = static_cast<double>(now - c.timestamp_ns) / 1e3;
+        record_latency(us);
+        log_command(us, world->world().snapshot().time);
+      }
     }
     if (c.name == "estop") {
       world->world().emergency_stop();
@@ -232,6 +238,25 @@ private:
     latency_p99_us_ = at(std::min(window.size() - 1, window.size() * 99 / 100));
   }
 
+  // Each recent command's delay and the world's time at its arrival, oldest first, the first
+  // being command number command_log_first: a benchmark cuts a run's commands where the robot
+  // rested and takes its own percentiles, as it does for its baselines (issue 38). Between
+  // kCommandLog and twice that many are kept: the oldest half goes at once (amortised O(1)).
+  static constexpr std::size_t kCommandLog = 4096;
+
+  void log_command(double delay_us, double sim_time) {
+    if (command_log_delay_us_.size() == 2 * kCommandLog) {
+      const auto half = static_cast<std::ptrdiff_t>(kCommandLog);
+      command_log_delay_us_.erase(command_log_delay_us_.begin(),
+                                  command_log_delay_us_.begin() + half);
+      command_log_sim_time_.erase(command_log_sim_time_.begin(),
+                                  command_log_sim_time_.begin() + half);
+    }
+    command_log_delay_us_.push_back(delay_us);
+    command_log_sim_time_.push_back(sim_time);
+    command_log_first_ = latency_samples_ - command_log_delay_us_.size();
+  }
+
   // The command deadline: a robot whose controller went silent stops.
   std::optional<Clock::duration> service() override {
     auto world = RobotWorld::current();
@@ -258,6 +283,8 @@ private:
   std::uint64_t latency_samples_ = 0;
   std::vector<double> latencies_;
   double latency_sum_us_ = 0;
+  std::uint64_t command_log_first_ = 0;
+  std::vector<double> command_log_delay_us_, command_log_sim_time_;
   std::optional<Clock::time_point> last_command_;
 };
 

@@ -128,12 +128,8 @@ def first_launches(args, runs):
     for delivery in ("as-is", "stripped"):
         launch_ms, files_mb, wire_mb = [], [], []
         for _ in range(runs):
-            fresh = Domain(rsca, nodes=1, sdrroot=args.sdrroot,
-                           domaind_args=["--delivery", delivery])
-            # The node runs components as the GPP's run_as user (nobody, run by root): they
-            # enter their package under the run folder, which mkdtemp makes 0700.
-            os.chmod(fresh.run_dir, 0o755)
-            with fresh as domain:
+            with Domain(rsca, nodes=1, sdrroot=args.sdrroot,
+                        domaind_args=["--delivery", delivery]) as domain:
                 domain.cli("install", os.path.join(args.sdrroot, SAD))
                 reply, ms = domain.cli("launch", "ProducerConsumer")
                 step_ms, detail = execute_ms(reply)

@@ -172,6 +172,9 @@ class Domain:
         self.cli_args = cli_args or []
         self.spawned = []
         self.run_dir = tempfile.mkdtemp(prefix="rsca-bench-")
+        # The nodes run components as their GPP's run_as user (`rsca`, else `nobody`), who must
+        # pass through this folder to the package cache under it: mkdtemp makes it 0700.
+        os.chmod(self.run_dir, 0o755)
         self.env = dict(dds_env(), RSCA_RUN_DIR=self.run_dir, **(env or {}))
         self.nodes = nodes
         self.sdrroot = sdrroot

@@ -16,13 +16,12 @@ is measured, and the output says it too):
   (class Dds). Delay: the round trip, a reading there and a command back.
 - rsca: a real local domain (rsca-domaind, rsca-noded for node1, a GPP, and rsca-noded for the
   robot's DCD), RangeStop launched: StopCrash in a process of its own on node1, the IRSensor and
-  the DriveSystem devices in the robot's node daemon, connected over Cyclone DDS. Delay: what the
-  DriveSystem measures: the mean of each run's commands from its command count and delay sum
-  before and after the run; p50 and p99 from the DriveSystem's own window over every command of
-  all runs, including the zero commands StopCrash sends once it has stopped the robot (their
-  share is estimated from the Robot's trace and printed): the DriveSystem keeps no per-command
-  record the benchmark could cut at rest. So that the phase is the baselines' (start to rest),
-  each run lasts what the last baseline run took to rest (its world time).
+  the DriveSystem devices in the robot's node daemon, connected over Cyclone DDS. Delay: each
+  command's, taken at the drive (the DriveSystem's command log: every recent command's delay and
+  the world's time at its arrival), from the run's start until the robot rests, as for the
+  baselines; the commands StopCrash sends after rest are cut off (and counted). The mean and the
+  percentiles are computed here over every run's commands. Each run lasts what the last baseline
+  run took to rest (its world time), and a little longer if StopCrash has not stopped yet.
   Between runs the application is stopped, the Robot given the run's seed and reset (its world
   re-created, the robot back at its start), and the application started again (StopCrash.start()
   clears its latch). The CLI is not called while StopCrash runs: every CLI call is a DDS
@@ -36,7 +35,7 @@ Run i (from 0) uses seed 1 + i in all three ways (the sensor's noise). The stopp
 exact distance from the sensor to the wall at rest (world.true_range(0); the Robot's
 distance_to_wall). The prediction is sim::stop_tolerance with latency = the sensor period: the
 robot should rest no nearer than threshold - tolerance, give or take the noise (sigma 5 mm).
-Delay percentiles are taken as the DriveSystem takes them (sorted[n/2], sorted[n*99/100]).
+Delay percentiles are sorted[n/2] and sorted[n*99/100] over every run's commands, for every way.
 
 With --hosts (root; tools/hosts), as the paper ran it, across two network hosts: the robot (its
 node daemon for rsca, the robot process for tcp) on one, the controller (for rsca the node
@@ -137,11 +136,25 @@ def wait_for_rest(domain, args, run):
     raise RuntimeError(f"rsca run {run}: the robot did not come to rest within 60 s")
 
 
-def drive_counters(domain):
-    """The DriveSystem's command count and delay sum so far: a run's own mean is the difference
-    over the run."""
-    drive = props(domain, "robot:DriveSystem_1", "latency_samples", "latency_mean_us")
-    return drive["latency_samples"], drive["latency_mean_us"] * drive["latency_samples"]
+def drive_commands(domain):
+    """The DriveSystem's count of commands so far (with a timestamp)."""
+    return props(domain, "robot:DriveSystem_1", "latency_samples")["latency_samples"]
+
+
+def run_delays(domain, before, rest, run):
+    """The delays of the commands since command number `before` that arrived by `rest` (world
+    time; all of them when the robot's rest was not found), and how many came after, from the
+    DriveSystem's command log."""
+    log = props(domain, "robot:DriveSystem_1", "latency_samples", "command_log_first",
+                "command_log_delay_us", "command_log_sim_time")
+    first = log["command_log_first"]
+    if first > before:
+        raise RuntimeError(f"rsca run {run}: the drive's command log no longer holds the run's "
+                           f"first command ({before}; it starts at {first})")
+    delays = log["command_log_delay_us"][before - first:]
+    times = log["command_log_sim_time"][before - first:]
+    kept = [d for d, t in zip(delays, times) if rest is None or t <= rest]
+    return kept, len(delays) - len(kept)
 
 
 def rest_sim_time(robot):
@@ -220,7 +233,7 @@ class Rsca:
         domain, args = self.domain, self.args
         domain.cli("configure", "robot:Robot_1", f"seed={seed}")
         domain.cli("configure", "robot:Robot_1", "reset=true")
-        samples_before, sum_before = drive_counters(domain)
+        commands_before = drive_commands(domain)
         domain.cli("start", "RangeStop")
         # The run, undisturbed by the CLI: as long as the last baseline run took to rest (the
         # same phase; the world's clock started at the reset, before `start`, so the robot has
@@ -242,23 +255,17 @@ class Rsca:
             raise RuntimeError(f"rsca run {run}: StopCrash had not stopped the robot by the "
                                f"end of the run")
         wait_for_rest(domain, args, run)
-        samples_after, sum_after = drive_counters(domain)
         robot = props(domain, "robot:Robot_1", "distance_to_wall", "sim_time", "seed",
                       "trace_time", "trace_speed", "trace_command")
         rest = rest_sim_time(robot)
-        commands = samples_after - samples_before
-        # The commands of the run after the robot rested: the share of its samples the baselines
-        # do not have (they end at rest); an estimate, from the world's time.
-        after_rest = (max(0.0, stopped_at - rest) * 1000 / args.period_ms
-                      if rest is not None else None)
+        delays, after_rest = run_delays(domain, commands_before, rest, run)
         return None, {"way": "rsca", "run": run, "seed": seed,
                       "distance_to_wall": robot["distance_to_wall"],
                       "stop_range": stop["stop_range"], "sim_time": robot["sim_time"],
                       "commands_sent_total": stop["commands_sent"], "robot_seed": robot["seed"],
-                      "commands": commands, "rest_sim_time": rest,
-                      "stopped_sim_time": stopped_at,
-                      "commands_after_rest_estimate": after_rest,
-                      "delay_mean_us": (sum_after - sum_before) / commands if commands else None}
+                      "commands": len(delays), "rest_sim_time": rest,
+                      "stopped_sim_time": stopped_at, "commands_after_rest": after_rest,
+                      "delays_us": delays}
 
 
 def main():
@@ -298,13 +305,10 @@ METHOD = ("The ways take turns run by run (run i: every way once, with seed 1 + 
           "each command's, taken at the drive, from the run's start until the robot rests "
           "(slower than 1 mm/s for 50 ms of world time after the stop), and their percentiles "
           "are computed here (sorted[n/2], sorted[n*99/100]) over every run; clock: the system "
-          "clock of the reading's stamp and of the drive. rsca: its mean is computed here per run "
-          "from the DriveSystem's command count and delay sum before and after the run (the "
-          "run's commands only; the run is stopped once the last baseline run's time to rest "
-          "has passed since its start, so that few come after rest), its percentiles are the "
-          "DriveSystem's own window (not a like-for-like figure: the DriveSystem keeps no "
-          "per-command record the benchmark can read; the share of its commands sent after rest "
-          "is estimated from the Robot's trace). dds: round trips, no robot.")
+          "clock of the reading's stamp and of the drive. rsca the same: each command's delay "
+          "from the DriveSystem's command log, cut where the robot rested (the world's time at "
+          "each command's arrival against the rest in the Robot's trace), percentiles computed "
+          "here alike. dds: round trips, no robot.")
 
 
 def run_interleaved(args, ways, runs, logs):
@@ -344,19 +348,12 @@ def way_result(way, header, runs, session):
         delays = [d for r in runs for d in r["delays_us"]]
         return {"delay_us": delay_summary(delays), "round_trips": len(delays)}
     drive = session.drive
-    means = [r["delay_mean_us"] for r in runs if r["delay_mean_us"] is not None]
-    commands = sum(r["commands"] for r in runs)
-    after = [r["commands_after_rest_estimate"] for r in runs
-             if r["commands_after_rest_estimate"] is not None]
+    delays = [d for r in runs for d in r["delays_us"]]
     return {
         "runs": runs,
-        "delay_us": {"mean": (sum(r["delay_mean_us"] * r["commands"] for r in runs
-                                  if r["delay_mean_us"] is not None) / commands
-                              if commands else float("nan")),
-                     "p50": drive.get("latency_p50_us"), "p99": drive.get("latency_p99_us"),
-                     "samples": commands, "percentiles_from": "the DriveSystem's window",
-                     "run_means": means},
-        "commands_after_rest_share_estimate": sum(after) / commands if commands and after else None,
+        "delay_us": delay_summary(delays),
+        "commands_after_rest_cut": sum(r["commands_after_rest"] for r in runs),
+        "runs_without_rest_found": sum(1 for r in runs if r["rest_sim_time"] is None),
         "drive": {k: drive[k] for k in ("commands_received", "safety_stops", "command_timeout_ms")
                   if k in drive},
         "stop_distance_m": distance_summary([r["distance_to_wall"] for r in runs]),
@@ -415,8 +412,7 @@ def experiment(args, parser):
                   f"{d['p99']:.1f} | | | | |")
             continue
         s = r["stop_distance_m"]
-        window = " (p50, p99: DriveSystem's window)" if w == "rsca" else ""
-        print(f"| {w}{window} | {len(r['runs'])} | {d['mean']:.1f} | {d['p50']:.1f} "
+        print(f"| {w} | {len(r['runs'])} | {d['mean']:.1f} | {d['p50']:.1f} "
               f"| {d['p99']:.1f} | "
               f"{s['mean']:.4f} | {s['sd']:.4f} | {s['min']:.4f} | {s['max']:.4f} |")
     if "prediction" in results:
@@ -442,16 +438,14 @@ def experiment(args, parser):
             ratio = (results["ways"]["rsca"]["delay_us"]["mean"] /
                      results["ways"][baseline]["delay_us"]["mean"])
             results[f"ratio_rsca_{baseline}_mean"] = ratio
-            print(f"ratio {where}rsca/{baseline} delay mean = {ratio:.2f} (rsca's commands after "
-                  "rest included)")
+            print(f"ratio {where}rsca/{baseline} delay mean = {ratio:.2f}")
     with open(args.out, "w") as f:
         json.dump(results, f, indent=2)
     if "rsca" in results["ways"]:
         r = results["ways"]["rsca"]
-        share = r["commands_after_rest_share_estimate"]
-        print(f"rsca delay over {r['delay_us']['samples']} commands of its runs; of them sent "
-              f"after the robot rested (estimate): "
-              f"{'unknown' if share is None else f'{100 * share:.0f} %'}; drive safety stops: "
+        print(f"rsca delay over {r['delay_us']['samples']} commands of its runs up to rest; "
+              f"cut after rest: {r['commands_after_rest_cut']}; runs whose rest was not found "
+              f"(kept whole): {r['runs_without_rest_found']}; drive safety stops: "
               f"{r['drive'].get('safety_stops')}")
     return 0
 
