@@ -209,9 +209,21 @@ int up(int nodes, const std::vector<std::string> &extra_dcds, const fs::path &ru
 }
 
 int down(const fs::path &run, const GlobalOptions &global) {
+  // A folder that is not there (a typo, or RSCA_DDS_TAG or RSCA_DDS_DOMAIN changed since `up`,
+  // which moves the default) is said, not thrown: it was an uncaught filesystem_error, rc 134.
+  std::error_code ec;
+  fs::directory_iterator entries(run, fs::directory_options::skip_permission_denied, ec);
+  if (ec) {
+    const std::string why =
+        fmt::format("no domain was started in {}: {} (`rsca domain up` keeps its pid files in "
+                    "--run-dir, by default $RSCA_RUN_DIR, else a folder per user, DDS domain id "
+                    "and RSCA_DDS_TAG: {})",
+                    run.string(), ec.message(), default_run_dir().string());
+    return report_failure(global, "domain down",
+                          control::CallError{control::Status::NotFound, why});
+  }
   std::vector<fs::path> pid_files;
-  for (const auto &e :
-       fs::directory_iterator(run, std::filesystem::directory_options::skip_permission_denied))
+  for (const auto &e : entries)
     if (e.path().extension() == ".pid" && e.path().filename() != "domaind.pid")
       pid_files.push_back(e.path());
   pid_files.push_back(run / "domaind.pid"); // nodes first: they stop their components
@@ -226,7 +238,6 @@ int down(const fs::path &run, const GlobalOptions &global) {
       }
       ++stopped;
     }
-    std::error_code ec;
     fs::remove(file, ec);
   }
   if (global.json)
