@@ -1,4 +1,6 @@
 // rsca: the command-line front end of the rsca domain.
+#include <string>
+
 #include <CLI/CLI.hpp>
 
 #include "commands.hpp"
@@ -8,6 +10,7 @@ int main(int argc, char **argv) {
   CLI::App app{"rsca — deploy and manage component applications on a robot's domain"};
   app.require_subcommand(1);
   app.fallthrough(); // global options may follow the subcommand
+  app.set_version_flag("--version", std::string("rsca ") + RSCA_VERSION);
   rsca::cli::GlobalOptions global;
   app.add_flag("--json", global.json, "Machine-readable JSON output");
   app.add_option("--sdrroot", global.sdrroot,
