@@ -1,6 +1,8 @@
 // rsca-producer: publishes sample sequences on samples_out at rate_hz, each of payload_size
 // samples of a 10 Hz sine at the stream's sample_rate, stamped with the time of publication; and
-// with each one an event "tick" {"sequence": n} on events_out (for event channels).
+// with each one an event "tick" {"sequence": n} on events_out (for event channels); last_sequence
+// is the sequence number last published.
+#include <atomic>
 #include <cmath>
 #include <numbers>
 
@@ -28,6 +30,7 @@ public:
     property("rate_hz", rate_hz_);
     property("payload_size", payload_size_);
     property("message", message_);
+    property("last_sequence", last_sequence_);
     struct_property("stream", stream_,
                     {{"stream_id", &Stream::stream_id}, {"sample_rate", &Stream::sample_rate}});
   }
@@ -49,6 +52,7 @@ private:
     tick_.value = fmt::format(R"({{"sequence": {}}})", samples_.sequence);
     if (auto written = events_.write(tick_); !written && failures_++ % 100 == 0)
       log().warn("{} (failures so far: {})", written.error(), failures_);
+    last_sequence_ = samples_.sequence;
     ++samples_.sequence;
     return std::chrono::duration_cast<Clock::duration>(
         std::chrono::duration<double>(1.0 / rate_hz_));
@@ -76,6 +80,7 @@ private:
   Stream stream_;
   rsca::port::Samples samples_;
   std::uint64_t failures_ = 0;
+  std::atomic<std::uint64_t> last_sequence_{0}; // read by queries while service() writes
 };
 
 } // namespace

@@ -33,6 +33,17 @@ tl::unexpected<control::CallError> released() {
   return control::call_error(Status::Unavailable, "the component is released");
 }
 
+op::AppliedQos applied_qos_message(const AppliedQos &q) {
+  return {std::string(profile::to_string(q.reliability)),
+          std::string(profile::to_string(q.history)),
+          q.depth,
+          std::string(profile::to_string(q.durability)),
+          std::string(profile::to_string(q.ownership)),
+          q.deadline_ns,
+          std::string(profile::to_string(q.liveliness)),
+          q.lease_ns};
+}
+
 } // namespace
 
 // Runs `op` for its operation at the component's address: exceptions become errors.
@@ -304,8 +315,10 @@ CallResult<op::StatusReply> Host::op_status(const Empty &, const Context &) {
       connection.samples = s.samples;
       connection.filtered = s.filtered;
       connection.deadline_missed = s.deadline_missed;
-      if (s.deadline_ns > 0)
-        connection.deadline_ns = s.deadline_ns;
+      if (s.qos && s.qos->deadline_ns > 0)
+        connection.deadline_ns = s.qos->deadline_ns;
+      if (s.qos)
+        connection.qos = applied_qos_message(*s.qos);
       connection.in_host = s.in_host;
       if (s.same_host)
         connection.same_host = true;

@@ -54,7 +54,10 @@ struct DataConnection {
   std::optional<shm::RingWriter> ring_writer;
   std::optional<shm::RingReader> ring_reader;
   std::uint32_t writers_lost_reported = 0;
-  std::chrono::nanoseconds lease{0}; // a reader's liveliness lease (0: none)
+  // The liveliness lease a ring reader checks, or a ring writer's ticker asserts (0: none), and
+  // its kind (a manual writer asserts by writing).
+  std::chrono::nanoseconds lease{0};
+  profile::Liveliness liveliness = profile::Liveliness::Automatic;
   // The ring's alive_ns when lost liveliness was last reported (receive thread): a gap is
   // reported once, however it was seen.
   std::int64_t lost_at_alive_ns = -1;
@@ -95,6 +98,9 @@ std::int64_t steady_ns();
 void note_local_write(DataConnection &c);
 // How often the writer (uses) or the reader's writers (provides) missed the connection's deadline.
 std::uint32_t deadline_misses(const DataConnection &c, profile::PortDirection direction);
+// The QoS the end applies, read back from its live transport (component/applied_qos.cpp);
+// nothing when DDS cannot say.
+std::optional<AppliedQos> applied_qos(const DataConnection &c);
 
 } // namespace detail
 } // namespace rsca::component

@@ -38,6 +38,7 @@ public:
   void push(LocalSample sample);
   std::deque<LocalSample> take();
   std::uint64_t dropped() const;
+  std::size_t depth() const { return depth_; } // 0: keep all (up to kKeepAllLimit)
 
 private:
   ReceiveLoop &loop_;

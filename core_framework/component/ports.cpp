@@ -104,6 +104,16 @@ std::pair<std::chrono::nanoseconds, bool> liveliness_lease(const dds_qos_t *qos)
   return {std::chrono::nanoseconds{lease}, kind == DDS_LIVELINESS_AUTOMATIC};
 }
 
+profile::Liveliness liveliness_kind(const dds_qos_t *qos) {
+  dds_liveliness_kind_t kind = DDS_LIVELINESS_AUTOMATIC;
+  dds_duration_t lease = DDS_INFINITY;
+  if (qos != nullptr)
+    dds_qget_liveliness(qos, &kind, &lease);
+  return kind == DDS_LIVELINESS_MANUAL_BY_TOPIC         ? profile::Liveliness::ManualByTopic
+         : kind == DDS_LIVELINESS_MANUAL_BY_PARTICIPANT ? profile::Liveliness::ManualByParticipant
+                                                        : profile::Liveliness::Automatic;
+}
+
 // Transient-local or more durable: the reader is owed the writer's history, and keeps what
 // arrives before its component starts (DDS keeps it in the reader's history until taken).
 bool durable(const dds_qos_t *qos) {
@@ -225,12 +235,15 @@ PortBase::open_same_host(detail::ReceiveLoop *loop, std::unique_ptr<DataConnecti
                       "a same-host connection, but this process has no host arena from its node");
   c->deadline = requested_deadline(qos);
   c->relayed = ring.relayed;
+  const auto [lease, automatic] = liveliness_lease(qos);
+  c->lease = lease;
+  c->liveliness = liveliness_kind(qos);
   if (direction_ == profile::PortDirection::Uses) {
     auto writer = shm::RingWriter::open(arena->arena(), ring.offset);
     if (!writer)
       return make_error({"port", 0, 0}, "port", writer.error());
     c->ring_writer.emplace(std::move(*writer));
-    if (auto [lease, automatic] = liveliness_lease(qos); automatic) {
+    if (automatic) {
       detail::LivelinessTicker::instance().add(&*c->ring_writer, lease);
       c->ticking = true;
     }
@@ -247,7 +260,6 @@ PortBase::open_same_host(detail::ReceiveLoop *loop, std::unique_ptr<DataConnecti
     return make_error({"port", 0, 0}, "port", reader.error());
   c->ring_reader.emplace(std::move(*reader));
   c->writers_lost_reported = c->ring_reader->writers_lost();
-  c->lease = liveliness_lease(qos).first;
   return c;
 }
 
@@ -267,8 +279,8 @@ std::vector<ConnectionStatus> PortBase::status() const {
   out.reserve(connections_.size());
   for (const auto &[id, c] : connections_)
     out.push_back({id, c->topic_name, matched_count(*c, direction_), c->samples.load(),
-                   c->filtered.load(), deadline_misses(*c, direction_), c->deadline.count(),
-                   c->in_host(), c->same_host(), c->relayed, c->tcp()});
+                   c->filtered.load(), deadline_misses(*c, direction_), c->in_host(),
+                   c->same_host(), c->relayed, c->tcp(), detail::applied_qos(*c)});
   return out;
 }
 

@@ -25,6 +25,7 @@
 #include "common/diagnostic.hpp"
 #include "component/port_types.hpp"
 #include "dds/entity.hpp"
+#include "profile/assembly.hpp"
 #include "profile/scd.hpp"
 
 namespace rsca::component {
@@ -34,6 +35,20 @@ struct DataConnection;
 class ReceiveLoop;
 } // namespace detail
 
+// The QoS one end of a connection applies, read back from its live transport: a DDS reader's or
+// writer's own QoS (dds_get_qos), or the settings a ring, TCP stream or in-host inbox was opened
+// with. What the domain lists as the end's "qos", so that a QoS is checked where it acts.
+struct AppliedQos {
+  profile::Reliability reliability = profile::Reliability::Reliable;
+  profile::History history = profile::History::KeepLast;
+  std::int32_t depth = 0; // keeplast: the samples kept
+  profile::Durability durability = profile::Durability::Volatile;
+  profile::Ownership ownership = profile::Ownership::Shared;
+  std::int64_t deadline_ns = 0; // 0: none
+  profile::Liveliness liveliness = profile::Liveliness::Automatic;
+  std::int64_t lease_ns = 0; // 0: none
+};
+
 struct ConnectionStatus {
   std::string connection;
   std::string topic;
@@ -41,11 +56,11 @@ struct ConnectionStatus {
   std::uint64_t samples = 0;         // written (uses) or received (provides)
   std::uint64_t filtered = 0;        // provides: received but not delivered (the content filter)
   std::uint32_t deadline_missed = 0; // the connection's deadline, missed (offered or requested)
-  std::int64_t deadline_ns = 0;      // the deadline the end was made with (0: none)
   bool in_host = false;              // both ends in one process: no DDS entities
   bool same_host = false;            // both ends on one host: a ring in shared memory
   bool relayed = false;              // a ring the node relays to and from the ends on other hosts
   bool tcp = false;                  // a TCP stream between the two ends' processes
+  std::optional<AppliedQos> qos;     // as the end's transport applies it
 };
 
 // A same-host connection's ring, as the node gave it: where it is in the host's arena, and a

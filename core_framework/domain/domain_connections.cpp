@@ -48,6 +48,8 @@ Json end_state(const StatusOf &status_of, const std::string &address, const std:
                  {"tcp", c.tcp.value_or(false)}};
       if (c.deadline_ns)
         state["deadline_ns"] = *c.deadline_ns; // the deadline the end applies
+      if (c.qos)
+        state["qos"] = protocol::encode(*c.qos); // as the end's live transport applies it
       return state;
     }
   }

@@ -104,6 +104,31 @@ struct QueryReply {
   }
 };
 
+// The QoS one end of a connection applies, read back from its live transport (a DDS entity's
+// own QoS, or a ring's, TCP stream's or in-host queue's settings); names as a SAD's <qos> has
+// them ("reliable", "keeplast", "transientlocal", "exclusive", "manualbytopic").
+struct AppliedQos {
+  std::string reliability;
+  std::string history;
+  std::int32_t depth = 0; // keeplast: the samples kept
+  std::string durability;
+  std::string ownership;
+  std::int64_t deadline_ns = 0; // 0: none
+  std::string liveliness;
+  std::int64_t lease_ns = 0; // 0: none
+  static constexpr auto fields() {
+    using R = AppliedQos;
+    return std::tuple{required("reliability", &R::reliability),
+                      required("history", &R::history),
+                      required("depth", &R::depth),
+                      required("durability", &R::durability),
+                      required("ownership", &R::ownership),
+                      required("deadline_ns", &R::deadline_ns),
+                      required("liveliness", &R::liveliness),
+                      required("lease_ns", &R::lease_ns)};
+  }
+};
+
 // One connection of a port, as the component sees it.
 struct ConnectionStatus {
   std::string connection;
@@ -119,16 +144,17 @@ struct ConnectionStatus {
   std::optional<bool> tcp;           // a TCP stream between the two ends (transport="tcp")
   std::optional<std::string> target; // a control interface's connection: whom it calls
   std::optional<std::uint64_t> calls;
+  std::optional<AppliedQos> qos; // the end's, as its transport applies it
   static constexpr auto fields() {
     using R = ConnectionStatus;
     return std::tuple{
-        required("connection", &R::connection),  optional("topic", &R::topic),
-        optional("matched", &R::matched),        optional("samples", &R::samples),
-        optional("filtered", &R::filtered),      optional("deadline_missed", &R::deadline_missed),
-        optional("in_host", &R::in_host),        optional("same_host", &R::same_host),
-        optional("relayed", &R::relayed),        optional("tcp", &R::tcp),
-        optional("target", &R::target),          optional("calls", &R::calls),
-        optional("deadline_ns", &R::deadline_ns)};
+        required("connection", &R::connection),   optional("topic", &R::topic),
+        optional("matched", &R::matched),         optional("samples", &R::samples),
+        optional("filtered", &R::filtered),       optional("deadline_missed", &R::deadline_missed),
+        optional("in_host", &R::in_host),         optional("same_host", &R::same_host),
+        optional("relayed", &R::relayed),         optional("tcp", &R::tcp),
+        optional("target", &R::target),           optional("calls", &R::calls),
+        optional("deadline_ns", &R::deadline_ns), optional("qos", &R::qos)};
   }
 };
 

@@ -153,6 +153,8 @@ public:
     return {};
   }
   std::int32_t readers() const { return view_.header->readers.load(std::memory_order_relaxed); }
+  // The records the ring keeps: the most a reader can fall behind, and a late joiner's history.
+  std::uint32_t records() const { return view_.records; }
   // Says the writer is alive without writing (automatic liveliness: shm/ring.cpp).
   void assert_alive();
 
@@ -194,6 +196,7 @@ public:
   std::size_t take(Decode &&decode, Deliver &&deliver);
 
   std::uint64_t dropped() const { return dropped_; }
+  std::uint32_t depth() const { return depth_; } // the newest kept at each take; 0: all
   std::int32_t writers() const { return view_.header->writers.load(std::memory_order_relaxed); }
   std::uint32_t writers_lost() const {
     return view_.header->writers_lost.load(std::memory_order_relaxed);

@@ -22,7 +22,8 @@ std::vector<Json> listed_runtime_connections(TestDomain &domain) {
 
 } // namespace
 
-TEST_CASE("rsca connect --qos takes the QoS names and values a SAD connection takes",
+TEST_CASE("rsca connect --qos takes the QoS names and values a SAD connection takes, and both "
+          "live ends apply them",
           "[integration][connections]") {
   TestDomain domain(1);
   // Neither application runs: the connection is pending, and listed with its QoS.
@@ -41,13 +42,51 @@ TEST_CASE("rsca connect --qos takes the QoS names and values a SAD connection ta
   CHECK(qos.at("liveliness") == "manualbytopic");
   CHECK(qos.at("transportpriority") == -2);
 
+  // Once both ends run, each applies them, as its live transport reads them back (the ring of
+  // the node by default; DDS's own reader and writer on direct DDS).
+  const std::string transport = GENERATE(as<std::string>{}, "", "direct");
+  INFO("transport " << (transport.empty() ? "by default" : transport));
+  if (!transport.empty()) {
+    REQUIRE(domain.cli({"disconnect", "sad_qos"}).first == 0);
+    REQUIRE(domain
+                .cli({"connect", "a/Producer_1.samples_out", "b/Consumer_1.samples_in", "--id",
+                      "sad_qos", "--qos", "deadline=100ms", "--qos", "lease=1.5s", "--qos",
+                      "liveliness=manualbytopic", "--qos", "transport=" + transport})
+                .first == 0);
+  }
+  std::vector<long> pids;
+  for (const auto &[sad, name] : {std::pair{"QosSource", "a"}, std::pair{"QosSink", "b"}}) {
+    domain.install(sad);
+    REQUIRE(domain.cli({"launch", sad, "--name", name}).first == 0);
+    for (long pid : pids_of(domain.call("app.show", Json{{"app", name}}).value()))
+      pids.push_back(pid);
+  }
+  Json live;
+  REQUIRE(TestDomain::wait_for([&] {
+    live = listed_runtime_connections(domain).at(0);
+    return live.at("uses_state").contains("qos") && live.at("provides_state").contains("qos");
+  }));
+  INFO(live.dump());
+  for (const char *end : {"uses_state", "provides_state"}) {
+    const Json &applied = live.at(end).at("qos");
+    INFO(end);
+    CHECK(applied.at("deadline_ns") == 100'000'000);
+    CHECK(applied.at("lease_ns") == 1'500'000'000);
+    CHECK(applied.at("liveliness") == "manualbytopic");
+  }
+  CHECK(live.at("provides_state").at("same_host") == transport.empty());
+  REQUIRE(domain.cli({"disconnect", "sad_qos"}).first == 0);
+  REQUIRE(domain.call("app.release", Json{{"app", "a"}}).has_value());
+  REQUIRE(domain.call("app.release", Json{{"app", "b"}}).has_value());
+
   // A value the SAD refuses is refused the same way (no unit), and nothing is kept.
   auto [brc, bout] = domain.cli({"connect", "a/Producer_1.samples_out", "b/Consumer_1.samples_in",
                                  "--id", "no_unit", "--qos", "deadline=100"});
   INFO(bout);
   CHECK(brc == 1);
   CHECK_THAT(bout, Catch::Contains("\"deadline\" is 100, not a duration such as 100ms"));
-  CHECK(listed_runtime_connections(domain).size() == 1);
+  CHECK(listed_runtime_connections(domain).empty());
+  domain.require_clean(pids);
 }
 
 TEST_CASE("rsca connect refuses an end that can never exist at once, quoting an excerpt",
