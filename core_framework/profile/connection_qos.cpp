@@ -95,9 +95,6 @@ std::optional<std::string> qos_inconsistency(const ConnectionQos &qos) {
     return "depth applies only to history=\"keeplast\", not to keepall";
   if (qos.strength && qos.ownership != Ownership::Exclusive)
     return "strength applies only to ownership=\"exclusive\"";
-  // A TCP stream tells a closed connection, not a writer that stopped asserting itself.
-  if (qos.transport == Transport::Tcp && qos.lease && !qos.lease->infinite())
-    return "transport=\"tcp\" carries no liveliness lease: use transport=\"node\" or \"direct\"";
   if (qos.transport)
     return not_honoured(qos, *qos.transport);
   return std::nullopt;
@@ -106,13 +103,13 @@ std::optional<std::string> qos_inconsistency(const ConnectionQos &qos) {
 TransportHonours honours(Transport transport) {
   switch (transport) {
   case Transport::Direct:
-    return {Durability::Persistent, true, true};
+    return {Durability::Persistent, true, true, true};
   case Transport::Node: // a reader replays the ring's last records (shm/ring.hpp)
-    return {Durability::TransientLocal, false, false};
+    return {Durability::TransientLocal, false, false, true};
   case Transport::Tcp: // a stream keeps nothing for a later stream
-    return {Durability::Volatile, false, false};
+    return {Durability::Volatile, false, false, false};
   }
-  return {Durability::Volatile, false, false};
+  return {Durability::Volatile, false, false, false};
 }
 
 std::optional<std::string> not_honoured(const ConnectionQos &qos, Transport transport) {
@@ -122,6 +119,11 @@ std::optional<std::string> not_honoured(const ConnectionQos &qos, Transport tran
                        "domain then takes direct DDS) or give transport=\"direct\"",
                        to_string(transport), asked, why);
   };
+  // A TCP stream tells a closed connection, not a writer that stopped asserting itself.
+  if (qos.lease && !qos.lease->infinite() && !can.liveliness_lease)
+    return fmt::format("transport=\"{}\" carries no liveliness lease: use transport=\"node\" or "
+                       "\"direct\"",
+                       to_string(transport));
   const Durability durability = qos.durability.value_or(Durability::Volatile);
   if (durability > can.durability)
     return refused(fmt::format("durability=\"{}\"", to_string(durability)),

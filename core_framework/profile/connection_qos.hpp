@@ -39,6 +39,7 @@ struct TransportHonours {
   Durability durability;    // the most durable it keeps for a late joiner
   bool exclusive_ownership; // delivers the strongest live writer only
   bool reliable_keep_all;   // a reliable keep-all writer waits for, or reports, a slow reader
+  bool liveliness_lease;    // tells a writer that stopped asserting itself within a lease
 };
 TransportHonours honours(Transport transport);
 

@@ -449,16 +449,16 @@ inline std::pair<Json, std::string> delivered_package_of(TestDomain &domain,
   return cached_package_of(domain, "node1", program);
 }
 
-// Node daemon `index` frozen (SIGSTOP), as a hung node is: it answers no call and, past its DDS
-// lease, the domain loses it. Resumed however the test ends, so that the domain can stop it.
-class FrozenNode {
+// Process `pid` frozen (SIGSTOP), as a hung one is; resumed however the test ends.
+class FrozenProcess {
 public:
-  FrozenNode(TestDomain &domain, int index) : pid_(domain.node_pid(index)) {
+  explicit FrozenProcess(pid_t pid) : pid_(pid) {
+    REQUIRE(pid_ > 0); // never 0 or -1: a group, or every process
     REQUIRE(::kill(pid_, SIGSTOP) == 0);
   }
-  ~FrozenNode() { resume(); }
-  FrozenNode(const FrozenNode &) = delete;
-  FrozenNode &operator=(const FrozenNode &) = delete;
+  ~FrozenProcess() { resume(); }
+  FrozenProcess(const FrozenProcess &) = delete;
+  FrozenProcess &operator=(const FrozenProcess &) = delete;
   void resume() {
     if (pid_ > 0)
       ::kill(pid_, SIGCONT);
@@ -467,6 +467,12 @@ public:
 
 private:
   pid_t pid_;
+};
+
+// Node daemon `index` frozen: it answers no call and, past its DDS lease, the domain loses it.
+class FrozenNode : public FrozenProcess {
+public:
+  FrozenNode(TestDomain &domain, int index) : FrozenProcess(domain.node_pid(index)) {}
 };
 
 } // namespace rsca::test

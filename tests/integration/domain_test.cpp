@@ -16,6 +16,7 @@
 #include <fmt/format.h>
 
 #include "domain_fixture.hpp"
+#include "qos_checks.hpp"
 
 using namespace rsca::test;
 using namespace std::chrono_literals;
@@ -238,24 +239,6 @@ TEST_CASE("the domain publishes what happens to it, and rsca events follows it",
   CHECK(kinds == std::vector<std::string>{"node.added", "node.added", "application.created",
                                           "application.released", "node.removed"});
   domain.require_clean(pids_of(*app));
-}
-
-// The details of the latest "connection.problem" domain event saying `problem`, as `rsca events`
-// shows them; null when none came within wait_for's limit.
-Json connection_problem(TestDomain &domain, const std::string &problem) {
-  Json found;
-  TestDomain::wait_for([&] {
-    auto [rc, events] = domain.cli({"--json", "events", "--wait-ms", "300"});
-    std::istringstream lines(events);
-    for (std::string line; std::getline(lines, line);) {
-      const Json event = Json::parse(line, nullptr, false);
-      if (!event.is_discarded() && event.value("kind", "") == "connection.problem" &&
-          event.at("details").value("problem", "") == problem)
-        found = event.at("details");
-    }
-    return !found.is_null();
-  });
-  return found;
 }
 
 TEST_CASE("a deadline the writer stops meeting is reported as a domain event",

@@ -7,44 +7,12 @@
 #include <catch2/catch.hpp>
 #include <fmt/format.h>
 
-#include "domain_fixture.hpp"
+#include "qos_checks.hpp"
 
 using namespace rsca::test;
 using namespace std::chrono_literals;
 
 namespace {
-
-long property(TestDomain &domain, const std::string &app, const std::string &component,
-              const std::string &id) {
-  auto q = domain.call("app.query", Json{{"app", app}, {"component", component}, {"ids", {id}}});
-  return q ? q->at("properties").at(id).get<long>() : -1;
-}
-
-// Connection `id` as `rsca --json ls connections` lists it; null when it does not.
-Json listed_connection(TestDomain &domain, const std::string &id) {
-  auto [rc, out] = domain.cli({"--json", "ls", "connections"});
-  INFO(out);
-  REQUIRE(rc == 0);
-  const Json listed = Json::parse(out);
-  for (const auto &c : listed.at("connections"))
-    if (c.at("id") == id)
-      return c;
-  return nullptr;
-}
-
-// A number from one end's live state of connection `id`; -1 while that end shows none.
-long end_value(TestDomain &domain, const std::string &id, const char *end, const char *key) {
-  const Json c = listed_connection(domain, id);
-  if (c.is_null() || c.at(end).is_null() || !c.at(end).contains(key))
-    return -1;
-  return c.at(end).at(key).get<long>();
-}
-
-std::string node_of(TestDomain &domain, const std::string &app) {
-  auto shown = domain.call("app.show", Json{{"app", app}});
-  REQUIRE(shown.has_value());
-  return shown->at("components").at(0).at("node").get<std::string>();
-}
 
 // DurableTicks<suffix> publishes, is stopped, and LateTicks<suffix> joins its channel afterwards:
 // the late consumer receives exactly the last 5 ticks (its depth), though nothing is written any
