@@ -16,11 +16,14 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
+#include <atomic>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <string>
 #include <string_view>
+#include <thread>
 #include <variant>
 #include <vector>
 
@@ -113,8 +116,10 @@ TEST_CASE("a billion laughs entity bomb fails fast", "[malformed][entities]") {
 
 namespace {
 
-// A TCP listener on 127.0.0.1, never accepting: a connection made to it waits in its backlog,
-// so whether anyone connected can be asked afterwards.
+// A TCP server on 127.0.0.1 that answers every connection with an empty DTD, and counts them. It
+// answers rather than leaving connections in its backlog: a parser that fetched the DTD would
+// wait for the answer in its parse, forever, and the check would never run (seen: Xerces with
+// its network access let through hangs there).
 class DtdServer {
 public:
   DtdServer() : fd_(::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0)) {
@@ -127,21 +132,57 @@ public:
     socklen_t size = sizeof address;
     REQUIRE(::getsockname(fd_, reinterpret_cast<sockaddr *>(&address), &size) == 0);
     port_ = ntohs(address.sin_port);
+    server_ = std::jthread([this](const std::stop_token &stop) { serve(stop); });
   }
-  ~DtdServer() { ::close(fd_); }
+  ~DtdServer() {
+    server_.request_stop();
+    server_.join();
+    ::close(fd_);
+  }
   DtdServer(const DtdServer &) = delete;
   DtdServer &operator=(const DtdServer &) = delete;
 
   int port() const { return port_; }
-  // Whether a connection is waiting to be accepted.
-  bool connected() const {
-    pollfd p{fd_, POLLIN, 0};
-    return ::poll(&p, 1, 0) == 1;
-  }
+  // Whether anyone connected: counted as it is accepted, before it is answered.
+  bool connected() const { return connections_.load() > 0; }
 
 private:
+  void serve(const std::stop_token &stop) {
+    while (!stop.stop_requested()) {
+      pollfd p{fd_, POLLIN, 0};
+      if (::poll(&p, 1, 100) != 1) // woken to see the stop
+        continue;
+      const int client = ::accept4(fd_, nullptr, nullptr, SOCK_CLOEXEC);
+      if (client < 0)
+        continue;
+      ++connections_;
+      answer(client);
+      ::close(client);
+    }
+  }
+
+  // Reads the request's head (bounded, 2 s per read) and answers it with an empty DTD.
+  static void answer(int client) {
+    std::string request;
+    std::array<char, 4096> buffer{};
+    while (request.find("\r\n\r\n") == std::string::npos && request.size() < 65536) {
+      pollfd p{client, POLLIN, 0};
+      if (::poll(&p, 1, 2000) != 1)
+        return;
+      const auto n = ::read(client, buffer.data(), buffer.size());
+      if (n <= 0)
+        return;
+      request.append(buffer.data(), static_cast<std::size_t>(n));
+    }
+    constexpr std::string_view reply = "HTTP/1.0 200 OK\r\nContent-Type: application/xml-dtd\r\n"
+                                       "Content-Length: 0\r\nConnection: close\r\n\r\n";
+    [[maybe_unused]] const auto sent = ::send(client, reply.data(), reply.size(), MSG_NOSIGNAL);
+  }
+
   int fd_;
   int port_ = 0;
+  std::atomic<int> connections_{0};
+  std::jthread server_; // last: stopped before what it uses goes
 };
 
 // The files of the fixture `from`, copied into `to` with every text `what` replaced by `with`.
