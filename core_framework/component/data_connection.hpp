@@ -48,6 +48,11 @@ struct DataConnection {
   std::int64_t deadline_gap_ns = 0; // provides: the last_sample_ns that gap began at (same)
   bool watched = false; // a reader with a deadline or a liveliness lease: problems to look for
   bool durable = false; // a transient-local reader: what arrives before the start is kept
+  // A keep-last reader: what arrives while its component is stopped stays in the history (the
+  // newest `depth`: DDS's, the ring's, the inbox's) and is delivered at the start, as a reader
+  // that is merely busy would get it.
+  bool keep_last = false;
+  std::uint64_t held_arrivals = 0; // the ring's or inbox's count at the last look while stopped
 
   // Same-host: the ring's writer or reader; the deadline as in-host. Lost writers already
   // reported (provides, receive thread).
@@ -96,6 +101,9 @@ namespace detail {
 std::int64_t steady_ns();
 // An in-host or same-host writer's offered deadline: the periods each gap between writes spanned.
 void note_local_write(DataConnection &c);
+// A reader whose component is stopped keeps what arrives untaken: an arrival still ends a
+// deadline gap on the transports that count their own (DDS counts arrivals, not takes).
+void note_held_arrivals(DataConnection &c);
 // How often the writer (uses) or the reader's writers (provides) missed the connection's deadline.
 std::uint32_t deadline_misses(const DataConnection &c, profile::PortDirection direction);
 // The QoS the end applies, read back from its live transport (component/applied_qos.cpp);

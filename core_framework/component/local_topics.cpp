@@ -17,6 +17,7 @@ void LocalInbox::push(LocalSample sample) {
       ++dropped_;
     }
     queue_.push_back(std::move(sample));
+    ++pushed_;
   }
   loop_.wake_in_host();
 }
@@ -26,6 +27,11 @@ std::deque<LocalSample> LocalInbox::take() {
   std::lock_guard lock(mutex_);
   out.swap(queue_);
   return out;
+}
+
+std::uint64_t LocalInbox::pushed() const {
+  std::lock_guard lock(mutex_);
+  return pushed_;
 }
 
 std::uint64_t LocalInbox::dropped() const {

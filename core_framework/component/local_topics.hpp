@@ -38,6 +38,7 @@ public:
   void push(LocalSample sample);
   std::deque<LocalSample> take();
   std::uint64_t dropped() const;
+  std::uint64_t pushed() const;                // how many arrived so far
   std::size_t depth() const { return depth_; } // 0: keep all (up to kKeepAllLimit)
 
 private:
@@ -46,6 +47,7 @@ private:
   mutable std::mutex mutex_;
   std::deque<LocalSample> queue_;
   std::uint64_t dropped_ = 0;
+  std::uint64_t pushed_ = 0;
 };
 
 // The in-process side of one topic: its readers' inboxes and how many writers it has.

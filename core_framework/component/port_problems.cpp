@@ -79,6 +79,16 @@ void note_local_write(DataConnection &c) {
     c.deadline_missed.fetch_add(missed, std::memory_order_relaxed);
 }
 
+void note_held_arrivals(DataConnection &c) {
+  const std::uint64_t arrivals = c.ring_reader ? c.ring_reader->written()
+                                 : c.inbox     ? c.inbox->pushed()
+                                               : 0;
+  if (arrivals == c.held_arrivals)
+    return;
+  c.held_arrivals = arrivals;
+  c.last_sample_ns.store(steady_ns(), std::memory_order_relaxed);
+}
+
 // How often the writer (uses) or the reader's writers (provides) missed the connection's deadline.
 std::uint32_t deadline_misses(const DataConnection &c, profile::PortDirection direction) {
   if (c.own_deadline() && direction == profile::PortDirection::Uses) // and the current gap

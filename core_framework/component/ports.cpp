@@ -176,6 +176,7 @@ Expected<void> PortBase::connect(dds_entity_t participant, detail::ReceiveLoop *
   c->filter = std::move(filter);
   c->watched = direction_ == profile::PortDirection::Provides && has_problems_to_watch(qos);
   c->durable = direction_ == profile::PortDirection::Provides && durable(qos);
+  c->keep_last = direction_ == profile::PortDirection::Provides && history_depth(qos) != 0;
   c->deadline = requested_deadline(qos); // what status reports; DDS counts its own misses
   if (local || ring) {
     auto opened = local ? open_local(loop, std::move(c), qos)
@@ -324,6 +325,7 @@ Expected<std::string> PortBase::connect_tcp(detail::ReceiveLoop *loop,
       return make_error({"port", 0, 0}, "port", "no receive loop for a provides port");
     c->loop = loop;
     c->watched = has_problems_to_watch(qos);
+    c->keep_last = history_depth(qos) != 0;
     c->inbox = std::make_shared<detail::LocalInbox>(*loop, history_depth(qos));
     auto receiver = detail::TcpReceiver::listen(
         detail::listen_address(), token,
@@ -405,8 +407,10 @@ template <typename T>
 void ProvidesPort<T>::take_all(bool deliver) {
   std::shared_lock lock(mutex_);
   for (const auto &[id, c] : connections_) {
-    if (!deliver && c->durable)
-      continue; // kept for the component's start: it may be the history it is owed
+    if (!deliver && (c->durable || c->keep_last)) {
+      note_held_arrivals(*c);
+      continue; // kept for the component's start: the history it is owed, or the newest depth
+    }
     if (c->in_host() || c->tcp_in)
       take_local(*c, deliver);
     else if (c->ring_reader)

@@ -197,6 +197,8 @@ public:
 
   std::uint64_t dropped() const { return dropped_; }
   std::uint32_t depth() const { return depth_; } // the newest kept at each take; 0: all
+  // How many records the ring's writers have published so far.
+  std::uint64_t written() const { return view_.header->next_seq.load(std::memory_order_acquire); }
   std::int32_t writers() const { return view_.header->writers.load(std::memory_order_relaxed); }
   std::uint32_t writers_lost() const {
     return view_.header->writers_lost.load(std::memory_order_relaxed);
