@@ -88,6 +88,22 @@ TEST_CASE("a keep-last reader whose component is stopped gets, once started, at 
   pair.domain.require_clean(pair.pids);
 }
 
+// What arrives for a stopped reader is kept untaken; it still ends each deadline period, as DDS
+// counts arrivals rather than takes, on the transports whose reader counts its own misses.
+TEST_CASE("a stopped keep-last reader misses no deadline while its writer writes",
+          "[integration][qos][keep-last]") {
+  const Way way = GENERATE(kRing, kTcp);
+  INFO(way.name);
+  QosPair pair(way, {"deadline=100ms"});
+  REQUIRE(pair.domain.call("app.stop", Json{{"app", "QosSink"}}).has_value());
+  // Five periods of 500 Hz samples, none of them taken.
+  const long before = pair.producer("last_sequence");
+  REQUIRE(TestDomain::wait_for([&] { return pair.producer("last_sequence") >= before + 250; }));
+  CHECK(end_value(pair.domain, "c", "provides_state", "deadline_missed") == 0);
+  pair.release();
+  pair.domain.require_clean(pair.pids);
+}
+
 TEST_CASE("a deadline is met with no miss, then missed once the writer stops, through the relay "
           "between two nodes",
           "[integration][qos]") {
