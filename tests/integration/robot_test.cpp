@@ -1,5 +1,7 @@
 // The robot in the loop through a real domain: the robot node's devices (Robot, IRSensor,
 // DriveSystem) and StopCrash as a component process on another node, wired by the domain.
+#include <algorithm>
+
 #include "domain_fixture.hpp"
 #include "sim/drive.hpp"
 #include "sim/scenario.hpp"
@@ -118,6 +120,16 @@ TEST_CASE("RangeStop through the domain: StopCrash on node1 stops the robot at t
   CHECK(d.at("latency_samples").get<long>() > 50);
   CHECK(d.at("latency_p50_us").get<double>() > 0);
   CHECK(d.at("safety_stops") == 0);
+  // The command log a benchmark cuts at rest: every command so far (fewer than its size), in the
+  // order they came, the world's time not going back, the largest delay the drive's maximum.
+  const auto delays = d.at("command_log_delay_us").get<std::vector<double>>();
+  const auto times = d.at("command_log_sim_time").get<std::vector<double>>();
+  CHECK(d.at("command_log_first") == 0);
+  CHECK(delays.size() == d.at("latency_samples").get<std::size_t>());
+  REQUIRE(times.size() == delays.size());
+  CHECK(std::is_sorted(times.begin(), times.end()));
+  CHECK(times.back() > times.front());
+  CHECK(*std::max_element(delays.begin(), delays.end()) == d.at("latency_max_us").get<double>());
 
   REQUIRE(domain.call("app.release", Json{{"app", "RangeStop"}}).has_value());
   // The devices stay, without the application's connections.
