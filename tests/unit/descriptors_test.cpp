@@ -369,7 +369,7 @@ TEST_CASE("SAD: an external port naming a supported interface", "[descriptors][s
 
 TEST_CASE("PRF: Producer's simples and struct", "[descriptors][prf]") {
   const auto prf = read<Properties>(kProducer / "Producer.prf.xml");
-  REQUIRE(prf.properties.size() == 4);
+  REQUIRE(prf.properties.size() == 5);
 
   const auto &rate = definition<SimpleProperty>(prf, "rate_hz");
   CHECK(rate.name == "rate_hz");
@@ -397,6 +397,10 @@ TEST_CASE("PRF: Producer's simples and struct", "[descriptors][prf]") {
   CHECK(message.type.type == SimpleType::String);
   CHECK(as<std::string>(message.value) == "hello");
   CHECK(message.units.empty());
+
+  const auto &last = definition<SimpleProperty>(prf, "last_sequence");
+  CHECK(last.type.type == SimpleType::ULongLong);
+  CHECK(last.mode == AccessMode::ReadOnly);
 
   const auto &stream = definition<StructProperty>(prf, "stream");
   CHECK(stream.kinds == std::vector<PropertyKind>{PropertyKind::Property});
