@@ -8,9 +8,8 @@ Usage: python3 tests/bench/fanout_setup_bench.py --bin build/bin [--subscribers 
 """
 import argparse
 import os
-import tempfile
 
-from local_domain import Domain, alive, cpu_ticks
+from local_domain import Domain, alive, cpu_ticks, work_dir
 from port_bench_fanout import Schedule, fanout_sads, wait_discovery_settled
 from port_bench_helpers import SDRROOT
 
@@ -21,7 +20,7 @@ def main():
     parser.add_argument("--subscribers", type=int, default=100)
     parser.add_argument("--runs", type=int, default=4)
     args = parser.parse_args()
-    work = tempfile.mkdtemp(prefix="rsca-fanout-setup-")
+    work = work_dir("rsca-fanout-setup-", components_write=True)
     sads, sdr = fanout_sads(args.subscribers, args.subscribers, Schedule(True), work)
     name, sad = sads[0]
     with Domain(os.path.join(args.bin, "rsca"), nodes=2, sdrroot=SDRROOT,

@@ -147,6 +147,15 @@ def on_host(host, args):
     return ["ip", "netns", "exec", host, *args] if host else list(args)
 
 
+def work_dir(prefix, components_write=False):
+    """A new folder in the temporary folder, which the components' user can pass through (the
+    nodes run components as their GPP's run_as user, `rsca` or else `nobody`: mkdtemp makes it
+    0700) and, with `components_write`, write their result files into."""
+    folder = tempfile.mkdtemp(prefix=prefix)
+    os.chmod(folder, 0o1777 if components_write else 0o755)
+    return folder
+
+
 class Domain:
     """`rsca domain up --nodes N` on a DDS domain id and run folder of its own. With `sdrroot`,
     the DMD and the node DCDs (dev/nodes/node1..N) come from that SDR root; `env` adds to the
@@ -171,10 +180,7 @@ class Domain:
         # Global CLI options of every call through cli(), e.g. ["--timeout-ms", "30000"].
         self.cli_args = cli_args or []
         self.spawned = []
-        self.run_dir = tempfile.mkdtemp(prefix="rsca-bench-")
-        # The nodes run components as their GPP's run_as user (`rsca`, else `nobody`), who must
-        # pass through this folder to the package cache under it: mkdtemp makes it 0700.
-        os.chmod(self.run_dir, 0o755)
+        self.run_dir = work_dir("rsca-bench-")
         self.env = dict(dds_env(), RSCA_RUN_DIR=self.run_dir, **(env or {}))
         self.nodes = nodes
         self.sdrroot = sdrroot

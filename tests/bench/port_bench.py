@@ -48,9 +48,8 @@ import math
 import os
 import shutil
 import sys
-import tempfile
 
-from local_domain import Domain, NetHosts, skipped_without_hosts
+from local_domain import Domain, NetHosts, skipped_without_hosts, work_dir
 from port_bench_fanout import Schedule, analyse_fanout, fanout_raw, fanout_rsca
 from port_bench_helpers import (FANOUT_LEASE_MS, MODES, SDRROOT, SIDES, SPIN_US, LatencyIceoryx,
                                 LatencyRaw, LatencyRsca, busy_note, host_state, latency_stats, lease_env, ratio,
@@ -75,7 +74,7 @@ def bench_latency_hosts(args):
     count, warmup = (1000, 2000) if args.quick else (2000, 2000)
     rsca = os.path.join(args.bin, "rsca")
     raw = os.path.join(args.bin, "rsca-bench-raw")
-    work = tempfile.mkdtemp(prefix="rsca-portbench-")
+    work = work_dir("rsca-portbench-", components_write=True)
     env = dict(lease_env(args.lease_ms), RSCA_DDS_INTERFACE="eth0")
     rtts = {name: array.array("Q") for name in sides_hosts}
     try:
@@ -142,6 +141,7 @@ def latency_sides(domain, mode, args, work, count, warmup, closing, sizes):
     spin = MODES[mode]
     work = os.path.join(work, mode)
     os.makedirs(work, exist_ok=True)
+    os.chmod(work, 0o1777)  # the components' user writes its results here, as in work_dir()
 
     def keep(side):
         closing.callback(side.close)
@@ -249,7 +249,7 @@ def bench_latency(args):
     count, warmup = (1000, 2000) if args.quick else (2000, 2000)  # per round
     rsca = os.path.join(args.bin, "rsca")
     raw = os.path.join(args.bin, "rsca-bench-raw")
-    work = tempfile.mkdtemp(prefix="rsca-portbench-")
+    work = work_dir("rsca-portbench-", components_write=True)
     lease = lease_env(args.lease_ms)
     rtts = {name: array.array("Q") for order in orders[:1] for name in order}
     before = host_state()
@@ -295,7 +295,7 @@ def bench_fanout(args):
     rsca = os.path.join(args.bin, "rsca")
     raw = os.path.join(args.bin, "rsca-bench-raw")
     iceoryx = os.path.join(args.bin, "rsca-bench-iceoryx")
-    work = tempfile.mkdtemp(prefix="rsca-portbench-")
+    work = work_dir("rsca-portbench-", components_write=True)
     results = {"schedule": vars(schedule), "subscribers": {}}
     try:
         lease = lease_env(args.lease_ms)
