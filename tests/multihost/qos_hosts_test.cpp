@@ -1,11 +1,13 @@
 // The QoS of a connection through the nodes' relays across two network hosts (issue 38): every
-// sample delivered once and in order, the deadline met with no miss, and a stopped keep-last
-// reader given only the newest at its start, on a real network interface between the hosts
-// (network namespaces joined by a bridge).
+// sample delivered once and in order, the deadline met with no miss, a stopped keep-last reader
+// given only the newest at its start, and a frozen writer's lost liveliness reported by the
+// reader's end, on a real network interface between the hosts (network namespaces joined by a
+// bridge).
 #include <catch2/catch.hpp>
 
 #include <algorithm>
 #include <csignal>
+#include <sstream>
 
 #include "hosts_domain.hpp"
 
@@ -87,6 +89,37 @@ void release_both(HostsDomain &domain, const std::string &id, const std::vector<
   }));
 }
 
+// The details of the first "connection.problem" event saying `problem`, waited for; null when
+// none came in time.
+Json connection_problem(HostsDomain &domain, const std::string &problem) {
+  Json found;
+  HostsDomain::wait_for([&] {
+    const auto run = domain.cli(1, {"events", "--wait-ms", "300"}, HostsDomain::over_dds());
+    std::istringstream lines(run.out);
+    for (std::string line; found.is_null() && std::getline(lines, line);) {
+      const Json event = Json::parse(line, nullptr, false);
+      if (!event.is_discarded() && event.value("kind", "") == "connection.problem" &&
+          event.at("details").value("problem", "") == problem)
+        found = event.at("details");
+    }
+    return !found.is_null();
+  });
+  return found;
+}
+
+// A process stopped with SIGSTOP for as long as it lives, continued however the test ends.
+class Frozen {
+public:
+  explicit Frozen(pid_t pid) : pid_(pid) { ::kill(pid_, SIGSTOP); }
+  ~Frozen() { resume(); }
+  Frozen(const Frozen &) = delete;
+  Frozen &operator=(const Frozen &) = delete;
+  void resume() { ::kill(pid_, SIGCONT); }
+
+private:
+  pid_t pid_;
+};
+
 } // namespace
 
 TEST_CASE("a reliable connection with a deadline through the relays across two hosts delivers "
@@ -150,5 +183,32 @@ TEST_CASE("a keep-last reader whose component is stopped gets, once started, at 
   CHECK(got <= kDepth);
   CHECK(queried(domain, "QosSink/Consumer_1", "sequence_gaps") == 0);
   CHECK(queried(domain, "QosSink/Consumer_1", "sequence_repeats") == 0);
+  release_both(domain, "c", pids);
+}
+
+TEST_CASE("a writer frozen past its liveliness lease is reported lost by the reader's end "
+          "through the relays across two hosts, and delivers again once resumed",
+          "[multihost]") {
+  HostsDomain domain(2);
+  const auto pids = launch_on_two_hosts(domain);
+  connect_across(domain, "c", {"liveliness=automatic", "lease=300ms"});
+  REQUIRE(HostsDomain::wait_for([&] { return queried(domain, "QosSink", "received") > 50; }, 30s));
+  {
+    const Json provides = end_state(domain, "c", "provides_state");
+    INFO(provides.dump());
+    REQUIRE_FALSE(provides.is_null());
+    CHECK(provides.at("relayed") == true);
+    CHECK(provides.at("qos").at("lease_ns") == 300'000'000);
+  }
+  Frozen frozen(pids.at(0)); // the producer
+  const Json problem = connection_problem(domain, "liveliness lost");
+  frozen.resume();
+  INFO(problem.dump());
+  REQUIRE_FALSE(problem.is_null());
+  CHECK(problem.value("application", "") == "QosSink");
+  CHECK(problem.value("component", "") == "Consumer_1");
+  const long received = queried(domain, "QosSink/Consumer_1", "received");
+  CHECK(HostsDomain::wait_for(
+      [&] { return queried(domain, "QosSink/Consumer_1", "received") > received + 50; }));
   release_both(domain, "c", pids);
 }
