@@ -76,6 +76,14 @@ void connect_across(HostsDomain &domain, const std::string &id,
   REQUIRE(connected.rc == 0);
 }
 
+// The sink's consumer reaches sequence `last` with no sequence missing or repeated on the way.
+void received_in_order_up_to(HostsDomain &domain, long last) {
+  CHECK(HostsDomain::wait_for(
+      [&] { return queried(domain, "QosSink/Consumer_1", "last_sequence") == last; }));
+  CHECK(queried(domain, "QosSink/Consumer_1", "sequence_gaps") == 0);
+  CHECK(queried(domain, "QosSink/Consumer_1", "sequence_repeats") == 0);
+}
+
 // Disconnects `id`, releases both applications, and waits for their processes to be gone.
 void release_both(HostsDomain &domain, const std::string &id, const std::vector<pid_t> &pids) {
   CHECK(domain.cli(1, {"disconnect", id}, HostsDomain::over_dds()).rc == 0);
@@ -143,11 +151,7 @@ TEST_CASE("a reliable connection with a deadline through the relays across two h
 
   const auto stopped = domain.cli(1, {"stop", "QosSource"}, HostsDomain::over_dds());
   REQUIRE(stopped.rc == 0);
-  const long last = queried(domain, "QosSource/Producer_1", "last_sequence");
-  CHECK(HostsDomain::wait_for(
-      [&] { return queried(domain, "QosSink/Consumer_1", "last_sequence") == last; }));
-  CHECK(queried(domain, "QosSink/Consumer_1", "sequence_gaps") == 0);
-  CHECK(queried(domain, "QosSink/Consumer_1", "sequence_repeats") == 0);
+  received_in_order_up_to(domain, queried(domain, "QosSource/Producer_1", "last_sequence"));
   release_both(domain, "c", pids);
 }
 
@@ -175,14 +179,11 @@ TEST_CASE("a keep-last reader whose component is stopped gets, once started, at 
   REQUIRE(domain.cli(1, {"start", "QosSink"}, HostsDomain::over_dds()).rc == 0);
 
   // The consumer counts from its start: what it got are the newest, none missing up to the last.
-  CHECK(HostsDomain::wait_for(
-      [&] { return queried(domain, "QosSink/Consumer_1", "last_sequence") == last; }));
+  received_in_order_up_to(domain, last);
   const long got = queried(domain, "QosSink/Consumer_1", "received");
   INFO("written while stopped " << last - before << ", received at the start " << got);
   CHECK(got >= 1);
   CHECK(got <= kDepth);
-  CHECK(queried(domain, "QosSink/Consumer_1", "sequence_gaps") == 0);
-  CHECK(queried(domain, "QosSink/Consumer_1", "sequence_repeats") == 0);
   release_both(domain, "c", pids);
 }
 
