@@ -3,6 +3,8 @@
 // connections and channels are in domain_connections.cpp.
 #include "domain/domain_manager.hpp"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <functional>
 #include <sstream>
@@ -14,13 +16,16 @@
 
 #include "allocator/plan_json.hpp"
 #include "common/elapsed.hpp"
+#include "common/host_name.hpp"
 #include "common/names.hpp"
+#include "control/name_holder.hpp"
 #include "control/operation.hpp"
 #include "domain/domain_manager_impl.hpp"
 #include "profile/property_binding.hpp"
 #include "profile/property_json.hpp"
 #include "protocol/addresses.hpp"
 #include "protocol/component_ops.hpp"
+#include "protocol/domain_announcement.hpp"
 
 namespace rsca::domain {
 namespace {
@@ -56,6 +61,23 @@ CallResult<Reply> as_domain_reply(CallResult<Reply> result) {
       (result.error().status == Status::Unavailable || result.error().status == Status::Timeout))
     result.error().status = Status::Failed;
   return result;
+}
+
+// Why this daemon must not serve domain `name`: another daemon of that name lives on the same DDS
+// domain and tag (control/name_holder.hpp). Two would both take the domain's requests, and the
+// one that stops first would take the other's nodes and applications with it.
+std::optional<std::string> held_by_another(const dds::Participant &participant,
+                                           const std::string &name) {
+  spdlog::info("looking for another daemon of domain {} (up to {} ms)", name,
+               control::kNameCheck.count());
+  auto held = control::live_holder<protocol::domain::DomainAnnouncement>(
+      participant, protocol::domain_address(name), fmt::format("domain {}", name));
+  if (!held)
+    return std::nullopt;
+  return fmt::format("{}: this daemon (pid {} on host {}) does not start beside it; stop that one "
+                     "first, or give this one another DDS domain or tag (RSCA_DDS_DOMAIN, "
+                     "RSCA_DDS_TAG)",
+                     *held, ::getpid(), host_name());
 }
 
 } // namespace
@@ -423,6 +445,9 @@ DomainManager::~DomainManager() {
 
 Expected<std::unique_ptr<DomainManager>>
 DomainManager::create(std::shared_ptr<dds::Participant> participant, DomainOptions options) {
+  // Before its store is touched: a namesake refused leaves the holder's as it was.
+  if (auto held = held_by_another(*participant, options.name))
+    return make_error({"domain " + options.name, 0, 0}, "name-taken", *held);
   auto impl = std::make_unique<Impl>();
   impl->options = std::move(options);
   impl->participant = participant;
@@ -469,6 +494,12 @@ DomainManager::create(std::shared_ptr<dds::Participant> participant, DomainOptio
   impl->restore_connections();
   impl->serve();
   impl->endpoint->start_serving();
+  // Who serves the domain, for a namesake started later to find (held_by_another).
+  const protocol::domain::DomainAnnouncement self{
+      impl->options.name, static_cast<std::int64_t>(::getpid()), host_name(), impl->incarnation};
+  if (auto ok = impl->endpoint->announce(protocol::domain::kDomainKind, protocol::encode(self));
+      !ok)
+    return tl::unexpected(ok.error());
   spdlog::info("domain {} serving at {} (incarnation {})", impl->options.name,
                impl->endpoint->address(), impl->incarnation);
   return std::unique_ptr<DomainManager>(new DomainManager(std::move(impl)));

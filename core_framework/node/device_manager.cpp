@@ -14,6 +14,7 @@
 #include "common/install_layout.hpp"
 #include "common/names.hpp"
 #include "common/periodic.hpp"
+#include "control/name_holder.hpp"
 #include "control/operation.hpp"
 #include "node/daemon_log.hpp"
 #include "node/device_libraries.hpp"
@@ -154,6 +155,25 @@ struct DeviceManager::Impl {
 };
 
 namespace {
+
+// Why this daemon must not serve node `name`: a live node of another run already does
+// (control/name_holder.hpp), a namesake from a copied DCD. Its own announcement would overwrite
+// the holder's, and its stop would withdraw it: the domain took the holder for stopped while its
+// processes ran on. A holder whose process is gone from this host is this node's last run (killed
+// and restarted within its lease): that one is taken over, as ever.
+std::optional<std::string> held_by_another(const dds::Participant &participant,
+                                           const std::string &domain, const std::string &name,
+                                           const std::filesystem::path &dcd) {
+  spdlog::info("looking for another daemon of node {} (up to {} ms)", name,
+               control::kNameCheck.count());
+  auto held = control::live_holder<op::NodeAnnouncement>(
+      participant, protocol::node_address(domain, name), fmt::format("node {}", name));
+  if (!held)
+    return std::nullopt;
+  return fmt::format("{}: this node daemon (pid {} on host {}, DCD {}) does not start beside it; "
+                     "give it another name in its DCD, or stop that one first",
+                     *held, ::getpid(), host_name(), dcd.string());
+}
 
 // The DCD's device instances in the order they start: those with a start order by it (REDHAWK
 // 2.2's componentinstantiation/@startorder), then the others in the DCD's order.
@@ -465,6 +485,10 @@ DeviceManager::create(std::shared_ptr<dds::Participant> participant, NodeOptions
   for (const auto &w : impl->node.tolerated)
     spdlog::warn("{}", to_string(w));
   apply_logging_config(impl->node);
+  // Before anything of the node exists: a namesake refused leaves the holder's host as it was.
+  if (auto held = held_by_another(*participant, impl->options.domain_name, impl->dcd->name,
+                                  impl->options.dcd))
+    return make_error({impl->options.dcd.string(), 0, 0}, "name-taken", *held);
   control::EndpointOptions endpoint_options;
   endpoint_options.hold_requests = true; // until its devices run and their handlers are there
   auto endpoint = control::Endpoint::open(

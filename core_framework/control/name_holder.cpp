@@ -1,0 +1,92 @@
+#include "control/name_holder.hpp"
+
+#include <unistd.h>
+
+#include <fstream>
+
+#include "common/host_name.hpp"
+#include "control.h" // generated from dds/control.idl
+#include "control/endpoint_impl.hpp"
+
+namespace rsca::control {
+namespace {
+
+// The program a process runs, as the kernel names it (its first 15 bytes).
+std::string program_of(const std::string &pid) {
+  std::ifstream in("/proc/" + pid + "/comm");
+  std::string name;
+  std::getline(in, name);
+  return name;
+}
+
+// Whether process `pid` has exited and waits for its parent to reap it: a zombie still has its
+// comm, but nothing of it runs.
+bool zombie(const std::string &pid) {
+  std::ifstream in("/proc/" + pid + "/stat");
+  std::string stat;
+  std::getline(in, stat);
+  const auto end_of_name = stat.rfind(')'); // the name may hold spaces and parentheses
+  return end_of_name != std::string::npos && end_of_name + 2 < stat.size() &&
+         stat[end_of_name + 2] == 'Z';
+}
+
+// The body of the first live announcement of `address` among what `reader` holds.
+std::optional<Json> take_live(dds_entity_t reader, const std::string &address) {
+  void *samples[detail::kTakeBatch] = {nullptr};
+  dds_sample_info_t infos[detail::kTakeBatch];
+  std::optional<Json> found;
+  for (;;) {
+    const dds_return_t n = dds_take(reader, samples, infos, detail::kTakeBatch, detail::kTakeBatch);
+    if (n <= 0)
+      return found;
+    for (dds_return_t i = 0; i < n && !found; ++i) {
+      const auto *a = static_cast<const rsca_ctl_Announcement *>(samples[i]);
+      if (!infos[i].valid_data || infos[i].instance_state != DDS_IST_ALIVE ||
+          detail::str(a->address) != address || detail::str(a->kind) == protocol::kWithdrawnKind)
+        continue;
+      // Untrusted like any sample: a body that is no JSON object still says the address is held.
+      found = detail::parse_body(a->body).value_or(Json::object());
+    }
+    dds_return_loan(reader, samples, n);
+  }
+}
+
+} // namespace
+
+std::optional<Json> live_announcement(const dds::Participant &participant,
+                                      const std::string &address, std::chrono::milliseconds wait) {
+  const auto qos = detail::announcement_qos();
+  const dds_entity_t pp = participant.get();
+  auto topic = dds::checked(dds_create_topic(pp, &rsca_ctl_Announcement_desc,
+                                             detail::kAnnouncementTopic, qos.get(), nullptr),
+                            "creating the announcement topic");
+  if (!topic)
+    return std::nullopt; // the endpoint's own creation will say why
+  auto reader = dds::checked(dds_create_reader(pp, topic->get(), qos.get(), nullptr),
+                             "creating the announcement reader");
+  auto waitset = dds::checked(dds_create_waitset(pp), "creating a waitset");
+  if (!reader || !waitset)
+    return std::nullopt;
+  dds_set_status_mask(reader->get(), DDS_DATA_AVAILABLE_STATUS);
+  dds_waitset_attach(waitset->get(), reader->get(), reader->get());
+  const auto deadline = Clock::now() + wait;
+  for (auto now = Clock::now(); now < deadline; now = Clock::now()) {
+    dds_waitset_wait(waitset->get(), nullptr, 0,
+                     std::chrono::duration_cast<std::chrono::nanoseconds>(deadline - now).count());
+    if (auto found = take_live(reader->get(), address))
+      return found;
+  }
+  return std::nullopt;
+}
+
+bool may_still_run(const std::string &host, std::int64_t pid) {
+  if (host != host_name())
+    return true;
+  if (pid <= 0 || pid == static_cast<std::int64_t>(::getpid()))
+    return false;
+  const std::string other = std::to_string(pid);
+  const std::string program = program_of(other);
+  return !program.empty() && program == program_of("self") && !zombie(other);
+}
+
+} // namespace rsca::control

@@ -1,0 +1,64 @@
+// One name, one holder: a daemon about to serve an address (a domain's, a node's) first looks on
+// its DDS domain and tag for a live announcement of that address by another run. Without it, a
+// namesake served beside the holder: the same partition (both took its requests), the same
+// announcement instance (the namesake's stop disposed the holder's, and the domain dropped a live
+// node with its processes running on: issue 39).
+//
+// The look is bounded (kNameCheck): a holder whose announcement has not reached this process by
+// then (DDS discovery slower than that) is missed, and two namesakes started at the same moment
+// both go on. It is a guard against an operator's mistake, not a lock.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "dds/participant.hpp"
+#include "protocol/codec.hpp"
+
+namespace rsca::control {
+
+// Discovery of the other participants and their durable announcements takes tens of milliseconds
+// on one host or a LAN; a second leaves room for a loaded host.
+inline constexpr std::chrono::milliseconds kNameCheck{1000};
+
+// The body of a live announcement of `address` (alive, not withdrawn), as soon as one arrives
+// within `wait`; nothing when none did.
+std::optional<nlohmann::json> live_announcement(const dds::Participant &participant,
+                                                const std::string &address,
+                                                std::chrono::milliseconds wait);
+
+// Whether the run that announced itself as `pid` on `host` may still be running. An announcement
+// outlives its announcer by its DDS lease when the announcer is killed, so a live announcement
+// alone does not tell a namesake from a run that just died and is being restarted. On this host
+// the pid does: a run that died has no process of its pid running this program (a pid reused by
+// another program is not it). On another host nothing here can look, and a run moves host only
+// with its operator: it is taken to run.
+bool may_still_run(const std::string &host, std::int64_t pid);
+
+// Who holds `address`, if a live run does: "<what> is served by pid P on host H (DDS domain D,
+// tag T)". `Announcement` is the holder's announcement type (it has `pid` and `host`); a body that
+// does not decode is another version's or another kind's, named as such.
+template <typename Announcement>
+std::optional<std::string> live_holder(const dds::Participant &participant,
+                                       const std::string &address, const std::string &what) {
+  const auto body = live_announcement(participant, address, kNameCheck);
+  if (!body)
+    return std::nullopt;
+  const auto &dds = participant.settings();
+  const auto where = fmt::format("DDS domain {}, tag \"{}\"", dds.domain_id, dds.tag);
+  auto holder = protocol::decode<Announcement>(*body);
+  if (!holder)
+    return fmt::format("{} is announced at {} on {} by a process that does not say who it is ({})",
+                       what, address, where, holder.error());
+  if (!may_still_run(holder->host, holder->pid))
+    return std::nullopt;
+  return fmt::format("{} is served by pid {} on host {} ({})", what, holder->pid, holder->host,
+                     where);
+}
+
+} // namespace rsca::control
