@@ -33,6 +33,17 @@ if(RSCA_SANITIZE_THREAD)
   target_compile_definitions(rsca_compile_options INTERFACE RSCA_SANITIZE_THREAD=1)
 endif()
 
+# The linker: lld when the compiler can use it (Debian's lld package, which tools/install-deps
+# installs), else the default (GNU ld). Linking is a large share of a build here: every component
+# executable links the component library whole, and the ASan build's are ~65 MB each. Measured on
+# the ASan unit-test binary (238 MB): GNU ld 9.3 s, gold 7.5 s, lld 2.9 s. Only rsca's own targets:
+# the SDK a user builds against keeps the user's linker.
+include(CheckLinkerFlag)
+check_linker_flag(CXX -fuse-ld=lld RSCA_HAVE_LLD)
+if(RSCA_HAVE_LLD)
+  add_link_options(-fuse-ld=lld)
+endif()
+
 function(rsca_target_options target)
   target_link_libraries(${target} PRIVATE rsca_compile_options)
 endfunction()
