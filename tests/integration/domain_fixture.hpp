@@ -15,6 +15,7 @@
 #include <future>
 
 #include "../unit/test_domain.hpp"
+#include "cache_seed.hpp"
 #include "child_process.hpp"
 #include "control/endpoint.hpp"
 #include "wait_for.hpp"
@@ -124,6 +125,10 @@ public:
       domaind_->wait_exit(5s);
     }
     std::error_code ec;
+    if (seeded_)
+      for (const auto &cache : fs::directory_iterator(run_ / "cache", ec))
+        cache_seed::keep(kBin, cache.path());
+    cache_seed::remove_tree(run_ / "cache");
     fs::remove_all(run_, ec);
   }
 
@@ -349,6 +354,12 @@ private:
                                   "--control-socket",
                                   (run_ / fmt::format("node{}.sock", index)).string()};
     args.insert(args.end(), more_args.begin(), more_args.end());
+#ifdef RSCA_SANITIZE
+    if (const auto name = cache_seed::node_name(dcd); !default_delivery_kept && !name.empty()) {
+      seeded_ = true; // cache_seed.hpp says why
+      cache_seed::seed(kBin, run_ / "cache" / name);
+    }
+#endif
     return std::make_unique<ChildProcess>((kBin / "rsca-noded").string(), args, env_);
   }
 
@@ -364,6 +375,7 @@ private:
   std::unique_ptr<ChildProcess> domaind_;
   std::vector<fs::path> exec_path_; // the domain daemon's; empty: its default
   std::vector<std::unique_ptr<ChildProcess>> nodes_;
+  bool seeded_ = false; // its nodes' caches started from the pool (cache_seed.hpp)
   std::shared_ptr<rsca::dds::Participant> participant_;
   std::unique_ptr<rsca::control::Endpoint> client_;
 };
