@@ -197,6 +197,8 @@ class Domain:
         if self.cli_host:
             command = on_host(self.cli_host, command)
             env = dict(env, RSCA_NODE_SOCKET="none")
+        else:  # here, through a node's socket; over DDS only on loopback, never this machine's
+            env = {k: v for k, v in env.items() if k != "RSCA_DDS_INTERFACE"}  # own network
         out = subprocess.run(command, env=env, capture_output=True, text=True, timeout=timeout)
         elapsed = (time.perf_counter() - started) * 1e3
         if check and out.returncode != 0:
