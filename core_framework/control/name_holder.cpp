@@ -79,14 +79,17 @@ std::optional<Json> live_announcement(const dds::Participant &participant,
   return std::nullopt;
 }
 
-bool may_still_run(const std::string &host, std::int64_t pid) {
+std::string own_program() {
+  return program_of("self");
+}
+
+bool may_still_run(const std::string &host, std::int64_t pid, const std::string &program) {
   if (host != host_name())
     return true;
   if (pid <= 0 || pid == static_cast<std::int64_t>(::getpid()))
     return false;
   const std::string other = std::to_string(pid);
-  const std::string program = program_of(other);
-  return !program.empty() && program == program_of("self") && !zombie(other);
+  return program_of(other) == program && !zombie(other);
 }
 
 } // namespace rsca::control

@@ -32,20 +32,25 @@ std::optional<nlohmann::json> live_announcement(const dds::Participant &particip
                                                 const std::string &address,
                                                 std::chrono::milliseconds wait);
 
-// Whether the run that announced itself as `pid` on `host` may still be running. An announcement
-// outlives its announcer by its DDS lease when the announcer is killed, so a live announcement
-// alone does not tell a namesake from a run that just died and is being restarted. On this host
-// the pid does: a run that died has no process of its pid running this program (a pid reused by
-// another program is not it). On another host nothing here can look, and a run moves host only
-// with its operator: it is taken to run.
-bool may_still_run(const std::string &host, std::int64_t pid);
+// Whether the run of `program` that announced itself as `pid` on `host` may still be running. An
+// announcement outlives its announcer by its DDS lease when the announcer is killed, so a live
+// announcement alone does not tell a namesake from a run that just died and is being restarted.
+// On this host the pid does: a run that died has no process of its pid running `program` (a pid
+// reused by another program is not it; a zombie runs nothing). On another host nothing here can
+// look, and a run moves host only with its operator: it is taken to run.
+bool may_still_run(const std::string &host, std::int64_t pid, const std::string &program);
 
-// Who holds `address`, if a live run does: "<what> is served by pid P on host H (DDS domain D,
-// tag T)". `Announcement` is the holder's announcement type (it has `pid` and `host`); a body that
-// does not decode is another version's or another kind's, named as such.
+// The name the kernel gives the program this process runs (its first 15 bytes).
+std::string own_program();
+
+// Who holds `address`, if a live run of `program` (rsca-domaind, rsca-noded) does: "<what> is
+// served by pid P on host H (DDS domain D, tag T)". `Announcement` is the holder's announcement
+// type (it has `pid` and `host`); a body that does not decode is another version's or another
+// kind's, named as such.
 template <typename Announcement>
 std::optional<std::string> live_holder(const dds::Participant &participant,
-                                       const std::string &address, const std::string &what) {
+                                       const std::string &address, const std::string &what,
+                                       const std::string &program) {
   const auto body = live_announcement(participant, address, kNameCheck);
   if (!body)
     return std::nullopt;
@@ -55,7 +60,7 @@ std::optional<std::string> live_holder(const dds::Participant &participant,
   if (!holder)
     return fmt::format("{} is announced at {} on {} by a process that does not say who it is ({})",
                        what, address, where, holder.error());
-  if (!may_still_run(holder->host, holder->pid))
+  if (!may_still_run(holder->host, holder->pid, program))
     return std::nullopt;
   return fmt::format("{} is served by pid {} on host {} ({})", what, holder->pid, holder->host,
                      where);

@@ -71,7 +71,8 @@ std::optional<std::string> held_by_another(const dds::Participant &participant,
   spdlog::info("looking for another daemon of domain {} (up to {} ms)", name,
                control::kNameCheck.count());
   auto held = control::live_holder<protocol::domain::DomainAnnouncement>(
-      participant, protocol::domain_address(name), fmt::format("domain {}", name));
+      participant, protocol::domain_address(name), fmt::format("domain {}", name),
+      control::own_program());
   if (!held)
     return std::nullopt;
   return fmt::format("{}: this daemon (pid {} on host {}) does not start beside it; stop that one "

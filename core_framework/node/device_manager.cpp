@@ -167,7 +167,8 @@ std::optional<std::string> held_by_another(const dds::Participant &participant,
   spdlog::info("looking for another daemon of node {} (up to {} ms)", name,
                control::kNameCheck.count());
   auto held = control::live_holder<op::NodeAnnouncement>(
-      participant, protocol::node_address(domain, name), fmt::format("node {}", name));
+      participant, protocol::node_address(domain, name), fmt::format("node {}", name),
+      control::own_program());
   if (!held)
     return std::nullopt;
   return fmt::format("{}: this node daemon (pid {} on host {}, DCD {}) does not start beside it; "
