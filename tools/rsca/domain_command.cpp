@@ -1,10 +1,13 @@
 // rsca domain up|down: a local domain daemon and N node daemons in the background, with their
 // logs and pid files in a run folder.
 #include <signal.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <thread>
 
@@ -13,9 +16,11 @@
 #include "commands.hpp"
 #include "common/install_layout.hpp"
 #include "common/own_folder.hpp"
+#include "control/name_holder.hpp"
 #include "domain_client.hpp"
 #include "exit_codes.hpp"
 #include "process/spawn.hpp"
+#include "protocol/domain_announcement.hpp"
 #include "protocol/domain_ops.hpp"
 
 namespace rsca::cli {
@@ -38,6 +43,13 @@ fs::path default_sdrroot(const GlobalOptions &global) {
 
 bool alive(pid_t pid) {
   return pid > 0 && ::kill(pid, 0) == 0;
+}
+
+// Whether a daemon this command started has exited. Reaped here: an exited child stays a zombie,
+// which kill(pid, 0) takes for alive (a refused domain daemon went unseen until the deadline).
+bool has_exited(pid_t pid) {
+  int status = 0;
+  return ::waitpid(pid, &status, WNOHANG) == pid || !alive(pid);
 }
 
 std::optional<pid_t> read_pid(const fs::path &file) {
@@ -124,6 +136,62 @@ Expected<pid_t> spawn_node(const fs::path &dcd, const std::string &name, const f
   return spawn_daemon(bin / "rsca-noded", args, run / (name + ".log"), run / (name + ".pid"));
 }
 
+// Who serves domain `domain` on this DDS domain and tag already, if a live daemon does
+// (control/name_holder.hpp): a second one beside it would take its requests, and its nodes named
+// as the first's would take theirs over.
+std::optional<std::string> domain_held(const std::string &domain) {
+  auto settings = dds::DdsSettings::from_environment();
+  settings.trace = "none";
+  auto participant = dds::Participant::create(settings);
+  if (!participant)
+    return std::nullopt; // the domain daemon, joining the same way, will say why
+  return control::live_holder<protocol::domain::DomainAnnouncement>(
+      **participant, protocol::domain_address(domain), fmt::format("domain {}", domain),
+      "rsca-domaind");
+}
+
+// Stops a daemon as `domain down` does: asked, then killed if it does not go within 5 s.
+void stop_daemon(pid_t pid) {
+  ::kill(pid, SIGTERM);
+  if (!wait_exit(pid, 5s)) {
+    ::kill(pid, SIGKILL);
+    wait_exit(pid, 2s);
+  }
+}
+
+struct Started {
+  pid_t pid;
+  fs::path log;
+  fs::path pid_file;
+};
+
+// A daemon `up` started stopped: every other one it started goes too, nodes first, and their pid
+// files: an `up` that fails leaves nothing of its own running.
+int abandon_up(const std::vector<Started> &started, const Started &stopped) {
+  fmt::print(stderr, "rsca domain up: a daemon (pid {}) stopped; its log ends:\n{}", stopped.pid,
+             tail(stopped.log));
+  std::error_code ec;
+  for (auto it = started.rbegin(); it != started.rend(); ++it) {
+    if (!has_exited(it->pid))
+      stop_daemon(it->pid);
+    fs::remove(it->pid_file, ec);
+  }
+  fmt::print(stderr, "rsca domain up: the {} other daemon(s) it started are stopped\n",
+             started.size() - 1);
+  return kFailed;
+}
+
+// Whether every node daemon `up` started (all but the first of `started`, the domain daemon) is
+// registered: a domain that lists nodes of the same names run by others is not this one.
+bool all_registered(const protocol::domain::NodesReply &reply,
+                    const std::vector<Started> &started) {
+  std::set<std::int64_t> listed;
+  for (const auto &n : reply.nodes)
+    listed.insert(n.pid);
+  return std::all_of(started.begin() + 1, started.end(),
+                     [&](const Started &s) { return listed.contains(s.pid); });
+}
+
 int up(int nodes, const std::vector<std::string> &extra_dcds, const fs::path &run,
        const GlobalOptions &global) {
   std::error_code ec;
@@ -133,6 +201,13 @@ int up(int nodes, const std::vector<std::string> &extra_dcds, const fs::path &ru
         stderr,
         "rsca domain up: a domain is already up in {} (domaind pid {}); `rsca domain down` first\n",
         run.string(), *pid);
+    return kRejected;
+  }
+  if (auto held = domain_held(global.domain)) {
+    fmt::print(stderr,
+               "rsca domain up: {}; nothing started (stop that domain first, or use another DDS "
+               "domain or tag: RSCA_DDS_DOMAIN, RSCA_DDS_TAG)\n",
+               *held);
     return kRejected;
   }
   const fs::path bin = own_folder();
@@ -145,7 +220,7 @@ int up(int nodes, const std::vector<std::string> &extra_dcds, const fs::path &ru
     fmt::print(stderr, "rsca domain up: {}\n", domaind.error().to_string());
     return kFailed;
   }
-  std::vector<std::pair<pid_t, fs::path>> started{{*domaind, run / "domaind.log"}};
+  std::vector<Started> started{{*domaind, run / "domaind.log", run / "domaind.pid"}};
   for (int i = 1; i <= nodes; ++i) {
     auto dcd = node_dcd(i, sdrroot, run);
     if (!dcd) {
@@ -158,7 +233,7 @@ int up(int nodes, const std::vector<std::string> &extra_dcds, const fs::path &ru
       fmt::print(stderr, "rsca domain up: {}\n", pid.error().to_string());
       return kFailed;
     }
-    started.emplace_back(*pid, run / (name + ".log"));
+    started.push_back({*pid, run / (name + ".log"), run / (name + ".pid")});
   }
   for (const auto &dcd : extra_dcds) {
     const std::string name = fs::path(dcd).parent_path().filename().string();
@@ -167,7 +242,7 @@ int up(int nodes, const std::vector<std::string> &extra_dcds, const fs::path &ru
       fmt::print(stderr, "rsca domain up: {}\n", pid.error().to_string());
       return kFailed;
     }
-    started.emplace_back(*pid, run / (name + ".log"));
+    started.push_back({*pid, run / (name + ".log"), run / (name + ".pid")});
   }
   const std::size_t expected = static_cast<std::size_t>(nodes) + extra_dcds.size();
   auto client = DomainClient::connect(global);
@@ -179,14 +254,11 @@ int up(int nodes, const std::vector<std::string> &extra_dcds, const fs::path &ru
       std::chrono::steady_clock::now() + std::chrono::milliseconds(global.timeout_ms) * 4;
   protocol::domain::NodesReply reply;
   for (;;) {
-    for (const auto &[pid, log] : started)
-      if (!alive(pid)) {
-        fmt::print(stderr, "rsca domain up: a daemon (pid {}) stopped; its log ends:\n{}", pid,
-                   tail(log));
-        return kFailed;
-      }
+    for (const auto &s : started)
+      if (has_exited(s.pid))
+        return abandon_up(started, s);
     auto listed = client->call<protocol::domain::Nodes>({}, 1s);
-    if (listed && listed->nodes.size() >= expected) {
+    if (listed && all_registered(*listed, started)) {
       reply = *listed;
       break;
     }
@@ -231,11 +303,7 @@ int down(const fs::path &run, const GlobalOptions &global) {
   for (const auto &file : pid_files) {
     auto pid = read_pid(file);
     if (pid && alive(*pid)) {
-      ::kill(*pid, SIGTERM);
-      if (!wait_exit(*pid, 5s)) {
-        ::kill(*pid, SIGKILL);
-        wait_exit(*pid, 2s);
-      }
+      stop_daemon(*pid);
       ++stopped;
     }
     fs::remove(file, ec);
