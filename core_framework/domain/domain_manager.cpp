@@ -368,22 +368,45 @@ DomainManager::Impl::show_application(const app_ops::AppRequest &request) {
   return live_view_of(*app);
 }
 
-// Admission and placement of an installed application on the domain as it is, reserving nothing.
+// Admission and placement of an application on the domain as it is, reserving nothing.
 CallResult<app_ops::PlanReply>
-DomainManager::Impl::plan_application(const app_ops::PlanRequest &request) {
-  auto strategy = strategy_of(request.strategy);
+DomainManager::Impl::plan_profile(const profile::ResolvedApplication &profile,
+                                  const std::string &name,
+                                  const std::map<std::string, std::string> &assign,
+                                  const std::optional<std::string> &strategy_name) {
+  auto strategy = strategy_of(strategy_name);
   if (!strategy)
     return tl::unexpected(strategy.error());
+  if (auto stray = allocator::unknown_assignment(profile, assign))
+    return unknown_assignment_error(name, *stray);
+  const allocator::PlanOptions plan_options{strategy->value_or(options.strategy)};
+  auto plan = allocator.plan(allocator::plan_request_of(profile, assign), plan_options);
+  return allocator::plan_reply(plan, plan_options.strategy);
+}
+
+CallResult<app_ops::PlanReply>
+DomainManager::Impl::plan_application(const app_ops::PlanRequest &request) {
   auto installed = repository->find(request.application);
   if (!installed)
     return control::call_error(Status::NotFound, fmt::format("no application {} is installed",
                                                              excerpt(request.application)));
-  if (auto stray = allocator::unknown_assignment(*installed->profile, request.assign))
-    return unknown_assignment_error(request.application, *stray);
-  const allocator::PlanOptions plan_options{strategy->value_or(options.strategy)};
-  auto plan =
-      allocator.plan(allocator::plan_request_of(*installed->profile, request.assign), plan_options);
-  return allocator::plan_reply(plan, plan_options.strategy);
+  return plan_profile(*installed->profile, request.application, request.assign, request.strategy);
+}
+
+// The same of an application's files, read aside and removed again: nothing is installed.
+CallResult<app_ops::PlanReply>
+DomainManager::Impl::plan_files(const app_ops::PlanFilesRequest &request) {
+  auto profile = repository->read_aside(request.files);
+  if (!profile)
+    return tl::unexpected(profile.error());
+  const auto &sad = *(*profile)->sad;
+  const std::string name = sad.name.empty() ? sad.id : sad.name;
+  auto planned = plan_profile(**profile, name, request.assign, request.strategy);
+  spdlog::info("planned {} from its files, installing nothing: {}", excerpt(name),
+               !planned            ? "refused"
+               : planned->admitted ? "admitted"
+                                   : "rejected");
+  return planned;
 }
 
 template <control::Operation Op, typename Handler>
@@ -412,6 +435,7 @@ void DomainManager::Impl::serve() {
   serve_op<protocol::file::Read>(&Impl::read_file);
   serve_op<app_ops::Create>(&Impl::create_application);
   serve_op<app_ops::Plan>(&Impl::plan_application);
+  serve_op<app_ops::PlanFiles>(&Impl::plan_files);
   serve_op<app_ops::Progress>(&Impl::progress);
   serve_op<app_ops::Cancel>(&Impl::cancel_launch);
   serve_op<app_ops::Release>(&Impl::release);

@@ -112,6 +112,11 @@ struct DomainManager::Impl {
   CallResult<app_ops::ListReply> list_applications();
   CallResult<app_ops::ApplicationView> show_application(const app_ops::AppRequest &request);
   CallResult<app_ops::PlanReply> plan_application(const app_ops::PlanRequest &request);
+  CallResult<app_ops::PlanReply> plan_files(const app_ops::PlanFilesRequest &request);
+  CallResult<app_ops::PlanReply> plan_profile(const profile::ResolvedApplication &profile,
+                                              const std::string &name,
+                                              const std::map<std::string, std::string> &assign,
+                                              const std::optional<std::string> &strategy);
   CallResult<protocol::Empty> component_exited(const protocol::domain::ComponentExitedReport &r);
   CallResult<protocol::Empty>
   connection_problem(const protocol::domain::ConnectionProblemReport &r);

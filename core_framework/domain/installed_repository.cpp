@@ -6,10 +6,12 @@
 #include <fstream>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
 #include "common/names.hpp"
 #include "content/base64.hpp"
+#include "profile/application_checks.hpp"
 #include "profile/runtime_model.hpp"
 
 namespace rsca::domain {
@@ -139,6 +141,56 @@ CallResult<void> checked_name(const std::string &name) {
   return {};
 }
 
+// A problem found in a staged install, with the staging folder taken out of its paths: they then
+// read as the client's, relative to the SDR root its files came from, rather than as a folder
+// that is gone once the install ends.
+std::string as_client_paths(std::string text, const fs::path &staged) {
+  const std::string prefix = (staged / "").string();
+  for (auto at = text.find(prefix); at != std::string::npos; at = text.find(prefix, at))
+    text.erase(at, prefix.size());
+  return text;
+}
+
+// The application `request` carries, its files written into `dir` and loaded from there; the
+// SAD's path and the name are checked first. `sad`: the SAD's path inside `dir`.
+CallResult<profile::ResolvedApplication>
+write_and_load(const fs::path &dir, const InstallRequest &request, fs::path &sad) {
+  auto relative = safe_relative(request.sad);
+  if (!relative)
+    return control::call_error(
+        Status::BadRequest,
+        fmt::format("the SAD's path \"{}\" is not inside an SDR root", excerpt(request.sad)));
+  sad = *relative;
+  if (request.name)
+    if (auto named = checked_name(*request.name); !named)
+      return tl::unexpected(named.error());
+  if (auto written = write_files(dir, request.files); !written)
+    return tl::unexpected(written.error());
+  profile::ProfileLoader loader(dir);
+  auto app = loader.load_application(dir / sad);
+  if (!app)
+    return control::call_error(Status::BadRequest, as_client_paths(app.error().to_string(), dir));
+  return std::move(*app);
+}
+
+// An install for a launch (`rsca launch SAD`) of what no launch could run is refused before it
+// replaces anything.
+CallResult<void> launchable(const InstallRequest &request, const profile::ResolvedApplication &app,
+                            const fs::path &staged) {
+  if (!request.for_launch.value_or(false))
+    return {};
+  const auto refused = profile::launch_refusals(app);
+  if (refused.empty())
+    return {};
+  std::vector<std::string> problems;
+  for (const auto &r : refused)
+    problems.push_back(as_client_paths(to_string(r), staged));
+  return control::call_error(Status::BadRequest,
+                             fmt::format("the application cannot be launched, nothing was "
+                                         "installed:\n{}",
+                                         fmt::join(problems, "\n")));
+}
+
 // The application's components then start from their runtime models, without reading XML; a
 // component without one still starts, reading its profile (profile/runtime_model.hpp).
 void write_runtime_models(const profile::ResolvedApplication &app) {
@@ -199,31 +251,33 @@ void InstalledRepository::load() {
 }
 
 CallResult<InstalledApplication> InstalledRepository::install(const InstallRequest &request) {
-  auto sad = safe_relative(request.sad);
-  if (!sad)
-    return control::call_error(
-        Status::BadRequest,
-        fmt::format("the SAD's path \"{}\" is not inside an SDR root", excerpt(request.sad)));
-  if (request.name)
-    if (auto named = checked_name(*request.name); !named)
-      return tl::unexpected(named.error());
   // Written and loaded aside first: only an install that loads replaces anything.
   ScopedFolder staging(root_, staging_dir() / unique_name("install"));
-  if (auto written = write_files(staging.path(), request.files); !written)
-    return tl::unexpected(written.error());
-  profile::ProfileLoader loader(staging.path());
-  auto app = loader.load_application(staging.path() / *sad);
+  fs::path sad;
+  auto app = write_and_load(staging.path(), request, sad);
   if (!app)
-    return control::call_error(Status::BadRequest, app.error().to_string());
+    return tl::unexpected(app.error());
+  if (auto ok = launchable(request, *app, staging.path()); !ok)
+    return tl::unexpected(ok.error());
   const std::string name =
       request.name.value_or(app->sad->name.empty() ? app->sad->id : app->sad->name);
   if (auto named = checked_name(name); !named)
     return tl::unexpected(named.error());
   std::lock_guard lock(mutex_);
-  auto installed = replace(name, staging.path(), *sad);
+  auto installed = replace(name, staging.path(), sad);
   if (installed)
     staging.keep(); // it became the install
   return installed;
+}
+
+CallResult<std::shared_ptr<const profile::ResolvedApplication>>
+InstalledRepository::read_aside(const InstallRequest &request) const {
+  ScopedFolder staging(root_, staging_dir() / unique_name("read"));
+  fs::path sad;
+  auto app = write_and_load(staging.path(), request, sad);
+  if (!app)
+    return tl::unexpected(app.error());
+  return std::make_shared<const profile::ResolvedApplication>(std::move(*app));
 }
 
 // Puts a staged install in the place of `name` (called with mutex_ held). What was installed

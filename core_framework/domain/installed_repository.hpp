@@ -6,8 +6,9 @@
 // (common/names.hpp) before it touches the file system, a file's path must be relative and stay
 // inside the install, and every folder the repository removes or replaces is checked to lie inside
 // it. An install is staged in a folder of its own and takes the application's place only once it
-// loads; one that fails at any point leaves the repository as it was (no staging folder, the
-// previous install of the same name intact).
+// loads (and, for a launch, only once nothing in it would make the launch refuse it); one that
+// fails at any point leaves the repository as it was (no staging folder, the previous install of
+// the same name intact).
 #pragma once
 
 #include <filesystem>
@@ -43,6 +44,10 @@ public:
   // with a warning.
   void load();
   control::CallResult<InstalledApplication> install(const InstallRequest &request);
+  // The application `request` carries, read in a staging folder that is removed again: what it
+  // would install, installing nothing (`rsca plan SAD`).
+  control::CallResult<std::shared_ptr<const profile::ResolvedApplication>>
+  read_aside(const InstallRequest &request) const;
   control::CallResult<void> uninstall(const std::string &name);
   std::optional<InstalledApplication> find(const std::string &name) const;
   std::vector<InstalledApplication> list() const;

@@ -11,6 +11,7 @@
 #include "common/elapsed.hpp"
 #include "dds/port_qos.hpp"
 #include "domain/launch.hpp"
+#include "profile/application_checks.hpp"
 #include "profile/property_binding.hpp"
 #include "profile/property_json.hpp"
 #include "protocol/component_ops.hpp"
@@ -47,17 +48,12 @@ CallResult<std::shared_ptr<Application>> ApplicationFactory::Launch::run() {
 }
 
 CallResult<void> ApplicationFactory::Launch::check() {
-  // A missing file first: it explains the wiring findings it causes (ports of a missing SCD).
-  if (auto missing = missing_files(); !missing.empty())
-    return control::call_error(Status::BadRequest, fmt::format("{}", fmt::join(missing, "\n")));
-  if (!request_.profile->warnings.empty()) {
+  if (auto refused = profile::launch_refusals(*request_.profile); !refused.empty()) {
     std::vector<std::string> problems;
-    for (const auto &w : request_.profile->warnings)
-      problems.push_back(to_string(w));
+    for (const auto &r : refused)
+      problems.push_back(to_string(r));
     return control::call_error(Status::BadRequest, fmt::format("{}", fmt::join(problems, "\n")));
   }
-  if (auto unsupported = unsupported_connections(); !unsupported.empty())
-    return control::call_error(Status::BadRequest, fmt::format("{}", fmt::join(unsupported, "\n")));
   if (auto joined = s_.channels->join(channel_members()); !joined)
     return joined;
   saga_.on_undo([this] {
@@ -69,62 +65,6 @@ CallResult<void> ApplicationFactory::Launch::check() {
   detail_ = fmt::format("{} components, {} connections", count_instances(),
                         request_.profile->sad->connections.size());
   return {};
-}
-
-// A profile may name files that are not there, as REDHAWK allows until they are needed: a
-// component whose package misses one is needed now, and cannot run.
-std::vector<std::string> ApplicationFactory::Launch::missing_files() const {
-  std::vector<std::string> out;
-  for (const auto &placement : request_.profile->sad->placements) {
-    const auto *pkg = request_.profile->softpkg_of(placement);
-    if (pkg == nullptr)
-      continue;
-    for (const auto &ci : placement.instantiations)
-      for (const auto &missing : pkg->unavailable)
-        out.push_back(
-            fmt::format("component {} cannot be launched: {}", ci.id, to_string(missing)));
-  }
-  return out;
-}
-
-std::vector<std::string> ApplicationFactory::Launch::unsupported_connections() const {
-  using Kind = profile::EndpointTarget::Kind;
-  std::vector<std::string> out;
-  const auto &sad = *request_.profile->sad;
-  for (std::size_t i = 0; i < sad.connections.size(); ++i) {
-    const auto &c = sad.connections[i];
-    const std::string id = connection_id(c, i);
-    for (const auto *end : {&c.uses.target, &c.provides.target}) {
-      if (end->kind == Kind::FindBy && !end->findby.is_event_channel())
-        out.push_back(fmt::format("connection {}: only event channels can be found by findby; "
-                                  "\"{}\" is not one",
-                                  id, end->findby.name));
-      if (end->kind == Kind::ComponentInstantiation &&
-          sad.find_instantiation(end->refid) == nullptr)
-        out.push_back(fmt::format("connection {}: \"{}\" is no component of the application (a "
-                                  "DeviceManager, to REDHAWK): rsca cannot connect to it",
-                                  id, end->refid));
-    }
-    const auto is_device = [](const profile::EndpointTarget &t) {
-      return t.kind == Kind::DeviceThatLoadedThisComponent ||
-             t.kind == Kind::DeviceUsedByThisComponent || t.kind == Kind::DeviceUsedByApplication;
-    };
-    if ((c.publishes_to_channel() && is_device(c.uses.target)) ||
-        (c.subscribes_to_channel() && is_device(c.provides.target)))
-      out.push_back(fmt::format(
-          "connection {}: a device port cannot be an event channel member yet: connect it "
-          "to a component port",
-          id));
-    if (c.provides.kind == profile::ProvidesEnd::Kind::SupportedInterface &&
-        (c.uses.target.kind != Kind::ComponentInstantiation ||
-         c.provides.target.kind != Kind::ComponentInstantiation))
-      out.push_back(fmt::format("connection {}: a supported interface connects a component's "
-                                "uses port to another component of the application "
-                                "(componentinstantiationref on both sides), not to a device "
-                                "or a channel",
-                                id));
-  }
-  return out;
 }
 
 std::vector<std::pair<std::string, ChannelMember>>
@@ -151,7 +91,7 @@ ApplicationFactory::Launch::channel_members() const {
 
 std::string ApplicationFactory::Launch::connection_id(const profile::Connection &c,
                                                       std::size_t index) {
-  return c.id.empty() ? fmt::format("connection_{}", index + 1) : c.id;
+  return profile::connection_id(c, index);
 }
 
 const std::string &ApplicationFactory::Launch::channel_name(const profile::Connection &c) {

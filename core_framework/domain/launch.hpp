@@ -38,13 +38,10 @@ public:
   CallResult<std::shared_ptr<Application>> run();
 
 private:
-  // Wiring problems found while loading (unknown ports, mismatched port types) and event-channel
-  // members that could never match the channel's others stop a launch before anything runs.
+  // What the profile alone makes unlaunchable (profile::launch_refusals: missing files, wiring
+  // findings, connections rsca cannot make yet) and event-channel members that could never match
+  // the channel's others stop a launch before anything runs.
   CallResult<void> check();
-
-  // Connections rsca cannot make yet, each named with why: refused here rather than left out.
-  std::vector<std::string> missing_files() const;
-  std::vector<std::string> unsupported_connections() const;
 
   // This application's publishers and subscribers of event channels, by channel name.
   std::vector<std::pair<std::string, ChannelMember>> channel_members() const;

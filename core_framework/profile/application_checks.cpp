@@ -1,6 +1,7 @@
 #include "profile/application_checks.hpp"
 
 #include <cstdint>
+#include <optional>
 #include <set>
 
 #include <fmt/format.h>
@@ -218,6 +219,69 @@ private:
   std::vector<Diagnostic> &tolerated_;
 };
 
+// Each component whose package misses a file it needs to run.
+std::vector<Diagnostic> missing_files(const ResolvedApplication &app) {
+  std::vector<Diagnostic> out;
+  for (const auto &placement : app.sad->placements) {
+    const auto *pkg = app.softpkg_of(placement);
+    if (pkg == nullptr)
+      continue;
+    for (const auto &ci : placement.instantiations)
+      for (const auto &missing : pkg->unavailable)
+        out.push_back({missing.where, missing.rule,
+                       fmt::format("component {} cannot be launched: {}", ci.id, missing.message)});
+  }
+  return out;
+}
+
+// One end of a connection that rsca cannot connect: why, or nothing.
+std::optional<std::string> unsupported_end(const SoftwareAssembly &sad, const EndpointTarget &end) {
+  using Kind = EndpointTarget::Kind;
+  if (end.kind == Kind::FindBy && !end.findby.is_event_channel())
+    return fmt::format("only event channels can be found by findby; \"{}\" is not one",
+                       end.findby.name);
+  if (end.kind == Kind::ComponentInstantiation && sad.find_instantiation(end.refid) == nullptr)
+    return fmt::format("\"{}\" is no component of the application (a DeviceManager, to "
+                       "REDHAWK): rsca cannot connect to it",
+                       end.refid);
+  return std::nullopt;
+}
+
+// Why rsca cannot make connection `c` yet, each reason once.
+std::vector<std::string> unsupported_reasons(const SoftwareAssembly &sad, const Connection &c) {
+  using Kind = EndpointTarget::Kind;
+  std::vector<std::string> out;
+  for (const auto *end : {&c.uses.target, &c.provides.target})
+    if (auto why = unsupported_end(sad, *end))
+      out.push_back(std::move(*why));
+  const auto is_device = [](const EndpointTarget &t) {
+    return t.kind == Kind::DeviceThatLoadedThisComponent ||
+           t.kind == Kind::DeviceUsedByThisComponent || t.kind == Kind::DeviceUsedByApplication;
+  };
+  if ((c.publishes_to_channel() && is_device(c.uses.target)) ||
+      (c.subscribes_to_channel() && is_device(c.provides.target)))
+    out.emplace_back("a device port cannot be an event channel member yet: connect it to a "
+                     "component port");
+  if (c.provides.kind == ProvidesEnd::Kind::SupportedInterface &&
+      (c.uses.target.kind != Kind::ComponentInstantiation ||
+       c.provides.target.kind != Kind::ComponentInstantiation))
+    out.emplace_back("a supported interface connects a component's uses port to another "
+                     "component of the application (componentinstantiationref on both sides), "
+                     "not to a device or a channel");
+  return out;
+}
+
+std::vector<Diagnostic> unsupported_connections(const SoftwareAssembly &sad) {
+  std::vector<Diagnostic> out;
+  for (std::size_t i = 0; i < sad.connections.size(); ++i) {
+    const auto &c = sad.connections[i];
+    for (auto &why : unsupported_reasons(sad, c))
+      out.push_back({c.where, "unsupported-connection",
+                     fmt::format("connection {}: {}", connection_id(c, i), why)});
+  }
+  return out;
+}
+
 } // namespace
 
 std::vector<Diagnostic> check_application(const ResolvedApplication &app,
@@ -248,6 +312,22 @@ std::vector<Diagnostic> check_node(const ResolvedNode &node, std::vector<Diagnos
     }
   }
   return errors.diagnostics();
+}
+
+std::vector<Diagnostic> launch_refusals(const ResolvedApplication &app) {
+  if (auto missing = missing_files(app); !missing.empty())
+    return missing;
+  if (!app.warnings.empty()) {
+    auto refused = app.warnings;
+    for (auto &w : refused)
+      w.severity = Severity::Error;
+    return refused;
+  }
+  return unsupported_connections(*app.sad);
+}
+
+std::string connection_id(const Connection &c, std::size_t index) {
+  return c.id.empty() ? fmt::format("connection_{}", index + 1) : c.id;
 }
 
 } // namespace rsca::profile

@@ -14,6 +14,7 @@
 #include "protocol/codec.hpp"
 #include "protocol/component_ops.hpp"
 #include "protocol/connection_ops.hpp"
+#include "protocol/domain_ops.hpp"
 
 namespace rsca::protocol {
 namespace application {
@@ -57,6 +58,20 @@ struct PlanRequest {
   static constexpr auto fields() {
     using R = PlanRequest;
     return std::tuple{required("application", &R::application), optional("assign", &R::assign),
+                      optional("strategy", &R::strategy)};
+  }
+};
+
+// Admission and placement of an application that is not installed (`rsca plan SAD`): its files,
+// as an install carries them, which the domain reads aside and removes once planned. A dry run:
+// nothing is installed or reserved.
+struct PlanFilesRequest {
+  domain::InstallRequest files;
+  std::map<std::string, std::string> assign;
+  std::optional<std::string> strategy;
+  static constexpr auto fields() {
+    using R = PlanFilesRequest;
+    return std::tuple{required("files", &R::files), optional("assign", &R::assign),
                       optional("strategy", &R::strategy)};
   }
 };
@@ -340,6 +355,11 @@ struct ListReply {
 struct Plan {
   static constexpr std::string_view name = "app.plan";
   using Request = PlanRequest;
+  using Reply = PlanReply;
+};
+struct PlanFiles {
+  static constexpr std::string_view name = "app.plan_files";
+  using Request = PlanFilesRequest;
   using Reply = PlanReply;
 };
 struct Create {

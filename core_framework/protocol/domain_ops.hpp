@@ -104,10 +104,15 @@ struct InstallRequest {
   std::string sad; // the SAD's path among the files
   std::vector<InstallFile> files;
   std::optional<std::string> name; // absent: the SAD's name
+  // true (`rsca launch SAD`): refused, replacing nothing, when a launch would refuse the
+  // application as its files are (profile::launch_refusals); absent: false, it installs with
+  // warnings.
+  std::optional<bool> for_launch;
   static constexpr auto fields() {
     return std::tuple{required("sad", &InstallRequest::sad),
                       required("files", &InstallRequest::files),
-                      optional("name", &InstallRequest::name)};
+                      optional("name", &InstallRequest::name),
+                      optional("for_launch", &InstallRequest::for_launch)};
   }
 };
 

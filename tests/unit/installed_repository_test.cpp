@@ -201,6 +201,18 @@ TEST_CASE("a failed install leaves no staging copy and keeps what was installed 
     CHECK(installed.error().status == Status::BadRequest);
     CHECK_THAT(installed.error().message, Catch::Contains("at most 10 MiB"));
   }
+  SECTION("for a launch, a SAD of the same name that a launch would refuse") {
+    auto miswired = request_for("HealthyMiswired");
+    miswired.for_launch = true;
+    auto installed = box.repository->install(miswired);
+    REQUIRE_FALSE(installed.has_value());
+    CHECK(installed.error().status == Status::BadRequest);
+    // Named as the client's file, relative to its SDR root, not as the staging copy.
+    CHECK_THAT(installed.error().message,
+               Catch::Contains("dom/waveforms/HealthyMiswired/HealthyMiswired.sad.xml:40:21: "
+                               "unknown-port"));
+    CHECK_THAT(installed.error().message, !Catch::Contains(".staging"));
+  }
   SECTION("a SAD whose name is 7 MB long") {
     auto huge = good;
     const std::string name(7 * 1024 * 1024, 'n');
@@ -223,6 +235,27 @@ TEST_CASE("a failed install leaves no staging copy and keeps what was installed 
   CHECK(fs::exists(after->sad));
   box.open(); // and after a restart
   CHECK(box.repository->find("Healthy").has_value());
+}
+
+TEST_CASE("an application read aside is loaded and leaves nothing in the repository",
+          "[unit][installed-repository]") {
+  Sandbox box;
+  const auto tree_before = box.tree();
+  auto app = box.repository->read_aside(request_for("Healthy"));
+  REQUIRE(app.has_value());
+  CHECK((*app)->sad->name == "Healthy");
+  CHECK((*app)->component_files.size() == 2);
+  auto escaping = request_for("Healthy");
+  escaping.files.push_back({"../../escape.xml", "x", {}, {}});
+  auto refused = box.repository->read_aside(escaping);
+  REQUIRE_FALSE(refused.has_value());
+  CHECK(refused.error().status == Status::BadRequest);
+  CHECK(box.leftovers().empty());
+  // Nothing else: the staging folder itself stays, empty, as after any install.
+  auto tree_after = box.tree();
+  tree_after.erase((box.root / ".staging").lexically_relative(box.top).string());
+  CHECK(tree_after == tree_before);
+  CHECK_FALSE(box.repository->find("Healthy").has_value());
 }
 
 TEST_CASE("a store record that points outside the repository is skipped, never acted on",

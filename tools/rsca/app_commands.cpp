@@ -18,7 +18,6 @@
 #include "domain_client.hpp"
 #include "exit_codes.hpp"
 #include "install_code.hpp"
-#include "profile/profile_loader.hpp"
 #include "protocol/application_ops.hpp"
 #include "protocol/connection_ops.hpp"
 #include "protocol/domain_ops.hpp"
@@ -32,49 +31,68 @@ namespace connection_ops = protocol::connection;
 using control::Json;
 using namespace std::chrono_literals;
 
-std::string read_text(const fs::path &file) {
-  std::ifstream in(file, std::ios::binary);
-  std::ostringstream out;
-  out << in.rdbuf();
-  return out.str();
+// Sends the install of the user's application; its installed name goes to `installed_name` (and
+// nothing is printed in --json mode) when given. `command`: the one the user ran.
+int send_install(const UserApplication &app, const DomainClient &client,
+                 const GlobalOptions &global, std::string *installed_name, const char *command) {
+  if (!global.json)
+    for (const auto &w : app.warnings)
+      fmt::print(stderr, "rsca {}: {}\n", command, to_string(w));
+  auto reply = client.call<protocol::domain::Install>(
+      app.request, std::chrono::milliseconds(global.timeout_ms) * 2);
+  if (!reply)
+    return report_failure(global, command, reply.error());
+  if (installed_name != nullptr)
+    *installed_name = reply->name;
+  if (global.json && installed_name == nullptr)
+    print_json(protocol::encode(*reply));
+  else if (!global.json)
+    fmt::print("installed {} ({} files)\n", reply->name, app.request.files.size());
+  return kOk;
 }
 
-std::optional<fs::path> sdrroot_of(const fs::path &file, const GlobalOptions &global) {
-  if (!global.sdrroot.empty())
-    return fs::absolute(global.sdrroot);
-  if (auto root = profile::SdrRoot::find_for(file))
-    return root->path();
-  return std::nullopt;
+// Whether the domain has an application installed under `name`; nullopt when it did not say.
+std::optional<bool> is_installed(const DomainClient &client, const std::string &name,
+                                 const GlobalOptions &global) {
+  auto listed =
+      client.call<protocol::domain::Installed>({}, std::chrono::milliseconds(global.timeout_ms));
+  if (!listed)
+    return std::nullopt;
+  return std::any_of(listed->applications.begin(), listed->applications.end(),
+                     [&](const auto &a) { return a.name == name; });
 }
 
-// The install request for a SAD: the application's files, read here and carried to the domain,
-// so that the CLI may run on another host than the domain daemon. `warnings`: what reading them
-// found, located in the user's files.
-Expected<protocol::domain::InstallRequest> install_request(const fs::path &sad,
-                                                           const GlobalOptions &global,
-                                                           const std::string &name,
-                                                           std::vector<Diagnostic> &warnings) {
-  auto root = sdrroot_of(sad, global);
-  if (!root)
-    return make_error(
-        {sad.string(), 0, 0}, "sdrroot",
-        "no SDR root found: no folder above this file holds dom/ or dev/ (give --sdrroot)");
-  profile::ProfileLoader loader(*root);
-  auto app = loader.load_application(sad);
-  if (!app)
-    return tl::unexpected(app.error());
-  warnings = app->warnings;
-  warnings.insert(warnings.end(), app->tolerated.begin(), app->tolerated.end());
-  protocol::domain::InstallRequest request{
-      app->sad_path.lexically_relative(*root).string(), {}, std::nullopt};
-  for (const auto &f : app->files())
-    request.files.push_back(
-        {fs::path(f).lexically_relative(*root).string(), read_text(f), std::nullopt, std::nullopt});
-  if (auto carried = add_code_files(*app, *root, request); !carried)
-    return tl::unexpected(carried.error());
-  if (!name.empty())
-    request.name = name;
-  return request;
+// What a launch launches: an installed name, or a SAD file installed first (`installed_now`: it
+// was not installed before, so a failed launch uninstalls it again). rc: an exit code.
+struct LaunchTarget {
+  std::string application;
+  bool installed_now = false;
+};
+
+LaunchTarget install_to_launch(const UserApplication &app, const DomainClient &client,
+                               const GlobalOptions &global, int &rc) {
+  const auto &sad = *app.profile.sad;
+  const auto before = is_installed(client, sad.name.empty() ? sad.id : sad.name, global);
+  LaunchTarget target;
+  rc = send_install(app, client, global, &target.application, "launch");
+  target.installed_now = rc == kOk && before == false;
+  return target;
+}
+
+// A launch of what it had installed failed and the domain rolled it back: the install goes too,
+// so that a failed launch of a SAD leaves nothing behind.
+void uninstall_again(const DomainClient &client, const std::string &application,
+                     const GlobalOptions &global) {
+  auto removed = client.call<protocol::domain::Uninstall>(
+      {application}, std::chrono::milliseconds(global.timeout_ms) * 2);
+  if (global.json)
+    return;
+  if (removed)
+    fmt::print(stderr, "rsca launch: uninstalled {} again (this launch had installed it)\n",
+               application);
+  else
+    fmt::print(stderr, "rsca launch: {} stays installed ({})\n", application,
+               removed.error().message);
 }
 
 } // namespace
@@ -86,31 +104,17 @@ int install(const std::string &sad, const std::string &name, const GlobalOptions
       fmt::print(stderr, "rsca install: {}\n", named.error().diagnostics().front().message);
       return kUsage;
     }
-  std::vector<Diagnostic> warnings;
-  auto request = install_request(sad, global, name, warnings);
-  if (!request) {
-    fmt::print(stderr, "rsca install: {}\n", request.error().to_string());
+  auto app = read_user_application(sad, global, name);
+  if (!app) {
+    fmt::print(stderr, "rsca install: {}\n", app.error().to_string());
     return kInvalidProfile;
   }
-  if (!global.json)
-    for (const auto &w : warnings)
-      fmt::print(stderr, "rsca install: {}\n", to_string(w));
   auto client = DomainClient::connect(global);
   if (!client) {
     fmt::print(stderr, "rsca install: {}\n", client.error().to_string());
     return kFailed;
   }
-  auto reply = client->call<protocol::domain::Install>(
-      *request, std::chrono::milliseconds(global.timeout_ms) * 2);
-  if (!reply)
-    return report_failure(global, "install", reply.error());
-  if (installed_name != nullptr)
-    *installed_name = reply->name;
-  if (global.json && installed_name == nullptr)
-    print_json(protocol::encode(*reply));
-  else if (!global.json)
-    fmt::print("installed {} ({} files)\n", reply->name, request->files.size());
-  return kOk;
+  return send_install(*app, *client, global, installed_name, "install");
 }
 
 std::optional<std::map<std::string, std::string>>
@@ -125,14 +129,6 @@ assignments_of(const std::vector<std::string> &assignments, const char *command)
     assign[a.substr(0, eq)] = a.substr(eq + 1);
   }
   return assign;
-}
-
-std::string installed_name_of(const std::string &what, const GlobalOptions &global, int &rc) {
-  std::string application = what;
-  rc = kOk;
-  if (fs::is_regular_file(what))
-    rc = install(what, "", global, &application);
-  return application;
 }
 
 namespace {
@@ -235,14 +231,20 @@ int launch(const std::string &what, const std::string &name, bool no_start,
   if (!assign)
     return kUsage;
   int rc = kOk;
-  const std::string application = installed_name_of(what, global, rc);
-  if (rc != kOk)
-    return rc;
+  std::optional<UserApplication> file;
+  if (fs::is_regular_file(what))
+    if (file = launchable_file(what, global, rc); !file)
+      return rc;
   auto client = DomainClient::connect(global);
   if (!client) {
     fmt::print(stderr, "rsca launch: {}\n", client.error().to_string());
     return kFailed;
   }
+  LaunchTarget target{what, false};
+  if (file)
+    if (target = install_to_launch(*file, *client, global, rc); rc != kOk)
+      return rc;
+  const std::string &application = target.application;
   const std::string launch_id =
       fmt::format("{}-{}", getpid(), std::chrono::steady_clock::now().time_since_epoch().count());
   app_ops::CreateRequest request;
@@ -262,10 +264,13 @@ int launch(const std::string &what, const std::string &name, bool no_start,
   InterruptsNoted interrupts;
   auto future = client->call_async<app_ops::Create>(request, launch_timeout);
   auto reply = await_launch(*client, launch_id, future, show_progress, global);
+  const bool timed_out = !reply && reply.error().status == control::Status::Timeout &&
+                         std::chrono::steady_clock::now() - sent >= launch_timeout;
+  if (!reply && !timed_out && !reply.error().maybe_received && target.installed_now)
+    uninstall_again(*client, application, global);
   // The CLI's own deadline, not the domain's reply that a step timed out: the domain took the
   // request (else the call fails as unavailable) but is not done with it.
-  if (!reply && reply.error().status == control::Status::Timeout &&
-      std::chrono::steady_clock::now() - sent >= launch_timeout) {
+  if (timed_out) {
     return report_failure(global, "launch",
                           {control::Status::Timeout,
                            fmt::format("the domain had not finished launching {} after {} ms; {}; "

@@ -35,8 +35,6 @@ void add_completion_command(CLI::App &app, int &exit_code);
 // (and nothing is printed in --json mode) when given. An exit code.
 int install(const std::string &sad, const std::string &name, const GlobalOptions &global,
             std::string *installed_name = nullptr);
-// `what` is a SAD file (installed first) or an installed name; the installed name. rc: exit code.
-std::string installed_name_of(const std::string &what, const GlobalOptions &global, int &rc);
 // --assign COMPONENT=DEVICE arguments; nullopt (after saying why) when malformed.
 std::optional<std::map<std::string, std::string>>
 assignments_of(const std::vector<std::string> &assignments, const char *command);

@@ -2,15 +2,65 @@
 
 #include <algorithm>
 #include <fstream>
+#include <optional>
+#include <sstream>
 #include <string>
 
 #include <fmt/format.h>
 
 #include "content/base64.hpp"
+#include "exit_codes.hpp"
+#include "profile/application_checks.hpp"
 
 namespace rsca::cli {
 
 namespace fs = std::filesystem;
+
+namespace {
+
+std::string read_text(const fs::path &file) {
+  std::ifstream in(file, std::ios::binary);
+  std::ostringstream out;
+  out << in.rdbuf();
+  return out.str();
+}
+
+std::optional<fs::path> sdrroot_of(const fs::path &file, const GlobalOptions &global) {
+  if (!global.sdrroot.empty())
+    return fs::absolute(global.sdrroot);
+  if (auto root = profile::SdrRoot::find_for(file))
+    return root->path();
+  return std::nullopt;
+}
+
+} // namespace
+
+Expected<UserApplication> read_user_application(const fs::path &sad, const GlobalOptions &global,
+                                                const std::string &name) {
+  auto root = sdrroot_of(sad, global);
+  if (!root)
+    return make_error(
+        {sad.string(), 0, 0}, "sdrroot",
+        "no SDR root found: no folder above this file holds dom/ or dev/ (give --sdrroot)");
+  profile::ProfileLoader loader(*root);
+  auto app = loader.load_application(sad);
+  if (!app)
+    return tl::unexpected(app.error());
+  UserApplication user{std::move(*app), {}, {}};
+  user.warnings = user.profile.warnings;
+  user.warnings.insert(user.warnings.end(), user.profile.tolerated.begin(),
+                       user.profile.tolerated.end());
+  auto &request = user.request;
+  request.sad = user.profile.sad_path.lexically_relative(*root).string();
+  for (const auto &f : user.profile.files())
+    request.files.push_back(
+        {fs::path(f).lexically_relative(*root).string(), read_text(f), std::nullopt, std::nullopt});
+  if (auto carried = add_code_files(user.profile, *root, request); !carried)
+    return tl::unexpected(carried.error());
+  if (!name.empty())
+    request.name = name;
+  return user;
+}
 
 Expected<void> add_code_files(const profile::ResolvedApplication &app, const fs::path &root,
                               protocol::domain::InstallRequest &request) {
@@ -43,6 +93,25 @@ Expected<void> add_code_files(const profile::ResolvedApplication &app, const fs:
                              (perms & fs::perms::owner_exec) != fs::perms::none});
   }
   return {};
+}
+
+std::optional<UserApplication> launchable_file(const std::string &sad, const GlobalOptions &global,
+                                               int &rc) {
+  auto app = read_user_application(sad, global, "");
+  if (!app) {
+    fmt::print(stderr, "rsca launch: {}\n", app.error().to_string());
+    rc = kInvalidProfile;
+    return std::nullopt;
+  }
+  if (auto refused = profile::launch_refusals(app->profile); !refused.empty()) {
+    fmt::print(stderr, "rsca launch: {} cannot be launched; nothing was installed:\n", sad);
+    for (const auto &r : refused)
+      fmt::print(stderr, "  {}\n", to_string(r));
+    rc = kInvalidProfile;
+    return std::nullopt;
+  }
+  app->request.for_launch = true; // the domain checks it again before it replaces anything
+  return std::move(*app);
 }
 
 } // namespace rsca::cli

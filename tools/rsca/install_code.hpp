@@ -1,14 +1,39 @@
-// The code an install carries to the domain with the profiles: what lies beside each SPD
-// (profile::ResolvedApplication::code_files()), in base64, within kMaxInstallBytes in all.
+// What an install carries to the domain: the user's application read where its files stand (so
+// that what is wrong in them is named in them, with line and column), made into the request, with
+// the code that lies beside each SPD (profile::ResolvedApplication::code_files()) in base64,
+// within kMaxInstallBytes in all.
 #pragma once
 
 #include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
 
+#include "commands.hpp"
 #include "common/diagnostic.hpp"
 #include "profile/profile_loader.hpp"
 #include "protocol/domain_ops.hpp"
 
 namespace rsca::cli {
+
+struct UserApplication {
+  profile::ResolvedApplication profile; // as read from the user's files
+  protocol::domain::InstallRequest request;
+  std::vector<Diagnostic> warnings; // what reading the files found, located in them
+};
+
+// The application of the SAD `sad` and the install request that carries it, named `name` (empty:
+// the SAD's name); an error located in the user's files. Read here and carried to the domain, so
+// that the CLI may run on another host than the domain daemon.
+Expected<UserApplication> read_user_application(const std::filesystem::path &sad,
+                                                const GlobalOptions &global,
+                                                const std::string &name);
+
+// A SAD file to launch, read and checked where it stands as the launch will check it
+// (profile::launch_refusals): a SAD no launch could run is refused naming the user's file, line
+// and column, before anything is sent. nullopt, and rc an exit code, when it is refused.
+std::optional<UserApplication> launchable_file(const std::string &sad, const GlobalOptions &global,
+                                               int &rc);
 
 // Adds the application's code files to `request`, named relative to the SDR root `root`; an
 // error at the file that cannot be read or does not fit.

@@ -9,6 +9,7 @@
 #include "commands.hpp"
 #include "domain_client.hpp"
 #include "exit_codes.hpp"
+#include "install_code.hpp"
 #include "profile/profile_loader.hpp"
 #include "protocol/application_ops.hpp"
 
@@ -116,24 +117,42 @@ int plan_offline(const PlanArgs &args, const std::map<std::string, std::string> 
   return report(application->sad->name, allocator::plan_reply(plan, options.strategy), global);
 }
 
+// A SAD file is planned from its files, which the domain reads aside and removes: a dry run that
+// installs nothing. An installed name is planned as installed.
 int plan_online(const PlanArgs &args, const std::map<std::string, std::string> &assign,
                 const GlobalOptions &global) {
-  int rc = kOk;
-  const std::string application = installed_name_of(args.what, global, rc);
-  if (rc != kOk)
-    return rc;
+  std::optional<UserApplication> files;
+  if (fs::is_regular_file(args.what)) {
+    auto app = read_user_application(args.what, global, "");
+    if (!app) {
+      fmt::print(stderr, "rsca plan: {}\n", app.error().to_string());
+      return kInvalidProfile;
+    }
+    files = std::move(*app);
+    if (!global.json)
+      for (const auto &w : files->warnings)
+        fmt::print(stderr, "rsca plan: {}\n", to_string(w));
+  }
   auto client = DomainClient::connect(global);
   if (!client) {
     fmt::print(stderr, "rsca plan: {}\n", client.error().to_string());
     return kFailed;
   }
-  app_ops::PlanRequest request{application, assign, std::nullopt};
-  if (!args.strategy.empty())
-    request.strategy = args.strategy;
-  auto reply = client->call<app_ops::Plan>(request, std::chrono::milliseconds(global.timeout_ms));
+  const std::optional<std::string> strategy =
+      args.strategy.empty() ? std::nullopt : std::optional(args.strategy);
+  const auto timeout = std::chrono::milliseconds(global.timeout_ms);
+  if (!files) {
+    auto reply = client->call<app_ops::Plan>({args.what, assign, strategy}, timeout);
+    if (!reply)
+      return report_failure(global, "plan", reply.error());
+    return report(args.what, *reply, global);
+  }
+  // Twice the timeout, as an install: the domain writes and reads the files first.
+  auto reply = client->call<app_ops::PlanFiles>({files->request, assign, strategy}, timeout * 2);
   if (!reply)
     return report_failure(global, "plan", reply.error());
-  return report(application, *reply, global);
+  const auto &sad = *files->profile.sad;
+  return report(sad.name.empty() ? sad.id : sad.name, *reply, global);
 }
 
 } // namespace
