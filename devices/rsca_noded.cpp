@@ -73,6 +73,13 @@ int main(int argc, char **argv) {
                  "A component's log past this many KiB is rotated, one older file kept (LOG.1), "
                  "as is this daemon's own (rsca-noded.NODE.1.log); 0: never")
       ->capture_default_str();
+  auto log_keep_hours = static_cast<std::uint64_t>(options.log_keep.count());
+  app.add_option("--log-keep-hours", log_keep_hours,
+                 "A component's log that no running process writes (a released application's, a "
+                 "failed launch's) is deleted once nothing wrote to it for this many hours "
+                 "(1 to 87600)")
+      ->check(CLI::Range(std::uint64_t{1}, std::uint64_t{87600}))
+      ->capture_default_str();
   std::string control_socket;
   app.add_option("--control-socket", control_socket,
                  "A Unix socket where local clients (the CLI) reach the domain through this node "
@@ -120,6 +127,7 @@ int main(int argc, char **argv) {
     options.exec_path = rsca::layout::component_folders();
   options.log_dir = log_dir;
   options.log_max_bytes = log_max_kib << 10U;
+  options.log_keep = std::chrono::hours(log_keep_hours);
   options.cache.dir = cache_dir;
   options.cache.max_bytes = cache_mib << 20U;
   if (!control_socket.empty())

@@ -32,6 +32,8 @@ struct ComponentInstance {
   std::string via;     // the endpoint that serves its address (its node or host); empty: itself
   std::string spd;     // the SPD it runs from
   long pid = 0;
+  // Where its process began writing its log on its node (ExecuteReply), for app.failed.
+  std::optional<std::uint64_t> log_offset{};
   ComponentState state = ComponentState::Allocated;
   ComponentState state_before_lost = ComponentState::Allocated; // restored when its node is back
   std::uint32_t start_order = 0;

@@ -76,6 +76,9 @@ struct DomainServices {
   // rolled-back launch or a release must not leave it running for nobody. Null (a unit test's):
   // such a process is left to its node.
   std::function<void(const std::string &node, long pid, const std::string &label)> end_when_back;
+  // Told of each launch that failed after starting processes (null: nobody), so that their
+  // logs stay reachable (app.failed).
+  std::function<void(protocol::application::FailedLaunch)> launch_failed;
   std::chrono::milliseconds call_timeout{5000};
   std::chrono::milliseconds registration_timeout{10000};
   allocator::Strategy strategy = allocator::Strategy::Pack;

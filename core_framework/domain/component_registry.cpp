@@ -101,7 +101,8 @@ ComponentRegistry::wait_registered(const std::vector<std::string> &addresses,
     for (const auto &a : addresses) {
       auto it = entries_.find(a);
       if (it != entries_.end() && it->second.exited) {
-        failure = fmt::format("{} exited before registering: {}", a, it->second.why);
+        failure = fmt::format("{} on node {} exited before registering: {}", a, it->second.node,
+                              it->second.why);
         return false;
       }
       registered += it != entries_.end() && it->second.registered ? 1 : 0;

@@ -43,6 +43,22 @@ CallResult<const ComponentInstance *> target_of(const Application &app,
                   component.empty() ? "(assembly controller)" : excerpt(component)));
 }
 
+// `why` a process exited and the last lines of its log, each indented under it.
+std::string with_log_tail(const std::string &why, const std::string &tail) {
+  std::string out = fmt::format("{}; the last lines of its log (`rsca logs --failed` after a "
+                                "failed launch shows it whole):",
+                                why);
+  std::size_t at = 0;
+  while (at < tail.size()) {
+    auto nl = tail.find('\n', at);
+    if (nl == std::string::npos)
+      nl = tail.size();
+    out += fmt::format("\n    {}", std::string_view(tail).substr(at, nl - at));
+    at = nl + 1;
+  }
+  return out;
+}
+
 using TextValues = std::map<std::string, Json>;
 
 // Property values given as text (from the CLI), typed against the component's PRF.
@@ -160,8 +176,10 @@ CallResult<protocol::Empty>
 DomainManager::Impl::component_exited(const protocol::domain::ComponentExitedReport &r) {
   // Every component the process served: one, or those of a component host.
   const std::string why = r.status.empty() ? std::string("exited") : r.status;
+  // A launch waiting for it fails with its last words: mostly why it exited.
+  const std::string told = r.log_tail.empty() ? why : with_log_tail(why, r.log_tail);
   for (const auto &address : r.addresses) {
-    components.exited(address, why); // a launch waiting for it fails at once
+    components.exited(address, told); // a launch waiting for it fails at once
     endpoint->abandon(address, why);
   }
   mark_exited(

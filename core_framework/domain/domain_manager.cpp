@@ -103,6 +103,7 @@ ApplicationFactory DomainManager::Impl::factory() {
   s.end_when_back = [this](const std::string &node, long pid, const std::string &label) {
     end_when_back(node, pid, label);
   };
+  s.launch_failed = [this](app_ops::FailedLaunch failed) { launches.failed(std::move(failed)); };
   s.call_timeout = options.call_timeout;
   s.registration_timeout = options.registration_timeout;
   s.strategy = options.strategy;
@@ -438,6 +439,10 @@ void DomainManager::Impl::serve() {
   serve_op<app_ops::PlanFiles>(&Impl::plan_files);
   serve_op<app_ops::Progress>(&Impl::progress);
   serve_op<app_ops::Cancel>(&Impl::cancel_launch);
+  serve_op<app_ops::Failed>([](Impl *impl, const app_ops::FailedRequest &r) {
+    return CallResult<app_ops::FailedReply>(
+        app_ops::FailedReply{impl->launches.failures(r.application)});
+  });
   serve_op<app_ops::Release>(&Impl::release);
   serve_op<app_ops::Start>(
       [](Impl *impl, const app_ops::AppRequest &r) { return impl->start_or_stop(r, true); });

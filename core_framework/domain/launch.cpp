@@ -209,6 +209,7 @@ CallResult<void> ApplicationFactory::Launch::execute() {
       continue;
     for (auto i : started_by[k]) {
       app_->components[i].pid = started.back()->pid;
+      app_->components[i].log_offset = started.back()->log_offset;
       app_->components[i].state = ComponentState::Executed;
     }
   }
@@ -370,6 +371,10 @@ ApplicationFactory::Launch::host_request(const ComponentInstance &first) const {
           std::nullopt}; // budget_ms: set when the calls are made
 }
 
+std::string ApplicationFactory::Launch::process_name(const ComponentInstance &c) const {
+  return is_hosted(c) ? host_request(c).component : c.id;
+}
+
 std::optional<protocol::node::AffinityDirective>
 ApplicationFactory::Launch::affinity_of(const ComponentInstance &c) const {
   const auto *ci = instantiation_of(c.id);
@@ -473,13 +478,36 @@ std::vector<std::string> ApplicationFactory::Launch::nodes_used() const {
 
 CallResult<std::shared_ptr<Application>>
 ApplicationFactory::Launch::fail(const char *step, const control::CallError &error) {
+  auto failed = failed_launch(step); // before the rollback forgets the processes
   const auto undone = saga_.roll_back();
   const std::string message =
       fmt::format("launch of {} failed at step '{}': {}{}", app_->name, step, error.message,
                   undone.empty() ? "" : fmt::format("\nrolled back: {}", fmt::join(undone, "; ")));
   spdlog::warn("{}", message);
   progress_({step, "failed", 0});
+  if (failed && s_.launch_failed) {
+    failed->error = message.substr(0, protocol::application::FailedLaunch::kMaxError);
+    s_.launch_failed(std::move(*failed));
+  }
   return control::call_error(error.status, message);
+}
+
+std::optional<protocol::application::FailedLaunch>
+ApplicationFactory::Launch::failed_launch(const char *step) const {
+  protocol::application::FailedLaunch failed;
+  for (const auto &c : app_->components)
+    if (c.pid != 0)
+      failed.components.push_back({c.id, c.node, c.pid, process_name(c), c.log_offset});
+  if (failed.components.empty())
+    return std::nullopt;
+  failed.application = app_->name;
+  failed.installed = request_.installed;
+  failed.launch_id = request_.id;
+  failed.step = step;
+  failed.failed_at_ms = std::chrono::duration_cast<std::chrono::milliseconds>(
+                            std::chrono::system_clock::now().time_since_epoch())
+                            .count();
+  return failed;
 }
 
 } // namespace rsca::domain

@@ -118,6 +118,9 @@ private:
 
   // A component host's process at its own address; its components' exec parameters follow.
   protocol::node::ExecuteRequest host_request(const ComponentInstance &first) const;
+  // The name of the process a component runs in, and of its log on its node: its own id, or its
+  // component host's.
+  std::string process_name(const ComponentInstance &c) const;
 
   // The component's execparam-only properties, as its SAD instantiation sets them.
   std::vector<std::pair<std::string, std::string>> execparams(const ComponentInstance &c) const;
@@ -138,6 +141,8 @@ private:
   std::vector<std::string> nodes_used() const;
 
   CallResult<std::shared_ptr<Application>> fail(const char *step, const control::CallError &error);
+  // The failed launch as app.failed tells it; nullopt when it had started no process.
+  std::optional<protocol::application::FailedLaunch> failed_launch(const char *step) const;
 
   // Per instance id: the SAD's instantiation and placement, the allocator's placement and the
   // component (an index into app_->components), so that per-component and per-connection

@@ -51,6 +51,23 @@ LaunchTracker::Cancelled LaunchTracker::cancel(const std::string &id) {
   return {true, false, !first};
 }
 
+void LaunchTracker::failed(protocol::application::FailedLaunch launch) {
+  std::lock_guard lock(mutex_);
+  failed_.push_back(std::move(launch));
+  while (failed_.size() > protocol::application::FailedLaunch::kKept)
+    failed_.pop_front();
+}
+
+std::vector<protocol::application::FailedLaunch>
+LaunchTracker::failures(const std::optional<std::string> &application) const {
+  std::lock_guard lock(mutex_);
+  std::vector<protocol::application::FailedLaunch> out;
+  for (const auto &f : failed_)
+    if (!application || f.application == *application)
+      out.push_back(f);
+  return out;
+}
+
 void LaunchTracker::retire(const std::string &id) {
   finished_.push_back(id);
   while (finished_.size() > kKeptFinished) {

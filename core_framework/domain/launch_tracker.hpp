@@ -44,6 +44,13 @@ public:
   };
   Cancelled cancel(const std::string &id);
 
+  // Remembers a launch that failed after starting processes: the last FailedLaunch::kKept, so
+  // that the logs of their rolled-back components stay reachable (app.failed).
+  void failed(protocol::application::FailedLaunch launch);
+  // Those of `application` (all when absent), oldest first.
+  std::vector<protocol::application::FailedLaunch>
+  failures(const std::optional<std::string> &application) const;
+
 private:
   struct Launch {
     Progress progress;
@@ -53,7 +60,8 @@ private:
 
   mutable std::mutex mutex_;
   std::map<std::string, Launch> launches_;
-  std::deque<std::string> finished_; // oldest first
+  std::deque<std::string> finished_;                       // oldest first
+  std::deque<protocol::application::FailedLaunch> failed_; // oldest first
 };
 
 } // namespace rsca::domain

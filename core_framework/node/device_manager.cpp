@@ -91,6 +91,8 @@ Json overrides_of(const profile::ComponentInstantiation &ci, const profile::Reso
 // How often the logs' sizes are looked at: a process logging fast overshoots its bound by at most
 // what it logs in this time.
 constexpr std::chrono::seconds kLogRotationPeriod{1};
+// Old logs are looked for once a minute: they are kept for hours at least.
+constexpr std::chrono::seconds kLogSweepPeriod{60};
 
 op::ProcessFigures figures_of(pid_t pid, const process::Figures &f) {
   return {pid, f.cpu_percent, f.rss_bytes, f.threads};
@@ -137,6 +139,7 @@ struct DeviceManager::Impl {
   std::mutex endpoint_mutex;        // the endpoint's end against a process exit reported meanwhile
   process::CpuSampler sampler;      // node.top's: its last reading of each process
   std::optional<Periodic> rotation; // of its processes' logs, by size
+  std::optional<Periodic> sweep;    // of the logs no process writes, by age
 
   Expected<void> start_devices();
   void not_started(op::FailedDevice failure);
@@ -152,6 +155,7 @@ struct DeviceManager::Impl {
   std::vector<op::ProcessRecord> running() const;
   CallResult<op::TopReply> top();
   void rotate_logs() const;
+  void sweep_logs() const;
 };
 
 namespace {
@@ -303,11 +307,18 @@ ExecutableDevice *DeviceManager::Impl::executable_device(const std::string &id) 
   return nullptr;
 }
 
-void DeviceManager::Impl::report_exit(const protocol::domain::ComponentExitedReport &report) {
+void DeviceManager::Impl::report_exit(const protocol::domain::ComponentExitedReport &exited) {
+  // Why a process exited is mostly in its last words: a launch that fails on it shows them
+  // (a few KiB of a local file: the reaper's thread reads them at once).
+  using Report = protocol::domain::ComponentExitedReport;
+  auto report = exited;
+  report.log_tail = log_tail(options.log_dir / report.application / (report.component + ".log"),
+                             Report::kMaxLogTailLines, Report::kMaxLogTailBytes);
   std::lock_guard lock(endpoint_mutex); // the reaper's thread: the endpoint may be going
   if (stopping.load() || !endpoint)
     return;
-  spdlog::warn("process {} exited on its own: {}", report.pid, report.status);
+  spdlog::warn("process {} ({}/{}) exited on its own: {}", report.pid, report.application,
+               report.component, report.status);
   // Fire and forget: the reply is not needed, and the reaper that calls this must not block.
   control::send<protocol::domain::ComponentExited>(
       *endpoint, protocol::domain_address(options.domain_name), report, std::chrono::seconds(2));
@@ -426,6 +437,12 @@ void DeviceManager::Impl::rotate_logs() const {
       spdlog::debug("{}: log rotated", p.label);
 }
 
+void DeviceManager::Impl::sweep_logs() const {
+  const auto keep = std::chrono::duration_cast<std::chrono::seconds>(options.log_keep);
+  if (const auto deleted = node::sweep_logs(options.log_dir, running(), keep); deleted > 0)
+    spdlog::info("{} logs no process wrote for {} h deleted", deleted, options.log_keep.count());
+}
+
 void DeviceManager::Impl::serve() {
   control::serve<op::Execute>(*endpoint, [this](const auto &request, const auto &context) {
     return execute(request, context);
@@ -448,6 +465,7 @@ DeviceManager::DeviceManager(std::unique_ptr<Impl> impl) : impl_(std::move(impl)
 
 DeviceManager::~DeviceManager() {
   impl_->rotation.reset(); // it reads the devices' processes
+  impl_->sweep.reset();
   impl_->stopping = true;
   impl_->endpoint->withdraw();
   impl_->links->close(); // relays under way fail: the endpoint's handlers return
@@ -533,6 +551,7 @@ DeviceManager::create(std::shared_ptr<dds::Participant> participant, NodeOptions
     return tl::unexpected(ok.error());
   if (impl->options.log_max_bytes > 0)
     impl->rotation.emplace(kLogRotationPeriod, [raw = impl.get()] { raw->rotate_logs(); });
+  impl->sweep.emplace(kLogSweepPeriod, [raw = impl.get()] { raw->sweep_logs(); });
   impl->serve();
   impl->endpoint->start_serving();
   // The domain is the node's caller, and the node calls it: both ways are made now, so the

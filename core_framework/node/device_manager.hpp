@@ -5,6 +5,7 @@
 // domain daemon that (re)starts sees it at once.
 #pragma once
 
+#include <chrono>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -27,6 +28,9 @@ struct NodeOptions {
   std::filesystem::path log_dir = "/tmp/rsca/logs";
   // A process's log past this is rotated, one older file kept (node/process_logs.hpp); 0: never.
   std::uint64_t log_max_bytes = 10ULL << 20U;
+  // The logs no running process writes (released applications', rolled-back launches') are
+  // deleted once unwritten for this long (node/process_logs.hpp, sweep_logs).
+  std::chrono::hours log_keep{24 * 7};
   // Where local clients (the CLI) connect for a link to the node (ProcessLinks::listen); none:
   // they use DDS.
   std::optional<std::filesystem::path> control_socket;

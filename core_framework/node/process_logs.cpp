@@ -130,6 +130,38 @@ Expected<bool> rotate_if_over(const fs::path &log, std::uint64_t max_bytes) {
   return true;
 }
 
+std::size_t sweep_logs(const fs::path &log_dir, const std::vector<op::ProcessRecord> &running,
+                       std::chrono::seconds keep) {
+  std::vector<fs::path> written;
+  for (const auto &p : running) {
+    written.push_back(fs::path(p.log).lexically_normal());
+    written.push_back(previous_of(written.back()));
+  }
+  const auto before = fs::file_time_type::clock::now() - keep;
+  std::size_t deleted = 0;
+  std::error_code ec;
+  for (const auto &folder : fs::directory_iterator(log_dir, ec)) {
+    std::error_code fec;
+    if (!folder.is_directory(fec) || folder.is_symlink(fec))
+      continue;
+    bool empty = true;
+    for (const auto &file : fs::directory_iterator(folder.path(), fec)) {
+      std::error_code e;
+      const bool old = file.is_regular_file(e) && file.last_write_time(e) < before && !e;
+      const auto path = file.path().lexically_normal();
+      if (!old || std::find(written.begin(), written.end(), path) != written.end() ||
+          !fs::remove(file.path(), e)) {
+        empty = false;
+        continue;
+      }
+      ++deleted;
+    }
+    if (empty && !fec)
+      fs::remove(folder.path(), fec); // only an empty folder goes
+  }
+  return deleted;
+}
+
 std::string utf8_or_replaced(std::string_view bytes) {
   std::string out;
   out.reserve(bytes.size());
@@ -161,6 +193,35 @@ std::string utf8_or_replaced(std::string_view bytes) {
     i += length;
   }
   return out;
+}
+
+std::string log_tail(const fs::path &log, std::size_t max_lines, std::size_t max_bytes) {
+  const auto size = size_of(log);
+  const auto from = size > max_bytes ? size - max_bytes : 0;
+  std::string bytes = bytes_of(log, {from, size});
+  // Begun inside a line: from the next one, unless that line is the last (cut below).
+  if (const auto nl = bytes.find('\n');
+      from > 0 && nl != std::string::npos && nl + 1 < bytes.size())
+    bytes.erase(0, nl + 1);
+  std::string text = utf8_or_replaced(bytes);
+  if (!text.empty() && text.back() != '\n')
+    text += '\n';
+  // Replaced bytes grow by up to three times: lines are dropped from the front until both
+  // bounds hold (a single line longer than max_bytes is cut from its start, whole characters).
+  std::size_t start = text.size();
+  for (std::size_t lines = 0; start > 0 && lines < max_lines; ++lines) {
+    const auto nl = start >= 2 ? text.rfind('\n', start - 2) : std::string::npos;
+    const std::size_t begin = nl == std::string::npos ? 0 : nl + 1;
+    if (text.size() - begin > max_bytes)
+      break;
+    start = begin;
+  }
+  if (start == text.size() && !text.empty()) { // the last line alone is too long
+    start = text.size() - std::min(text.size(), max_bytes);
+    while (start < text.size() && (static_cast<unsigned char>(text[start]) & 0xC0U) == 0x80U)
+      ++start;
+  }
+  return text.substr(start);
 }
 
 CallResult<op::LogsReply> read_log(const fs::path &log_dir, const op::LogsRequest &request,

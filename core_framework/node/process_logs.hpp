@@ -10,6 +10,7 @@
 // truncation is lost; a rotation takes a few milliseconds, once per --log-max-kib logged.
 #pragma once
 
+#include <chrono>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -48,8 +49,23 @@ control::CallResult<protocol::node::LogsReply> read_piece(const LogFiles &files,
                                                           std::optional<std::uint64_t> max_bytes,
                                                           const std::string &what);
 
+// Deletes the logs (LOG and LOG.1) in the application folders of `log_dir` that no process of
+// `running` writes and that nothing wrote to for `keep`, then the application folders left
+// empty: the logs of released applications and of rolled-back launches (rsca logs --failed)
+// are kept that long, not for ever. The node daemon's own log, a file of `log_dir` itself, is
+// not touched. How many files it deleted.
+std::size_t sweep_logs(const std::filesystem::path &log_dir,
+                       const std::vector<protocol::node::ProcessRecord> &running,
+                       std::chrono::seconds keep);
+
 // Copies `log` to `log`.1 and empties it when it holds more than `max_bytes`; whether it did.
 Expected<bool> rotate_if_over(const std::filesystem::path &log, std::uint64_t max_bytes);
+
+// The end of `log` for a report of its process's exit: its last whole lines (and a last one
+// unended: a dying process may not end it), at most `max_lines` of them and `max_bytes` bytes of
+// valid UTF-8; empty when there is no log.
+std::string log_tail(const std::filesystem::path &log, std::size_t max_lines,
+                     std::size_t max_bytes);
 
 // `bytes` as valid UTF-8 (JSON text must be): each byte that is not part of a valid sequence
 // becomes U+FFFD.

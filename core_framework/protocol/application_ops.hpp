@@ -352,6 +352,61 @@ struct ListReply {
   }
 };
 
+// A launch that failed, as the domain remembers it (the last kKept): which process each of its
+// components had on which node, so that their logs stay reachable after the rollback
+// (`rsca logs --failed`, which asks each node for them as for a running component's).
+struct FailedProcess {
+  std::string component; // its instance id
+  std::string node;
+  std::int64_t pid = 0;
+  std::string log; // the name its log has on its node: its own id, or its component host's
+  // Where this process began writing its log (the file holds earlier launches' lines before).
+  std::optional<std::uint64_t> log_offset{};
+  static constexpr auto fields() {
+    using R = FailedProcess;
+    return std::tuple{required("component", &R::component), required("node", &R::node),
+                      required("pid", &R::pid), required("log", &R::log),
+                      optional("log_offset", &R::log_offset)};
+  }
+};
+
+struct FailedLaunch {
+  static constexpr std::size_t kKept = 16;
+  static constexpr std::size_t kMaxError = 64U << 10U;
+  std::string application; // the running application's name
+  std::string installed;
+  std::string launch_id;
+  std::string step;
+  std::string error;
+  std::int64_t failed_at_ms = 0;         // since the Unix epoch
+  std::vector<FailedProcess> components; // those that had a process
+  static constexpr auto fields() {
+    using R = FailedLaunch;
+    return std::tuple{required("application", &R::application),
+                      required("installed", &R::installed),
+                      required("launch_id", &R::launch_id),
+                      required("step", &R::step),
+                      required("error", &R::error).at_most(kMaxError),
+                      required("failed_at_ms", &R::failed_at_ms),
+                      required("components", &R::components)};
+  }
+};
+
+// The failed launches of one application (absent: of all), oldest first.
+struct FailedRequest {
+  std::optional<std::string> application;
+  static constexpr auto fields() {
+    return std::tuple{optional("application", &FailedRequest::application)};
+  }
+};
+
+struct FailedReply {
+  std::vector<FailedLaunch> launches;
+  static constexpr auto fields() {
+    return std::tuple{required("launches", &FailedReply::launches).at_most(FailedLaunch::kKept)};
+  }
+};
+
 struct Plan {
   static constexpr std::string_view name = "app.plan";
   using Request = PlanRequest;
@@ -412,6 +467,11 @@ struct Show {
   static constexpr std::string_view name = "app.show";
   using Request = AppRequest;
   using Reply = ApplicationView;
+};
+struct Failed {
+  static constexpr std::string_view name = "app.failed";
+  using Request = FailedRequest;
+  using Reply = FailedReply;
 };
 
 } // namespace rsca::protocol::application

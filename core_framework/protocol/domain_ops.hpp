@@ -4,6 +4,7 @@
 // connection_ops.hpp.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -17,6 +18,10 @@ namespace rsca::protocol::domain {
 
 // A process a node started exited without being asked to.
 struct ComponentExitedReport {
+  // The end of its log the node sends with it (why a process exits is mostly its last words):
+  // whole lines, at most these many and bytes.
+  static constexpr std::size_t kMaxLogTailLines = 20;
+  static constexpr std::size_t kMaxLogTailBytes = 4096;
   std::string application;
   std::string component;
   std::vector<std::string> addresses; // every component it served: one, or a host's
@@ -25,13 +30,24 @@ struct ComponentExitedReport {
   std::string status; // "exited with 3", "killed by SIGSEGV"
   std::int32_t exit_code = 0;
   std::int32_t signal = 0;
+  std::string log_tail; // the last lines of its log (valid UTF-8); empty: none
   static constexpr auto fields() {
     using R = ComponentExitedReport;
-    return std::tuple{
-        required("application", &R::application), required("component", &R::component),
-        required("addresses", &R::addresses),     required("pid", &R::pid),
-        required("device", &R::device),           required("status", &R::status),
-        optional("exit_code", &R::exit_code),     optional("signal", &R::signal)};
+    return std::tuple{required("application", &R::application),
+                      required("component", &R::component),
+                      required("addresses", &R::addresses),
+                      required("pid", &R::pid),
+                      required("device", &R::device),
+                      required("status", &R::status),
+                      optional("exit_code", &R::exit_code),
+                      optional("signal", &R::signal),
+                      optional("log_tail", &R::log_tail).at_most(kMaxLogTailBytes)};
+  }
+  std::optional<DecodeError> check() const {
+    if (static_cast<std::size_t>(std::count(log_tail.begin(), log_tail.end(), '\n')) >
+        kMaxLogTailLines)
+      return DecodeError{"log_tail", fmt::format("more than {} lines", kMaxLogTailLines)};
+    return std::nullopt;
   }
 };
 

@@ -71,8 +71,12 @@ struct ExecuteRequest {
 struct ExecuteReply {
   std::int64_t pid = 0;
   std::string log; // the process's log file
+  // Its size when the process started: where this process's lines begin (a log of the same
+  // application and component is appended to by each launch).
+  std::optional<std::uint64_t> log_offset{};
   static constexpr auto fields() {
-    return std::tuple{required("pid", &ExecuteReply::pid), required("log", &ExecuteReply::log)};
+    return std::tuple{required("pid", &ExecuteReply::pid), required("log", &ExecuteReply::log),
+                      optional("log_offset", &ExecuteReply::log_offset)};
   }
 };
 

@@ -8,6 +8,7 @@
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <spdlog/spdlog.h>
 
 #include "affinity.hpp"
@@ -186,6 +187,13 @@ GppDevice::execute(const protocol::node::ExecuteRequest &r,
     request.env.emplace_back("LD_LIBRARY_PATH",
                              library_path(package->root(), r.package->library_dirs));
   request.log_file = context_.log_dir / application / (component + ".log");
+  std::error_code no_log; // none yet: this process's lines begin at 0
+  const std::uint64_t log_offset = std::filesystem::file_size(request.log_file, no_log);
+  if (!no_log) { // written now: the node's sweep of old logs leaves it (node/process_logs.hpp)
+    std::error_code untouched;
+    std::filesystem::last_write_time(request.log_file,
+                                     std::filesystem::file_time_type::clock::now(), untouched);
+  }
   request.label = protocol::node::process_label(application, component);
   // The process's control goes through this node (node/process_links.hpp): it gets its end of
   // the link as a known descriptor.
@@ -263,7 +271,7 @@ GppDevice::execute(const protocol::node::ExecuteRequest &r,
     on_exit(*pid, *status);
   spdlog::info("{}: executed {} as pid {} (log {})", context_.id, request.program.string(), *pid,
                request.log_file.string());
-  return protocol::node::ExecuteReply{*pid, request.log_file.string()};
+  return protocol::node::ExecuteReply{*pid, request.log_file.string(), no_log ? 0 : log_offset};
 }
 
 CallResult<protocol::node::TerminateReply>

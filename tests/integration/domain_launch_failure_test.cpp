@@ -164,3 +164,70 @@ TEST_CASE("no device that matches: the launch is rejected with the reason per de
   CHECK_THAT(out, Catch::Contains("node2:GPP_1"));
   domain.require_clean({});
 }
+
+// The SDK mistake a build does not catch: a component whose code binds a property its PRF lacks
+// exits (3) before registering, its runtime saying why in its log. The launch's error carries
+// that, and the log stays reachable after the rollback through `rsca logs --failed`.
+TEST_CASE("a component that exits before registering: the launch error names its node, exit code "
+          "and last log lines, and rsca logs --failed shows its log",
+          "[integration][domain][failure][logs]") {
+  TestDomain domain(1);
+  domain.install("Misbound");
+  const std::string why = "property \"chatter\" is bound, but the PRF does not define it";
+  auto [rc, out] = domain.cli({"launch", "Misbound"});
+  INFO(out);
+  CHECK(rc == 6);
+  CHECK_THAT(out, Catch::Contains("failed at step 'register'"));
+  CHECK_THAT(out, Catch::Contains("Misbound_1 on node node1 exited before registering"));
+  CHECK_THAT(out, Catch::Contains("exited with code 3"));
+  CHECK_THAT(out, Catch::Contains(why));
+  CHECK_THAT(out, Catch::Contains("rolled back"));
+  domain.require_clean({});
+  CHECK(domain.running_pids().empty());
+
+  // --json carries the same message.
+  auto [jrc, jout] = domain.cli({"launch", "Misbound", "--json"});
+  INFO(jout);
+  CHECK(jrc == 6);
+  const auto open = jout.find('{');
+  const auto close = jout.rfind('}');
+  REQUIRE(open != std::string::npos);
+  REQUIRE(close != std::string::npos);
+  const Json failed = Json::parse(jout.substr(open, close - open + 1));
+  const std::string message = failed.at("error").at("message");
+  CHECK_THAT(message, Catch::Contains("Misbound_1 on node node1"));
+  CHECK_THAT(message, Catch::Contains(why));
+  domain.require_clean({});
+
+  // The domain remembers the failed launches: which process each component had, on which node.
+  auto remembered = domain.call("app.failed", Json{{"application", "Misbound"}});
+  REQUIRE(remembered.has_value());
+  INFO(remembered->dump());
+  REQUIRE(remembered->at("launches").size() == 2);
+  const Json &last = remembered->at("launches").back();
+  CHECK(last.at("application") == "Misbound");
+  CHECK(last.at("step") == "register");
+  CHECK_THAT(last.at("error").get<std::string>(), Catch::Contains(why));
+  REQUIRE(last.at("components").size() == 2);
+  for (const auto &c : last.at("components")) {
+    CHECK(c.at("node") == "node1");
+    CHECK(c.at("pid").get<long>() > 0);
+  }
+
+  // The CLI reads the logs of the last failed launch from the node, through node.logs: the
+  // component's whole log from this launch, its reason with it.
+  auto [lrc, lout] = domain.cli({"logs", "--failed"});
+  INFO(lout);
+  CHECK(lrc == 0);
+  CHECK_THAT(lout, Catch::Contains("Misbound_1 | "));
+  CHECK_THAT(lout, Catch::Contains(why));
+  auto [nrc, nout] = domain.cli({"logs", "--failed", "Misbound", "--json"});
+  INFO(nout);
+  CHECK(nrc == 0);
+  CHECK_THAT(nout, Catch::Contains("\"component\":\"Misbound_1\""));
+  auto [urc, uout] = domain.cli({"logs", "--failed", "Healthy"});
+  INFO(uout);
+  CHECK(urc == 3);
+  CHECK_THAT(uout, Catch::Contains("no failed launch of Healthy"));
+  domain.require_clean({});
+}

@@ -149,3 +149,59 @@ TEST_CASE("reading a log goes across its rotation", "[logs]") {
   CHECK(tail->text == "first\nsecond\nthird\nfourth\n");
   CHECK(tail->next == 7);
 }
+
+TEST_CASE("an exit report's log tail: the last lines, bounded in lines and bytes, an unended last "
+          "line kept",
+          "[logs]") {
+  using rsca::node::log_tail;
+  LogFolder logs;
+  const auto log = logs.dir / "App" / "Comp_1.log";
+  CHECK(log_tail(log, 20, 4096).empty()); // no log
+  std::string text;
+  for (int i = 1; i <= 30; ++i)
+    text += fmt::format("line {}\n", i);
+  logs.write("Comp_1.log", text + "dying words");
+  const auto tail = log_tail(log, 5, 4096);
+  CHECK(tail == "line 27\nline 28\nline 29\nline 30\ndying words\n");
+  // Bytes bound it before lines do: whole lines only, the last ones.
+  CHECK(log_tail(log, 20, 20) == "line 30\ndying words\n");
+  // A last line longer than the bound is cut from its start, on a character's boundary.
+  logs.write("Comp_1.log", "short\n" + std::string(10, 'x') + "\xC3\xA9" + "end\n");
+  CHECK(log_tail(log, 20, 6) == "\xC3\xA9"
+                                "end\n");
+  CHECK(log_tail(log, 20, 5) == "end\n");
+  // Bytes that are no UTF-8 are replaced: the tail travels as JSON text.
+  logs.write("Comp_1.log", "bad \xFF byte\n");
+  CHECK(log_tail(log, 20, 4096) == "bad \xEF\xBF\xBD byte\n");
+}
+
+TEST_CASE("logs no running process writes are deleted once old, with the folders they leave "
+          "empty; a running process's, a fresh one and the daemon's own stay",
+          "[logs]") {
+  using rsca::node::sweep_logs;
+  LogFolder logs;
+  fs::create_directories(logs.dir / "Gone");
+  const auto old = fs::file_time_type::clock::now() - std::chrono::hours(25);
+  const auto write_old = [&](const fs::path &file) {
+    std::ofstream(file) << "x\n";
+    fs::last_write_time(file, old);
+  };
+  write_old(logs.dir / "Gone" / "Comp_1.log");
+  write_old(logs.dir / "Gone" / "Comp_1.log.1");
+  write_old(logs.dir / "App" / "Running_1.log"); // a quiet running process's
+  write_old(logs.dir / "App" / "Old_1.log");
+  logs.write("Fresh_1.log", "y\n");
+  write_old(logs.dir / "rsca-noded.node1.log");
+  const std::vector<op::ProcessRecord> running{
+      {42, "App/Running_1", (logs.dir / "App" / "Running_1.log").string()}};
+  CHECK(sweep_logs(logs.dir, running, std::chrono::hours(24)) == 3);
+  CHECK_FALSE(fs::exists(logs.dir / "Gone"));
+  CHECK_FALSE(fs::exists(logs.dir / "App" / "Old_1.log"));
+  CHECK(fs::exists(logs.dir / "App" / "Running_1.log"));
+  CHECK(fs::exists(logs.dir / "App" / "Fresh_1.log"));
+  CHECK(fs::exists(logs.dir / "rsca-noded.node1.log"));
+  // Kept longer than they are old: nothing goes.
+  write_old(logs.dir / "App" / "Old_1.log");
+  CHECK(sweep_logs(logs.dir, {}, std::chrono::hours(48)) == 0);
+  CHECK(fs::exists(logs.dir / "App" / "Old_1.log"));
+}

@@ -3,8 +3,11 @@
 // daemon's own log, read by that node (node.daemon_logs). The domain says where each component
 // runs (app.show) and where each node is (domain.nodes); each node is asked for the components it
 // runs. -f follows: the nodes are asked again every half second from where their last reply
-// ended. A name that is both an application's and a node's is the application's (the one a
-// user launched and is more likely to mean); `node:NAME` names the node.
+// ended. --failed reads the logs of the processes of a failed launch the domain remembers
+// (app.failed) the same way, from the files their rollback left on the nodes, each from where
+// that launch's process began writing it. A name that is both an application's and a node's is
+// the application's (the one a user launched and is more likely to mean); `node:NAME` names the
+// node.
 #include <algorithm>
 #include <chrono>
 #include <ctime>
@@ -35,6 +38,7 @@ struct LogsOptions {
   std::size_t lines = 100;
   std::string since; // a duration ("300s"): only the lines logged since then
   bool follow = false;
+  bool failed = false; // the logs of the last failed launch (of APP when given)
 };
 
 constexpr std::chrono::milliseconds kFollowPace{500};
@@ -128,6 +132,59 @@ std::vector<Source> component_sources(const app_ops::Show::Reply &shown,
   return sources;
 }
 
+// The logs of the processes of the last launch that failed (of the application the target names,
+// and only its component COMP when APP/COMP), which the domain remembers (app.failed): their
+// files stay on their nodes after the rollback. Printed first: which launch it was.
+std::vector<Source> failed_sources(const DomainClient &client, const LogsOptions &options,
+                                   const domain_ops::NodesReply &nodes, const GlobalOptions &global,
+                                   int &rc) {
+  const auto slash = options.target.find('/');
+  const std::string app = options.target.substr(0, slash);
+  const std::string component =
+      slash == std::string::npos ? std::string() : options.target.substr(slash + 1);
+  auto failed =
+      client.call<app_ops::Failed>({app.empty() ? std::nullopt : std::optional<std::string>(app)},
+                                   std::chrono::milliseconds(global.timeout_ms));
+  if (!failed) {
+    rc = report_failure(global, "logs", failed.error());
+    return {};
+  }
+  if (failed->launches.empty()) {
+    rc = report_failure(
+        global, "logs",
+        {control::Status::NotFound,
+         fmt::format("no failed launch{} is remembered (the domain keeps the last {})",
+                     app.empty() ? "" : " of " + app, app_ops::FailedLaunch::kKept)});
+    return {};
+  }
+  const auto &last = failed->launches.back();
+  std::vector<Source> sources;
+  for (const auto &p : last.components) {
+    const bool shared = std::any_of(sources.begin(), sources.end(),
+                                    [&](const Source &s) { return s.request.component == p.log; });
+    if (shared || (!component.empty() && p.component != component))
+      continue; // a component host's log once; only COMP's
+    for (const auto &n : nodes.nodes)
+      if (n.name == p.node)
+        sources.push_back({n.address,
+                           {},
+                           {last.application, p.log, std::nullopt, p.log_offset,
+                            node_ops::LogsRequest::kMaxBytes}});
+  }
+  if (sources.empty())
+    rc = report_failure(
+        global, "logs",
+        {control::Status::NotFound,
+         fmt::format("the last failed launch of {} has no {} on a node", last.application,
+                     component.empty() ? "process" : "component " + component)});
+  else if (!global.json)
+    fmt::print("launch {} of {} failed at step '{}' at {}; the logs of its processes:\n",
+               last.launch_id, last.application, last.step,
+               local_stamp(std::chrono::system_clock::time_point(
+                   std::chrono::milliseconds(last.failed_at_ms))));
+  return sources;
+}
+
 // The logs the target names, each with its node's address. rc: the exit code when it fails.
 std::vector<Source> sources_of(const DomainClient &client, const LogsOptions &options,
                                const GlobalOptions &global, int &rc) {
@@ -137,6 +194,8 @@ std::vector<Source> sources_of(const DomainClient &client, const LogsOptions &op
     rc = report_failure(global, "logs", nodes.error());
     return {};
   }
+  if (options.failed)
+    return failed_sources(client, options, *nodes, global, rc);
   if (options.target.rfind(kNodePrefix, 0) == 0)
     return node_source(*nodes, options.target.substr(kNodePrefix.size()), true, global, rc);
   const auto slash = options.target.find('/');
@@ -235,7 +294,7 @@ int logs(const LogsOptions &options, const GlobalOptions &global) {
   if (sources.empty())
     return rc;
   rc = read_once(*client, sources, options.lines, stamp, global);
-  if (!options.follow)
+  if (!options.follow || options.failed) // a failed launch's processes log no more
     return rc;
   for (;;) { // until interrupted
     std::this_thread::sleep_for(kFollowPace);
@@ -248,18 +307,34 @@ int logs(const LogsOptions &options, const GlobalOptions &global) {
 void add_logs_command(CLI::App &app, const GlobalOptions &global, int &exit_code) {
   auto *cmd = app.add_subcommand(
       "logs", "The logs of a running application's components (APP) or of one (APP/COMP), read "
-              "by the nodes that run them, or a node daemon's own log (NODE)");
+              "by the nodes that run them, or a node daemon's own log (NODE); with --failed, "
+              "those of the last failed launch's processes, kept after its rollback");
   auto options = std::make_shared<LogsOptions>();
   cmd->add_option("target", options->target,
                   "APP, APP/COMPONENT or NODE; a name that is both an application's and a "
-                  "node's is the application's: node:NODE names the node")
-      ->required();
-  cmd->add_option("-n,--lines", options->lines, "the last LINES lines of each log")
-      ->capture_default_str();
+                  "node's is the application's: node:NODE names the node. With --failed: "
+                  "APP or APP/COMPONENT, or nothing (the last failed launch of any)");
+  auto *lines = cmd->add_option("-n,--lines", options->lines,
+                                "the last LINES lines of each log (with --failed: all it holds "
+                                "of that launch, up to 1 MiB each, unless given)")
+                    ->capture_default_str();
+  cmd->add_flag("--failed", options->failed,
+                "the logs of the processes of the last launch that failed (of APP when given), "
+                "which its rollback ended: the domain remembers the last 16 failed launches, a "
+                "node keeps the log files (docs/architecture.md)");
   cmd->add_option("--since", options->since,
                   "only the lines logged in the last T (a duration: 90s, 3600s)");
   cmd->add_flag("-f,--follow", options->follow, "go on printing what is logged, until Ctrl-C");
-  cmd->callback([options, &global, &exit_code] { exit_code = logs(*options, global); });
+  cmd->callback([options, lines, &global, &exit_code] {
+    if (options->target.empty() && !options->failed) {
+      fmt::print(stderr, "rsca logs: a target is required (APP, APP/COMP or NODE), or --failed\n");
+      exit_code = kUsage;
+      return;
+    }
+    if (options->failed && lines->count() == 0)
+      options->lines = SIZE_MAX;
+    exit_code = logs(*options, global);
+  });
 }
 
 } // namespace rsca::cli
