@@ -4,6 +4,8 @@
 
 #include <fstream>
 
+#include <spdlog/spdlog.h>
+
 #include "common/host_name.hpp"
 #include "control.h" // generated from dds/control.idl
 #include "control/endpoint_impl.hpp"
@@ -90,6 +92,20 @@ bool may_still_run(const std::string &host, std::int64_t pid, const std::string 
     return false;
   const std::string other = std::to_string(pid);
   return program_of(other) == program && !zombie(other);
+}
+
+std::optional<std::string> held_by(const dds::Participant &participant, const std::string &what,
+                                   const std::string &host, std::int64_t pid,
+                                   const std::string &program) {
+  if (!may_still_run(host, pid, program)) {
+    spdlog::info("{} was served by pid {} on this host, which runs {} no more: its last run, "
+                 "taken over",
+                 what, pid, program);
+    return std::nullopt;
+  }
+  const auto &dds = participant.settings();
+  return fmt::format("{} is served by pid {} on host {} (DDS domain {}, tag \"{}\")", what, pid,
+                     host, dds.domain_id, dds.tag);
 }
 
 } // namespace rsca::control

@@ -4,6 +4,14 @@
 // announcement instance (the namesake's stop disposed the holder's, and the domain dropped a live
 // node with its processes running on: issue 39).
 //
+// A namesake and a restart are told apart by whether the holder lives. A run that was killed has
+// no participant any more, and Cyclone keeps no durable data apart from its writers (transient-
+// local history is served by the writer that wrote it): its announcement, still alive in the
+// caches of those who had it until its lease ends, never reaches a newcomer, so a node killed and
+// started again at once finds no holder (shown by domain_node_failure_test's restart within a
+// 60 s lease). A holder found but whose pid no longer runs its program on this host (it died
+// during the look) is not one either (may_still_run).
+//
 // The look is bounded (kNameCheck): a holder whose announcement has not reached this process by
 // then (DDS discovery slower than that) is missed, and two namesakes started at the same moment
 // both go on. It is a guard against an operator's mistake, not a lock.
@@ -43,6 +51,12 @@ bool may_still_run(const std::string &host, std::int64_t pid, const std::string 
 // The name the kernel gives the program this process runs (its first 15 bytes).
 std::string own_program();
 
+// "<what> is served by pid P on host H (DDS domain D, tag T)" when that run of `program` may
+// still run (may_still_run); nothing, said in the log, when it is gone.
+std::optional<std::string> held_by(const dds::Participant &participant, const std::string &what,
+                                   const std::string &host, std::int64_t pid,
+                                   const std::string &program);
+
 // Who holds `address`, if a live run of `program` (rsca-domaind, rsca-noded) does: "<what> is
 // served by pid P on host H (DDS domain D, tag T)". `Announcement` is the holder's announcement
 // type (it has `pid` and `host`); a body that does not decode is another version's or another
@@ -60,10 +74,7 @@ std::optional<std::string> live_holder(const dds::Participant &participant,
   if (!holder)
     return fmt::format("{} is announced at {} on {} by a process that does not say who it is ({})",
                        what, address, where, holder.error());
-  if (!may_still_run(holder->host, holder->pid, program))
-    return std::nullopt;
-  return fmt::format("{} is served by pid {} on host {} ({})", what, holder->pid, holder->host,
-                     where);
+  return held_by(participant, what, holder->host, holder->pid, program);
 }
 
 } // namespace rsca::control
