@@ -97,6 +97,10 @@ TEST_CASE("a failed launch of a SAD file uninstalls what it installed, and only 
   CHECK(rc == 6); // failed, rolled back
   CHECK_THAT(out, Catch::Contains("failed at step 'execute'"));
   CHECK_THAT(out, Catch::Contains("uninstalled MissingExecutable again"));
+  // The file the error is about is the user's, not the domain's copy of it.
+  CHECK_THAT(out, Catch::Contains((kTestSdr / "dom/components/Missing/Missing.spd.xml").string() +
+                                  ": code file rsca-no-such-program"));
+  CHECK_THAT(out, !Catch::Contains("repository"));
   CHECK(installed(domain).empty());
   CHECK(repository_folders(domain).empty());
 

@@ -268,6 +268,8 @@ int launch(const std::string &what, const std::string &name, bool no_start,
                          std::chrono::steady_clock::now() - sent >= launch_timeout;
   if (!reply && !timed_out && !reply.error().maybe_received && target.installed_now)
     uninstall_again(*client, application, global);
+  if (!reply && file)
+    reply.error().message = as_user_paths(reply.error().message, application, *file);
   // The CLI's own deadline, not the domain's reply that a step timed out: the domain took the
   // request (else the call fails as unavailable) but is not done with it.
   if (timed_out) {

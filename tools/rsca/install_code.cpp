@@ -46,7 +46,7 @@ Expected<UserApplication> read_user_application(const fs::path &sad, const Globa
   auto app = loader.load_application(sad);
   if (!app)
     return tl::unexpected(app.error());
-  UserApplication user{std::move(*app), {}, {}};
+  UserApplication user{std::move(*app), {}, {}, *root};
   user.warnings = user.profile.warnings;
   user.warnings.insert(user.warnings.end(), user.profile.tolerated.begin(),
                        user.profile.tolerated.end());
@@ -112,6 +112,22 @@ std::optional<UserApplication> launchable_file(const std::string &sad, const Glo
   }
   app->request.for_launch = true; // the domain checks it again before it replaces anything
   return std::move(*app);
+}
+
+std::string as_user_paths(const std::string &text, const std::string &application,
+                          const UserApplication &user) {
+  const std::string marker = "/applications/" + application + "/";
+  const std::string root = (user.root / "").string();
+  std::string out;
+  std::size_t done = 0;
+  for (auto at = text.find(marker); at != std::string::npos; at = text.find(marker, done)) {
+    // The path begins after the blank or quote before it.
+    const auto blank = text.find_last_of(" \t\n\"'(", at);
+    const std::size_t start = blank == std::string::npos ? done : std::max(blank + 1, done);
+    out += text.substr(done, start - done) + root;
+    done = at + marker.size();
+  }
+  return out + text.substr(done);
 }
 
 } // namespace rsca::cli

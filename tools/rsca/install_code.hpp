@@ -20,7 +20,14 @@ struct UserApplication {
   profile::ResolvedApplication profile; // as read from the user's files
   protocol::domain::InstallRequest request;
   std::vector<Diagnostic> warnings; // what reading the files found, located in them
+  std::filesystem::path root;       // the SDR root the files are named from
 };
+
+// `text` from the domain about the install `application` of `user`'s files, its paths into the
+// domain's copy (REPOSITORY/applications/NAME/..., laid out as the SDR root they came from) made
+// the user's files again.
+std::string as_user_paths(const std::string &text, const std::string &application,
+                          const UserApplication &user);
 
 // The application of the SAD `sad` and the install request that carries it, named `name` (empty:
 // the SAD's name); an error located in the user's files. Read here and carried to the domain, so
