@@ -14,11 +14,6 @@ namespace {
 
 const fs::path kPartialNode = kTestSdr / "dev/nodes/partial/DeviceManager.dcd.xml";
 
-std::string read_file(const fs::path &path) {
-  std::ifstream in(path);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
 std::vector<std::string> device_ids_of(TestDomain &domain, const std::string &node) {
   auto devices = domain.call("domain.devices");
   REQUIRE(devices.has_value());

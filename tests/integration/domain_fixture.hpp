@@ -31,6 +31,12 @@ inline const fs::path kBin = RSCA_BIN_DIR;
 inline const fs::path kSource = RSCA_SOURCE_DIR;
 inline const fs::path kTestSdr = kSource / "tests/data/integration";
 
+// A file's bytes; empty when it cannot be read.
+inline std::string read_file(const fs::path &file) {
+  std::ifstream in(file, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
 inline bool process_exists(long pid) {
   if (pid <= 0)
     return false;

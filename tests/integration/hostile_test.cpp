@@ -11,11 +11,6 @@ using namespace rsca::test;
 
 namespace {
 
-std::string read_file(const fs::path &file) {
-  std::ifstream in(file, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
 // The install request the CLI would send for an application of the test SDR root, before any
 // check of the CLI's own: what any client on the network can send.
 Json install_request(const std::string &application) {

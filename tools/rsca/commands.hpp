@@ -28,8 +28,8 @@ void add_events_command(CLI::App &app, const GlobalOptions &global, int &exit_co
 void add_new_command(CLI::App &app, const GlobalOptions &global, int &exit_code);
 void add_top_command(CLI::App &app, const GlobalOptions &global, int &exit_code);
 void add_logs_command(CLI::App &app, const GlobalOptions &global, int &exit_code);
-// rsca completion bash: made from `app`'s commands, so register it after them.
-void add_completion_command(CLI::App &app, int &exit_code);
+// rsca completion bash|zsh: made from `app`'s commands, so register it after them.
+void add_completion_command(CLI::App &app, const GlobalOptions &global, int &exit_code);
 
 // Installs the application of `sad` in the domain; its installed name goes to `installed_name`
 // (and nothing is printed in --json mode) when given. An exit code.

@@ -35,7 +35,7 @@ int main(int argc, char **argv) {
   rsca::cli::add_logs_command(app, global, exit_code);
   rsca::cli::add_domain_command(app, global, exit_code);
   rsca::cli::add_new_command(app, global, exit_code);
-  rsca::cli::add_completion_command(app, exit_code);
+  rsca::cli::add_completion_command(app, global, exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError &e) {
