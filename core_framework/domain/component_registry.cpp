@@ -101,7 +101,7 @@ ComponentRegistry::wait_registered(const std::vector<std::string> &addresses,
     for (const auto &a : addresses) {
       auto it = entries_.find(a);
       if (it != entries_.end() && it->second.exited) {
-        failure = fmt::format("{} on node {} exited before registering: {}", a, it->second.node,
+        failure = fmt::format("{} exited before registering, on node {}: {}", a, it->second.node,
                               it->second.why);
         return false;
       }

@@ -307,13 +307,7 @@ ExecutableDevice *DeviceManager::Impl::executable_device(const std::string &id) 
   return nullptr;
 }
 
-void DeviceManager::Impl::report_exit(const protocol::domain::ComponentExitedReport &exited) {
-  // Why a process exited is mostly in its last words: a launch that fails on it shows them
-  // (a few KiB of a local file: the reaper's thread reads them at once).
-  using Report = protocol::domain::ComponentExitedReport;
-  auto report = exited;
-  report.log_tail = log_tail(options.log_dir / report.application / (report.component + ".log"),
-                             Report::kMaxLogTailLines, Report::kMaxLogTailBytes);
+void DeviceManager::Impl::report_exit(const protocol::domain::ComponentExitedReport &report) {
   std::lock_guard lock(endpoint_mutex); // the reaper's thread: the endpoint may be going
   if (stopping.load() || !endpoint)
     return;

@@ -195,33 +195,36 @@ std::string utf8_or_replaced(std::string_view bytes) {
   return out;
 }
 
-std::string log_tail(const fs::path &log, std::size_t max_lines, std::size_t max_bytes) {
+std::string log_tail(const fs::path &log, std::uint64_t from, std::size_t max_lines,
+                     std::size_t max_bytes) {
   const auto size = size_of(log);
-  const auto from = size > max_bytes ? size - max_bytes : 0;
-  std::string bytes = bytes_of(log, {from, size});
+  const std::uint64_t begun = from <= size ? from : 0;
+  const std::uint64_t start =
+      std::max<std::uint64_t>(begun, size > max_bytes ? size - max_bytes : 0);
+  std::string bytes = bytes_of(log, {start, size});
   // Begun inside a line: from the next one, unless that line is the last (cut below).
   if (const auto nl = bytes.find('\n');
-      from > 0 && nl != std::string::npos && nl + 1 < bytes.size())
+      start > begun && nl != std::string::npos && nl + 1 < bytes.size())
     bytes.erase(0, nl + 1);
   std::string text = utf8_or_replaced(bytes);
   if (!text.empty() && text.back() != '\n')
     text += '\n';
   // Replaced bytes grow by up to three times: lines are dropped from the front until both
   // bounds hold (a single line longer than max_bytes is cut from its start, whole characters).
-  std::size_t start = text.size();
-  for (std::size_t lines = 0; start > 0 && lines < max_lines; ++lines) {
-    const auto nl = start >= 2 ? text.rfind('\n', start - 2) : std::string::npos;
+  std::size_t kept = text.size();
+  for (std::size_t lines = 0; kept > 0 && lines < max_lines; ++lines) {
+    const auto nl = kept >= 2 ? text.rfind('\n', kept - 2) : std::string::npos;
     const std::size_t begin = nl == std::string::npos ? 0 : nl + 1;
     if (text.size() - begin > max_bytes)
       break;
-    start = begin;
+    kept = begin;
   }
-  if (start == text.size() && !text.empty()) { // the last line alone is too long
-    start = text.size() - std::min(text.size(), max_bytes);
-    while (start < text.size() && (static_cast<unsigned char>(text[start]) & 0xC0U) == 0x80U)
-      ++start;
+  if (kept == text.size() && !text.empty()) { // the last line alone is too long
+    kept = text.size() - std::min(text.size(), max_bytes);
+    while (kept < text.size() && (static_cast<unsigned char>(text[kept]) & 0xC0U) == 0x80U)
+      ++kept;
   }
-  return text.substr(start);
+  return text.substr(kept);
 }
 
 CallResult<op::LogsReply> read_log(const fs::path &log_dir, const op::LogsRequest &request,

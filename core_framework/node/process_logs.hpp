@@ -62,9 +62,10 @@ std::size_t sweep_logs(const std::filesystem::path &log_dir,
 Expected<bool> rotate_if_over(const std::filesystem::path &log, std::uint64_t max_bytes);
 
 // The end of `log` for a report of its process's exit: its last whole lines (and a last one
-// unended: a dying process may not end it), at most `max_lines` of them and `max_bytes` bytes of
-// valid UTF-8; empty when there is no log.
-std::string log_tail(const std::filesystem::path &log, std::size_t max_lines,
+// unended: a dying process may not end it) after `from` (where the process began writing it;
+// ignored when the log is shorter, rotated since), at most `max_lines` of them and `max_bytes`
+// bytes of valid UTF-8; empty when there is no log.
+std::string log_tail(const std::filesystem::path &log, std::uint64_t from, std::size_t max_lines,
                      std::size_t max_bytes);
 
 // `bytes` as valid UTF-8 (JSON text must be): each byte that is not part of a valid sequence

@@ -16,6 +16,7 @@
 #include "common/names.hpp"
 #include "control/link_socket.hpp"
 #include "host_info.hpp"
+#include "node/process_logs.hpp"
 #include "protocol/exec_params.hpp"
 #include "run_as.hpp"
 #include "shm/arena.hpp"
@@ -264,6 +265,7 @@ GppDevice::execute(const protocol::node::ExecuteRequest &r,
     owner.addresses = std::move(addresses);
     owners_[*pid] = std::move(owner);
     packages_[*pid] = std::move(package);
+    log_starts_[*pid] = no_log ? 0 : log_offset;
   }
   // A process that exited before it was recorded above found nothing to report or release: what
   // on_exit would have done is done now (whoever takes the records first does it, once).
@@ -291,6 +293,7 @@ GppDevice::terminate(const protocol::node::TerminateRequest &r) {
   std::lock_guard lock(mutex_);
   owners_.erase(pid);
   packages_.erase(pid);
+  log_starts_.erase(pid);
   return protocol::node::TerminateReply{pid};
 }
 
@@ -306,11 +309,16 @@ void GppDevice::on_exit(ProcessId pid, const ExitStatus &status) {
   if (context_.links != nullptr)
     context_.links->detach(pid);
   std::shared_ptr<const node::PackageLease> package; // let go outside the lock
+  std::uint64_t log_start = 0;
   {
     std::lock_guard lock(mutex_);
     if (auto it = packages_.find(pid); it != packages_.end()) {
       package = std::move(it->second);
       packages_.erase(it);
+    }
+    if (auto it = log_starts_.find(pid); it != log_starts_.end()) {
+      log_start = it->second;
+      log_starts_.erase(it);
     }
   }
   if (status.requested)
@@ -329,6 +337,12 @@ void GppDevice::on_exit(ProcessId pid, const ExitStatus &status) {
   report.status = describe(status);
   report.exit_code = status.exit_code;
   report.signal = status.signal;
+  // Why a process exited is mostly in its last words: a launch that fails on it shows them (a few
+  // KiB of a local file, read on the reaper's thread).
+  using Report = protocol::domain::ComponentExitedReport;
+  report.log_tail =
+      node::log_tail(context_.log_dir / report.application / (report.component + ".log"), log_start,
+                     Report::kMaxLogTailLines, Report::kMaxLogTailBytes);
   context_.report_exit(report);
 }
 

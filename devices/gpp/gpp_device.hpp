@@ -56,6 +56,9 @@ private:
   std::map<ProcessId, protocol::domain::ComponentExitedReport> owners_;
   // The package each process runs inside, kept in the node's cache while it runs.
   std::map<ProcessId, std::shared_ptr<const node::PackageLease>> packages_;
+  // Where each process began writing its log (earlier launches' lines come before): the end of
+  // its log goes with the report of its exit, its own lines only.
+  std::map<ProcessId, std::uint64_t> log_starts_;
   // Every process starts from this thread, which outlives them all (process/spawn_thread.hpp):
   // destroyed after the launcher has stopped them.
   // Started from spawner_ too, and stopped after it (gpp/fork_servers.hpp).

@@ -156,23 +156,28 @@ TEST_CASE("an exit report's log tail: the last lines, bounded in lines and bytes
   using rsca::node::log_tail;
   LogFolder logs;
   const auto log = logs.dir / "App" / "Comp_1.log";
-  CHECK(log_tail(log, 20, 4096).empty()); // no log
+  CHECK(log_tail(log, 0, 20, 4096).empty()); // no log
   std::string text;
   for (int i = 1; i <= 30; ++i)
     text += fmt::format("line {}\n", i);
   logs.write("Comp_1.log", text + "dying words");
-  const auto tail = log_tail(log, 5, 4096);
+  const auto tail = log_tail(log, 0, 5, 4096);
   CHECK(tail == "line 27\nline 28\nline 29\nline 30\ndying words\n");
   // Bytes bound it before lines do: whole lines only, the last ones.
-  CHECK(log_tail(log, 20, 20) == "line 30\ndying words\n");
+  CHECK(log_tail(log, 0, 20, 20) == "line 30\ndying words\n");
   // A last line longer than the bound is cut from its start, on a character's boundary.
   logs.write("Comp_1.log", "short\n" + std::string(10, 'x') + "\xC3\xA9" + "end\n");
-  CHECK(log_tail(log, 20, 6) == "\xC3\xA9"
-                                "end\n");
-  CHECK(log_tail(log, 20, 5) == "end\n");
+  CHECK(log_tail(log, 0, 20, 6) == "\xC3\xA9"
+                                   "end\n");
+  CHECK(log_tail(log, 0, 20, 5) == "end\n");
   // Bytes that are no UTF-8 are replaced: the tail travels as JSON text.
   logs.write("Comp_1.log", "bad \xFF byte\n");
-  CHECK(log_tail(log, 20, 4096) == "bad \xEF\xBF\xBD byte\n");
+  CHECK(log_tail(log, 0, 20, 4096) == "bad \xEF\xBF\xBD byte\n");
+  // Only what the process wrote from where it began: an earlier launch's lines stay out, unless
+  // the log was rotated since (shorter than where it began).
+  logs.write("Comp_1.log", "earlier launch\nthis one\n");
+  CHECK(log_tail(log, 15, 20, 4096) == "this one\n");
+  CHECK(log_tail(log, 1000, 20, 4096) == "earlier launch\nthis one\n");
 }
 
 TEST_CASE("logs no running process writes are deleted once old, with the folders they leave "
