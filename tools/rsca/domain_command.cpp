@@ -165,42 +165,126 @@ struct Started {
   fs::path pid_file;
 };
 
-// A daemon `up` started stopped: every other one it started goes too, nodes first, and their pid
-// files: an `up` that fails leaves nothing of its own running.
-int abandon_up(const std::vector<Started> &started, const Started &stopped) {
-  fmt::print(stderr, "rsca domain up: a daemon (pid {}) stopped; its log ends:\n{}", stopped.pid,
-             tail(stopped.log));
+// Every daemon an `up` started, stopped, nodes first, and their pid files: an `up` that fails
+// leaves nothing of its own running. `rc`, for the caller to return.
+int stop_started(const std::vector<Started> &started, int rc) {
   std::error_code ec;
   for (auto it = started.rbegin(); it != started.rend(); ++it) {
     if (!has_exited(it->pid))
       stop_daemon(it->pid);
     fs::remove(it->pid_file, ec);
   }
-  fmt::print(stderr, "rsca domain up: the {} other daemon(s) it started are stopped\n",
-             started.size() - 1);
-  return kFailed;
+  return rc;
 }
 
-// Whether every node daemon `up` started (all but the first of `started`, the domain daemon) is
-// registered: a domain that lists nodes of the same names run by others is not this one.
-bool all_registered(const protocol::domain::NodesReply &reply,
-                    const std::vector<Started> &started) {
+// A daemon `up` started stopped: every other one it started goes too.
+int abandon_up(const std::vector<Started> &started, const Started &stopped) {
+  fmt::print(stderr, "rsca domain up: a daemon (pid {}) stopped; its log ends:\n{}", stopped.pid,
+             tail(stopped.log));
+  fmt::print(stderr, "rsca domain up: the {} other daemon(s) it started are stopped\n",
+             started.size() - 1);
+  return stop_started(started, kFailed);
+}
+
+// Whether every node daemon of `started` from `first_node` on is registered: a domain that lists
+// nodes of the same names run by others is not this one.
+bool all_registered(const protocol::domain::NodesReply &reply, const std::vector<Started> &started,
+                    std::size_t first_node) {
   std::set<std::int64_t> listed;
   for (const auto &n : reply.nodes)
     listed.insert(n.pid);
-  return std::all_of(started.begin() + 1, started.end(),
+  return std::all_of(started.begin() + static_cast<std::ptrdiff_t>(first_node), started.end(),
                      [&](const Started &s) { return listed.contains(s.pid); });
 }
 
-int up(int nodes, const std::vector<std::string> &extra_dcds, const fs::path &run,
+// Waits until the node daemons of `started` (from `first_node` on) are registered; one of
+// `started` that stops meanwhile makes the others stop too. kOk with the domain's nodes in `reply`.
+int wait_registered(const std::vector<Started> &started, std::size_t first_node,
+                    const fs::path &run, const GlobalOptions &global,
+                    protocol::domain::NodesReply &reply) {
+  auto client = DomainClient::connect(global);
+  if (!client) {
+    fmt::print(stderr, "rsca domain up: {}\n", client.error().to_string());
+    return kFailed;
+  }
+  const auto deadline =
+      std::chrono::steady_clock::now() + std::chrono::milliseconds(global.timeout_ms) * 4;
+  for (;;) {
+    for (const auto &s : started)
+      if (has_exited(s.pid))
+        return abandon_up(started, s);
+    auto listed = client->call<protocol::domain::Nodes>({}, 1s);
+    if (listed && all_registered(*listed, started, first_node)) {
+      reply = *listed;
+      return kOk;
+    }
+    if (std::chrono::steady_clock::now() > deadline) {
+      fmt::print(stderr, "rsca domain up: the nodes did not all register in time (see {})\n",
+                 run.string());
+      return kUnreachable;
+    }
+    std::this_thread::sleep_for(50ms); // pacing a poll of the domain, not a wait for a condition
+  }
+}
+
+// One node daemon per DCD given with --node, named after its DCD's folder, appended to `started`.
+int spawn_extra_nodes(const std::vector<std::string> &dcds, const fs::path &run,
+                      const GlobalOptions &global, std::vector<Started> &started) {
+  for (const auto &dcd : dcds) {
+    const std::string name = fs::path(dcd).parent_path().filename().string();
+    if (auto pid = read_pid(run / (name + ".pid")); pid && alive(*pid)) {
+      fmt::print(stderr, "rsca domain up: a node {} is already up in {} (pid {})\n", name,
+                 run.string(), *pid);
+      return kRejected;
+    }
+    auto pid = spawn_node(fs::absolute(dcd), name, run, global);
+    if (!pid) {
+      fmt::print(stderr, "rsca domain up: {}\n", pid.error().to_string());
+      return kFailed;
+    }
+    started.push_back({*pid, run / (name + ".log"), run / (name + ".pid")});
+  }
+  return kOk;
+}
+
+void print_up(const protocol::domain::NodesReply &reply, const fs::path &run,
+              const GlobalOptions &global, const std::string &text) {
+  if (global.json) {
+    Json shown = protocol::encode(reply);
+    shown["run_dir"] = run.string();
+    print_json(shown);
+  } else {
+    fmt::print("{}; logs in {}\n", text, run.string());
+  }
+}
+
+// `rsca domain up --node DCD` beside a domain already up in `run`: only those nodes start, and
+// join it; what fails stops them again, and the domain keeps running.
+int add_nodes(const std::vector<std::string> &dcds, const fs::path &run,
+              const GlobalOptions &global) {
+  std::vector<Started> started;
+  if (int rc = spawn_extra_nodes(dcds, run, global, started); rc != kOk)
+    return stop_started(started, rc);
+  protocol::domain::NodesReply reply;
+  if (int rc = wait_registered(started, 0, run, global, reply); rc != kOk)
+    return stop_started(started, rc);
+  print_up(reply, run, global,
+           fmt::format("domain {}: {} node(s) added, {} in all", global.domain, started.size(),
+                       reply.nodes.size()));
+  return kOk;
+}
+
+int up(int nodes, bool nodes_given, const std::vector<std::string> &extra_dcds, const fs::path &run,
        const GlobalOptions &global) {
   std::error_code ec;
   fs::create_directories(run / "logs", ec);
   if (auto pid = read_pid(run / "domaind.pid"); pid && alive(*pid)) {
-    fmt::print(
-        stderr,
-        "rsca domain up: a domain is already up in {} (domaind pid {}); `rsca domain down` first\n",
-        run.string(), *pid);
+    if (!extra_dcds.empty() && !nodes_given)
+      return add_nodes(extra_dcds, run, global);
+    fmt::print(stderr,
+               "rsca domain up: a domain is already up in {} (domaind pid {}); `rsca domain down` "
+               "first, or `rsca domain up --node DCD` to add a node to it\n",
+               run.string(), *pid);
     return kRejected;
   }
   if (auto held = domain_held(global.domain)) {
@@ -225,58 +309,24 @@ int up(int nodes, const std::vector<std::string> &extra_dcds, const fs::path &ru
     auto dcd = node_dcd(i, sdrroot, run);
     if (!dcd) {
       fmt::print(stderr, "rsca domain up: {}\n", dcd.error().to_string());
-      return kFailed;
+      return stop_started(started, kFailed);
     }
     const std::string name = fmt::format("node{}", i);
     auto pid = spawn_node(*dcd, name, run, global);
     if (!pid) {
       fmt::print(stderr, "rsca domain up: {}\n", pid.error().to_string());
-      return kFailed;
+      return stop_started(started, kFailed);
     }
     started.push_back({*pid, run / (name + ".log"), run / (name + ".pid")});
   }
-  for (const auto &dcd : extra_dcds) {
-    const std::string name = fs::path(dcd).parent_path().filename().string();
-    auto pid = spawn_node(fs::absolute(dcd), name, run, global);
-    if (!pid) {
-      fmt::print(stderr, "rsca domain up: {}\n", pid.error().to_string());
-      return kFailed;
-    }
-    started.push_back({*pid, run / (name + ".log"), run / (name + ".pid")});
-  }
-  const std::size_t expected = static_cast<std::size_t>(nodes) + extra_dcds.size();
-  auto client = DomainClient::connect(global);
-  if (!client) {
-    fmt::print(stderr, "rsca domain up: {}\n", client.error().to_string());
-    return kFailed;
-  }
-  const auto deadline =
-      std::chrono::steady_clock::now() + std::chrono::milliseconds(global.timeout_ms) * 4;
+  if (int rc = spawn_extra_nodes(extra_dcds, run, global, started); rc != kOk)
+    return stop_started(started, rc);
   protocol::domain::NodesReply reply;
-  for (;;) {
-    for (const auto &s : started)
-      if (has_exited(s.pid))
-        return abandon_up(started, s);
-    auto listed = client->call<protocol::domain::Nodes>({}, 1s);
-    if (listed && all_registered(*listed, started)) {
-      reply = *listed;
-      break;
-    }
-    if (std::chrono::steady_clock::now() > deadline) {
-      fmt::print(stderr, "rsca domain up: the nodes did not all register in time (see {})\n",
-                 run.string());
-      return kUnreachable;
-    }
-    std::this_thread::sleep_for(50ms); // pacing a poll of the domain, not a wait for a condition
-  }
-  if (global.json) {
-    Json shown = protocol::encode(reply);
-    shown["run_dir"] = run.string();
-    print_json(shown);
-  } else {
-    fmt::print("domain {} up: domaind pid {}, {} node(s); logs in {}\n", global.domain, *domaind,
-               expected, run.string());
-  }
+  if (int rc = wait_registered(started, 1, run, global, reply); rc != kOk)
+    return stop_started(started, rc);
+  print_up(reply, run, global,
+           fmt::format("domain {} up: domaind pid {}, {} node(s)", global.domain, *domaind,
+                       started.size() - 1));
   return kOk;
 }
 
@@ -325,14 +375,19 @@ void add_domain_command(CLI::App &app, const GlobalOptions &global, int &exit_co
   auto nodes = std::make_shared<int>(2);
   auto *up_cmd = domain->add_subcommand(
       "up", "Start a domain daemon and N node daemons; return when all are registered");
-  up_cmd->add_option("--nodes", *nodes, "How many node daemons")
-      ->capture_default_str()
-      ->check(CLI::Range(1, 100));
+  auto *nodes_option = up_cmd->add_option("--nodes", *nodes, "How many node daemons")
+                           ->capture_default_str()
+                           ->check(CLI::Range(1, 100));
   auto extra = std::make_shared<std::vector<std::string>>();
-  up_cmd->add_option("--node", *extra, "One more node daemon, for this DCD (repeatable)")
+  up_cmd
+      ->add_option("--node", *extra,
+                   "One more node daemon, for this DCD (repeatable); with a domain already up "
+                   "in the run folder (and no --nodes), only these start and join it")
       ->check(CLI::ExistingFile);
   up_cmd->add_option("--run-dir", *run, "Logs and pid files go here")->capture_default_str();
-  up_cmd->callback([=, &global, &exit_code] { exit_code = up(*nodes, *extra, *run, global); });
+  up_cmd->callback([=, &global, &exit_code] {
+    exit_code = up(*nodes, nodes_option->count() > 0, *extra, *run, global);
+  });
   auto *down_cmd = domain->add_subcommand("down", "Stop the daemons started by `rsca domain up`");
   down_cmd->add_option("--run-dir", *run, "Where `domain up` put its pid files")
       ->capture_default_str();
