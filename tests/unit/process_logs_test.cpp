@@ -181,7 +181,7 @@ TEST_CASE("an exit report's log tail: the last lines, bounded in lines and bytes
 }
 
 TEST_CASE("logs no running process writes are deleted once old, with the folders they leave "
-          "empty; a running process's, a fresh one and the daemon's own stay",
+          "empty, while a running process's, a fresh one and the daemon's own stay",
           "[logs]") {
   using rsca::node::sweep_logs;
   LogFolder logs;
