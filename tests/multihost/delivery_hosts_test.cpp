@@ -112,8 +112,10 @@ TEST_CASE("a transfer cut off (the domain daemon killed while a node fetches) le
           "[multihost][delivery][failure]") {
   // The build's files as they are: large enough that the transfer is under way for seconds.
   HostsDomain domain(2, {.cache_tmpfs = {}, .domaind_args = {"--delivery", "as-is"}});
-  // Slow enough that the transfer is under way for seconds: what the domain's host sends.
-  domain.hosts().limit_rate(1, "40mbit");
+  // Slow enough that the transfer is under way for seconds: what the domain's host sends. At
+  // 40 mbit the build's 2.5 MB executables (linked by lld, without their debug sections) were in
+  // place in half a second, and the poll below once missed them in incoming/ (CI, 2026-11-29).
+  domain.hosts().limit_rate(1, "8mbit");
   auto launch = std::async(std::launch::async, [&] {
     return domain.cli(1, {"launch", kDeliveredSad, "--assign", "Consumer_1=node2:GPP_1"},
                       HostsDomain::over_dds());
@@ -122,7 +124,7 @@ TEST_CASE("a transfer cut off (the domain daemon killed while a node fetches) le
   REQUIRE(HostsDomain::wait_for(
       [&] {
         for (const auto &f : files_under(incoming))
-          if (std::error_code ec; fs::file_size(f, ec) > 1'000'000 && !ec)
+          if (std::error_code ec; fs::file_size(f, ec) > 256'000 && !ec)
             return true;
         return false;
       },
@@ -131,6 +133,13 @@ TEST_CASE("a transfer cut off (the domain daemon killed while a node fetches) le
   // The node gives up on its pieces (their deadline, or the domain gone from DDS) and removes
   // what it had fetched.
   CHECK(HostsDomain::wait_for([&] { return files_under(incoming).empty(); }, 40s));
-  CHECK(files_under(domain.cache_dir(2) / "packages").empty());
+  // A package fetched whole before the kill (the first of the two may be) stays, with its
+  // manifest: nothing in packages/ lacks one.
+  std::error_code ec;
+  for (const auto &package : fs::directory_iterator(domain.cache_dir(2) / "packages", ec)) {
+    INFO(package.path());
+    CHECK(fs::exists(domain.cache_dir(2) / "manifests" /
+                     (package.path().filename().string() + ".json")));
+  }
   launch.wait();
 }
