@@ -208,6 +208,7 @@ TEST_CASE("a component's shared-library dependency is delivered with it, and its
 TEST_CASE("a file that fails verification on its node fails the launch at execute, rolls it back, "
           "and leaves nothing in the node's cache",
           "[integration][delivery][failure]") {
+  const ColdCaches cold; // the consumer's good bytes must not be in node2's cache already
   TestDomain domain;
   // The domain finds the components' code in a folder of this test's, whose copy it then alters.
   const fs::path bin = domain.run_dir() / "bin";

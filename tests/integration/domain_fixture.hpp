@@ -73,6 +73,17 @@ struct DefaultDelivery {
   DefaultDelivery &operator=(const DefaultDelivery &) = delete;
 };
 
+// Under the sanitizers, node caches start warm (cache_seed.hpp) unless a test holds
+// DefaultDelivery or ColdCaches: one whose node must fetch a file it could otherwise link from an
+// earlier test's (a file the domain serves altered under its old hash).
+inline bool cold_caches_kept = false;
+struct ColdCaches {
+  ColdCaches() { cold_caches_kept = true; }
+  ~ColdCaches() { cold_caches_kept = false; }
+  ColdCaches(const ColdCaches &) = delete;
+  ColdCaches &operator=(const ColdCaches &) = delete;
+};
+
 class TestDomain {
 public:
   // Twice the product's default: a dozen component processes under ASan on a loaded 2-core CI
@@ -361,7 +372,8 @@ private:
                                   (run_ / fmt::format("node{}.sock", index)).string()};
     args.insert(args.end(), more_args.begin(), more_args.end());
 #ifdef RSCA_SANITIZE
-    if (const auto name = cache_seed::node_name(dcd); !default_delivery_kept && !name.empty()) {
+    if (const auto name = cache_seed::node_name(dcd);
+        !default_delivery_kept && !cold_caches_kept && !name.empty()) {
       seeded_ = true; // cache_seed.hpp says why
       cache_seed::seed(kBin, run_ / "cache" / name);
     }
