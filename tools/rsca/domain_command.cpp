@@ -227,6 +227,18 @@ int wait_registered(const std::vector<Started> &started, std::size_t first_node,
   }
 }
 
+// Node daemon `name` for `dcd`, appended to `started`; kOk, or kFailed after saying why.
+int start_node(const fs::path &dcd, const std::string &name, const fs::path &run,
+               const GlobalOptions &global, std::vector<Started> &started) {
+  auto pid = spawn_node(dcd, name, run, global);
+  if (!pid) {
+    fmt::print(stderr, "rsca domain up: {}\n", pid.error().to_string());
+    return kFailed;
+  }
+  started.push_back({*pid, run / (name + ".log"), run / (name + ".pid")});
+  return kOk;
+}
+
 // One node daemon per DCD given with --node, named after its DCD's folder, appended to `started`.
 int spawn_extra_nodes(const std::vector<std::string> &dcds, const fs::path &run,
                       const GlobalOptions &global, std::vector<Started> &started) {
@@ -237,12 +249,8 @@ int spawn_extra_nodes(const std::vector<std::string> &dcds, const fs::path &run,
                  run.string(), *pid);
       return kRejected;
     }
-    auto pid = spawn_node(fs::absolute(dcd), name, run, global);
-    if (!pid) {
-      fmt::print(stderr, "rsca domain up: {}\n", pid.error().to_string());
-      return kFailed;
-    }
-    started.push_back({*pid, run / (name + ".log"), run / (name + ".pid")});
+    if (int rc = start_node(fs::absolute(dcd), name, run, global, started); rc != kOk)
+      return rc;
   }
   return kOk;
 }
@@ -311,13 +319,8 @@ int up(int nodes, bool nodes_given, const std::vector<std::string> &extra_dcds, 
       fmt::print(stderr, "rsca domain up: {}\n", dcd.error().to_string());
       return stop_started(started, kFailed);
     }
-    const std::string name = fmt::format("node{}", i);
-    auto pid = spawn_node(*dcd, name, run, global);
-    if (!pid) {
-      fmt::print(stderr, "rsca domain up: {}\n", pid.error().to_string());
-      return stop_started(started, kFailed);
-    }
-    started.push_back({*pid, run / (name + ".log"), run / (name + ".pid")});
+    if (int rc = start_node(*dcd, fmt::format("node{}", i), run, global, started); rc != kOk)
+      return stop_started(started, rc);
   }
   if (int rc = spawn_extra_nodes(extra_dcds, run, global, started); rc != kOk)
     return stop_started(started, rc);
