@@ -26,6 +26,21 @@ function(rsca_split_debug_info target)
     VERBATIM)
 endfunction()
 
+# What the built code declares (its ports, the properties it binds) goes beside the executable, as
+# <file>.rsca-code.json, written by the executable itself (`--rsca-describe`): `rsca validate`
+# and `rsca launch` compare it with the component's SPD, SCD and PRF, so that a misspelled
+# property or a port the SCD lacks is found before a launch (issue 39). Install it beside the
+# executable. A cross build cannot run its code: it writes none, and nothing is compared.
+function(rsca_describe_code target)
+  if(CMAKE_CROSSCOMPILING)
+    return()
+  endif()
+  add_custom_command(TARGET ${target} POST_BUILD
+    COMMAND ${CMAKE_COMMAND} -E env ASAN_OPTIONS=detect_leaks=0
+            $<TARGET_FILE:${target}> --rsca-describe $<TARGET_FILE:${target}>.rsca-code.json
+    VERBATIM)
+endfunction()
+
 function(rsca_add_component name)
   if(NOT ARGN)
     message(FATAL_ERROR "rsca_add_component(${name}): no sources given")
@@ -33,6 +48,7 @@ function(rsca_add_component name)
   add_executable(${name} ${ARGN})
   target_link_libraries(${name} PRIVATE rsca::runtime)
   rsca_split_debug_info(${name})
+  rsca_describe_code(${name})
   add_library(${name}-library MODULE ${ARGN})
   set_target_properties(${name}-library PROPERTIES OUTPUT_NAME ${name} PREFIX lib)
   target_link_libraries(${name}-library PRIVATE rsca::component_library)

@@ -12,6 +12,7 @@
 #include <cstring>
 
 #include "control/operation.hpp"
+#include "profile/code_description.hpp"
 #include "protocol/addresses.hpp"
 #include "protocol/domain_ops.hpp"
 #include "shm/process_arena.hpp"
@@ -60,21 +61,34 @@ std::vector<profile::PropertyDefinition> definitions_of(const profile::ResolvedS
 
 } // namespace
 
+profile::CodeDescription Host::describe(const Component &component) {
+  profile::CodeDescription out;
+  for (const auto &port : component.ports_)
+    out.ports.push_back({port->name(), port->direction(), false});
+  for (const auto &port : component.resource_ports_)
+    out.ports.push_back({port->name(), profile::PortDirection::Uses, true});
+  out.properties = component.properties_.bound_ids();
+  return out;
+}
+
+// The ports' names against the SCD are checked as `rsca validate` checks them
+// (profile::code_misfits); what only the live ports tell (their types, a name given twice) here.
 Expected<void> Host::check_ports() const {
   const auto &scd = softpkg_->scd;
   Error error;
   auto fail = [&](std::string message) {
     error.add({{softpkg_->spd_path.string(), 0, 0}, "binding", std::move(message)});
   };
+  profile::CodeDescription ports = describe(c());
+  ports.properties.clear(); // checked as the PRF is loaded (PropertySet::load)
+  for (auto &misfit : profile::code_misfits(ports, scd.get(), {}))
+    fail(std::move(misfit));
   for (const auto &port : c().ports_) {
     if (find_port(port->name()) != port.get())
       fail(fmt::format("the component declares port \"{}\" twice", port->name()));
     const auto *definition = scd ? scd->find_port(port->name(), port->direction()) : nullptr;
-    if (definition == nullptr) {
-      fail(fmt::format("the component has {} port \"{}\", which its SCD does not declare",
-                       profile::to_string(port->direction()), port->name()));
+    if (definition == nullptr)
       continue;
-    }
     const auto type = port::port_type_for_repid(definition->repid);
     if (type != port->type())
       fail(fmt::format("port \"{}\" carries {}, but its SCD repid is {}", port->name(),
@@ -85,10 +99,7 @@ Expected<void> Host::check_ports() const {
       fail(fmt::format("the component declares port \"{}\" twice", port->name()));
     const auto *definition =
         scd ? scd->find_port(port->name(), profile::PortDirection::Uses) : nullptr;
-    if (definition == nullptr)
-      fail(fmt::format("the component has uses port \"{}\", which its SCD does not declare",
-                       port->name()));
-    else if (!profile::is_control_interface(definition->repid))
+    if (definition != nullptr && !profile::is_control_interface(definition->repid))
       fail(fmt::format("port \"{}\" calls a component's CF interface, but its SCD repid is {}",
                        port->name(), definition->repid));
   }

@@ -21,6 +21,7 @@
 #include "component/receive_loop.hpp"
 #include "control/endpoint.hpp"
 #include "dds/participant.hpp"
+#include "profile/code_description.hpp"
 #include "profile/profile_loader.hpp"
 #include "protocol/component_ops.hpp"
 #include "protocol/node_ops.hpp"
@@ -55,6 +56,8 @@ public:
   // Initializes, configures with `properties` and starts the component: what the domain would
   // ask, for a component its own process brings up (a device in its node).
   Expected<void> bring_up(const Json &properties);
+  // What the component's code declares (ports, bound properties), as `--rsca-describe` writes it.
+  static profile::CodeDescription describe(const Component &component);
   // The component's ports, as a device announces them.
   std::vector<protocol::node::DevicePort> ports() const;
   // Withdraws the announcement, closes the endpoint (waiting for running operations), stops the

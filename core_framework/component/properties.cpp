@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include "profile/code_description.hpp"
 #include "profile/property_json.hpp"
 
 namespace rsca::component {
@@ -173,6 +174,13 @@ void merge(profile::StructValue &into, const profile::StructValue &from) {
 
 } // namespace
 
+std::vector<std::string> PropertySet::bound_ids() const {
+  std::vector<std::string> ids;
+  for (const auto &[id, binding] : bindings_)
+    ids.push_back(id);
+  return ids;
+}
+
 void PropertySet::bind(std::string id, std::unique_ptr<PropertyBinding> binding) {
   bindings_[std::move(id)] = std::move(binding);
 }
@@ -180,14 +188,13 @@ void PropertySet::bind(std::string id, std::unique_ptr<PropertyBinding> binding)
 Expected<void> PropertySet::load(std::vector<profile::PropertyDefinition> definitions) {
   definitions_ = std::move(definitions);
   Error error;
+  // Bound but not defined: as `rsca validate` finds it from the code's description.
+  for (auto &misfit : profile::code_misfits({{}, bound_ids()}, nullptr, definitions_))
+    error.add({{"component", 0, 0}, "binding", std::move(misfit)});
   for (const auto &[id, binding] : bindings_) {
     const auto *definition = find(id);
-    if (definition == nullptr) {
-      error.add({{"component", 0, 0},
-                 "binding",
-                 fmt::format("property \"{}\" is bound, but the PRF does not define it", id)});
+    if (definition == nullptr)
       continue;
-    }
     if (auto why = binding->mismatch(*definition))
       error.add({{"component", 0, 0}, "binding", fmt::format("property \"{}\": {}", id, *why)});
   }

@@ -322,6 +322,8 @@ public:
   control::CallResult<Json> query(const std::vector<std::string> &ids) const;
 
   const profile::PropertyDefinition *find(std::string_view id) const;
+  // The ids bound by the component's code, defined in its PRF or not.
+  std::vector<std::string> bound_ids() const;
 
 private:
   Json value_json(const profile::PropertyDefinition &definition) const;

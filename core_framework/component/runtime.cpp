@@ -8,6 +8,7 @@
 #include <csignal>
 #include <cstdlib>
 #include <cstring>
+#include <fstream>
 #include <functional>
 #include <map>
 #include <string_view>
@@ -127,7 +128,33 @@ void serve_forks_if_asked(int &argc, char **&argv, std::string_view ready) {
   process::serve_forks_if_asked(argc, argv, ready);
 }
 
+namespace {
+
+// `--rsca-describe FILE`, run by the SDK's build (cmake/RscaAddComponent.cmake): constructs the
+// component as a launch would and writes what its code declares (profile/code_description.hpp).
+int describe_code(const char *file, const Factory &factory) {
+  auto logger = spdlog::stderr_logger_st("rsca-describe");
+  Context context{"describe", "describe", "", "", {}, "", logger, std::nullopt, false};
+  try {
+    const auto component = factory(context);
+    std::ofstream out(file);
+    out << profile::to_json_text(detail::Host::describe(*component)) << "\n";
+    if (!out.flush()) {
+      logger->error("cannot write {}", file);
+      return kExitFailure;
+    }
+  } catch (const std::exception &e) {
+    logger->error("constructing the component failed: {}", e.what());
+    return kExitFailure;
+  }
+  return kExitOk;
+}
+
+} // namespace
+
 int run_component(int argc, char **argv, const Factory &factory) {
+  if (argc == 3 && std::string_view(argv[1]) == kDescribeOption)
+    return describe_code(argv[2], factory);
   return detail::run_process<ExecParams>(
       argc, argv,
       "COMPONENT_IDENTIFIER <id> PROFILE_NAME <spd> CONTROL_ADDRESS <address> [NAME_BINDING "

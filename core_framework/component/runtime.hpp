@@ -42,7 +42,10 @@ using protocol::parse_exec_params;
 using protocol::parse_host_params;
 
 using Factory = std::function<std::unique_ptr<Component>(const Context &)>;
+// Runs the component its node started; with `--rsca-describe FILE` only, writes what its code
+// declares to FILE instead (profile/code_description.hpp) and exits.
 int run_component(int argc, char **argv, const Factory &factory);
+inline constexpr std::string_view kDescribeOption = "--rsca-describe";
 
 // A shared-library component exports this function (component/export.hpp): it hands out the
 // component's factory.

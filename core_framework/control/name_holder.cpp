@@ -53,6 +53,15 @@ std::optional<Json> take_live(dds_entity_t reader, const std::string &address) {
   }
 }
 
+// Takes what a reader holds, only so that its data-available status resets.
+void forget_seen(dds_entity_t reader) {
+  void *samples[detail::kTakeBatch] = {nullptr};
+  dds_sample_info_t infos[detail::kTakeBatch];
+  for (dds_return_t n;
+       (n = dds_take(reader, samples, infos, detail::kTakeBatch, detail::kTakeBatch)) > 0;)
+    dds_return_loan(reader, samples, n);
+}
+
 } // namespace
 
 std::optional<Json> live_announcement(const dds::Participant &participant,
@@ -66,15 +75,28 @@ std::optional<Json> live_announcement(const dds::Participant &participant,
     return std::nullopt; // the endpoint's own creation will say why
   auto reader = dds::checked(dds_create_reader(pp, topic->get(), qos.get(), nullptr),
                              "creating the announcement reader");
+  auto peers =
+      dds::checked(dds_create_reader(pp, DDS_BUILTIN_TOPIC_DCPSPARTICIPANT, nullptr, nullptr),
+                   "creating the participant reader");
   auto waitset = dds::checked(dds_create_waitset(pp), "creating a waitset");
-  if (!reader || !waitset)
+  if (!reader || !peers || !waitset)
     return std::nullopt;
-  dds_set_status_mask(reader->get(), DDS_DATA_AVAILABLE_STATUS);
+  dds_set_status_mask(reader->get(), DDS_DATA_AVAILABLE_STATUS | DDS_SUBSCRIPTION_MATCHED_STATUS);
+  dds_set_status_mask(peers->get(), DDS_DATA_AVAILABLE_STATUS);
   dds_waitset_attach(waitset->get(), reader->get(), reader->get());
-  const auto deadline = Clock::now() + wait;
-  for (auto now = Clock::now(); now < deadline; now = Clock::now()) {
-    dds_waitset_wait(waitset->get(), nullptr, 0,
-                     std::chrono::duration_cast<std::chrono::nanoseconds>(deadline - now).count());
+  dds_waitset_attach(waitset->get(), peers->get(), peers->get());
+  DiscoveryQuiet quiet(Clock::now(), wait);
+  for (auto now = Clock::now(); !quiet.over(now); now = Clock::now()) {
+    const auto until = quiet.next_look();
+    const dds_return_t woken =
+        dds_waitset_wait(waitset->get(), nullptr, 0,
+                         std::chrono::duration_cast<std::chrono::nanoseconds>(until - now).count());
+    if (woken <= 0)
+      continue;
+    quiet.heard(Clock::now());
+    forget_seen(peers->get());
+    dds_subscription_matched_status_t matched;
+    dds_get_subscription_matched_status(reader->get(), &matched); // resets the status
     if (auto found = take_live(reader->get(), address))
       return found;
   }

@@ -17,6 +17,7 @@
 // both go on. It is a guard against an operator's mistake, not a lock.
 #pragma once
 
+#include <algorithm>
 #include <chrono>
 #include <cstdint>
 #include <optional>
@@ -34,8 +35,41 @@ namespace rsca::control {
 // on one host or a LAN; a second leaves room for a loaded host.
 inline constexpr std::chrono::milliseconds kNameCheck{1000};
 
-// The body of a live announcement of `address` (alive, not withdrawn), as soon as one arrives
-// within `wait`; nothing when none did.
+// When a look for a holder may end before its bound: once discovery has gone quiet. A holder's
+// announcement comes in a burst of discovery (its participant, then its writer matching ours, then
+// its durable samples), which starts as soon as both participants exist: Cyclone answers a new
+// participant's announcement at once. So the look ends when nothing new (participant, match,
+// sample) has been heard for `quiet`, and not before `least` has passed (the first exchange), nor
+// after the bound. Without it every daemon start waited the whole second (issue 39's cost in CI:
+// ~1 s on each of several hundred test domains).
+class DiscoveryQuiet {
+public:
+  static constexpr std::chrono::milliseconds kLeast{250};
+  static constexpr std::chrono::milliseconds kQuiet{150};
+
+  using Clock = std::chrono::steady_clock;
+  DiscoveryQuiet(Clock::time_point start, std::chrono::milliseconds bound)
+      : earliest_(start + std::min(bound, std::chrono::milliseconds(kLeast))),
+        deadline_(start + bound), last_heard_(start) {}
+
+  // Something was discovered at `now`: the quiet starts again.
+  void heard(Clock::time_point now) { last_heard_ = now; }
+  bool over(Clock::time_point now) const {
+    return now >= deadline_ || (now >= earliest_ && now >= last_heard_ + kQuiet);
+  }
+  // The moment to look again if nothing is heard before.
+  Clock::time_point next_look() const {
+    return std::min(deadline_, std::max(earliest_, last_heard_ + kQuiet));
+  }
+
+private:
+  Clock::time_point earliest_;
+  Clock::time_point deadline_;
+  Clock::time_point last_heard_;
+};
+
+// The body of a live announcement of `address` (alive, not withdrawn), as soon as one arrives;
+// nothing when none did before discovery went quiet (DiscoveryQuiet) or `wait` passed.
 std::optional<nlohmann::json> live_announcement(const dds::Participant &participant,
                                                 const std::string &address,
                                                 std::chrono::milliseconds wait);

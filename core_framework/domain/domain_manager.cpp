@@ -168,8 +168,22 @@ tl::unexpected<control::CallError> unknown_assignment_error(const std::string &a
 
 } // namespace
 
+// A launch that settles the install made for it (`rsca launch SAD`) keeps it or puts back what it
+// replaced (InstalledRepository::settle); its error then says which.
 CallResult<app_ops::CreateReply>
 DomainManager::Impl::create_application(const app_ops::CreateRequest &wire) {
+  auto created = create_installed(wire);
+  if (!wire.settles_install.value_or(false))
+    return created;
+  std::lock_guard lock(installs);
+  const auto settled = repository->settle(wire.application, created.has_value());
+  if (!created && !settled.empty())
+    created.error().message += "; " + settled;
+  return created;
+}
+
+CallResult<app_ops::CreateReply>
+DomainManager::Impl::create_installed(const app_ops::CreateRequest &wire) {
   if (wire.name)
     if (auto named = check_name("the application", *wire.name); !named)
       return control::call_error(Status::BadRequest, named.error());

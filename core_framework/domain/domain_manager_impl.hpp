@@ -96,6 +96,7 @@ struct DomainManager::Impl {
   CallResult<domain_ops::Named> uninstall(const domain_ops::Named &request);
   CallResult<domain_ops::InstalledReply> list_installed();
   CallResult<app_ops::CreateReply> create_application(const app_ops::CreateRequest &request);
+  CallResult<app_ops::CreateReply> create_installed(const app_ops::CreateRequest &request);
   CallResult<std::shared_ptr<Application>>
   launch(LaunchRequest &request, const std::string &launch_id, std::vector<LaunchStep> &steps);
   CallResult<app_ops::ProgressReply> progress(const app_ops::LaunchId &request);

@@ -264,7 +264,7 @@ CallResult<InstalledApplication> InstalledRepository::install(const InstallReque
   if (auto named = checked_name(name); !named)
     return tl::unexpected(named.error());
   std::lock_guard lock(mutex_);
-  auto installed = replace(name, staging.path(), sad);
+  auto installed = replace(name, staging.path(), sad, request.for_launch.value_or(false));
   if (installed)
     staging.keep(); // it became the install
   return installed;
@@ -284,13 +284,18 @@ InstalledRepository::read_aside(const InstallRequest &request) const {
 // under that name steps aside first and comes back if anything fails.
 CallResult<InstalledApplication> InstalledRepository::replace(const std::string &name,
                                                               const fs::path &staged,
-                                                              const fs::path &sad_in_install) {
+                                                              const fs::path &sad_in_install,
+                                                              bool on_trial) {
   const fs::path target = applications_dir() / name;
   std::error_code ec;
   fs::create_directories(applications_dir(), ec);
   ScopedFolder previous(root_, {});
   const auto old = folders_.find(name);
   const fs::path old_folder = old != folders_.end() ? old->second : target;
+  const auto old_install = installed_.find(name);
+  std::optional<InstalledApplication> replaced;
+  if (old_install != installed_.end())
+    replaced = old_install->second;
   if (fs::exists(old_folder, ec)) {
     previous.reset(staging_dir() / unique_name("previous"));
     fs::rename(old_folder, previous.path(), ec);
@@ -324,7 +329,74 @@ CallResult<InstalledApplication> InstalledRepository::replace(const std::string 
       name, sad, std::make_shared<const profile::ResolvedApplication>(std::move(*app))};
   installed_[name] = installed;
   folders_[name] = target;
+  if (!on_trial) {
+    drop_trial(name); // final: what an earlier trial held goes
+  } else if (!trials_.contains(name)) {
+    trials_[name] = Trial{previous.path(), old_folder, std::move(replaced)};
+    previous.keep(); // held until the launch ends
+  } // else: the earlier trial holds the last installation not on trial; this one's goes
   return installed;
+}
+
+std::string InstalledRepository::settle(const std::string &name, bool launched) {
+  std::lock_guard lock(mutex_);
+  auto it = trials_.find(name);
+  if (it == trials_.end())
+    return {};
+  Trial trial = std::move(it->second);
+  trials_.erase(it);
+  if (!launched)
+    return restore(name, std::move(trial));
+  if (!trial.held.empty())
+    remove_inside(root_, trial.held);
+  return {};
+}
+
+void InstalledRepository::drop_trial(const std::string &name) {
+  auto it = trials_.find(name);
+  if (it == trials_.end())
+    return;
+  if (!it->second.held.empty())
+    remove_inside(root_, it->second.held);
+  trials_.erase(it);
+}
+
+// Puts back what the install on trial replaced (called with mutex_ held), or removes the install
+// when it replaced nothing.
+std::string InstalledRepository::restore(const std::string &name, Trial trial) {
+  if (const auto current = folders_.find(name); current != folders_.end())
+    remove_inside(root_, current->second);
+  installed_.erase(name);
+  folders_.erase(name);
+  std::error_code ec;
+  if (!trial.held.empty() && trial.previous)
+    fs::rename(trial.held, trial.folder, ec);
+  const bool back = !trial.held.empty() && trial.previous && !ec;
+  const auto stored =
+      back ? store_.put_installed({name, trial.previous->sad.lexically_relative(root_).string()})
+           : store_.remove_installed(name);
+  if (!stored)
+    spdlog::error("the record of installed application {} not updated: {}", name,
+                  stored.error().to_string());
+  if (back) {
+    installed_[name] = std::move(*trial.previous);
+    folders_[name] = trial.folder;
+    spdlog::info("installed application {}: its launch failed, the installation it replaced is "
+                 "back",
+                 name);
+    return fmt::format("the installation of {} it replaced is back", name);
+  }
+  if (!trial.held.empty()) {
+    spdlog::error("installed application {}: the installation it replaced could not be put "
+                  "back: {}",
+                  name, ec.message());
+    remove_inside(root_, trial.held);
+    return fmt::format("{} is no longer installed: the installation it replaced could not be put "
+                       "back ({})",
+                       name, ec.message());
+  }
+  spdlog::info("installed application {}: its launch failed, uninstalled again", name);
+  return fmt::format("{} is uninstalled again (this launch had installed it)", name);
 }
 
 CallResult<void> InstalledRepository::uninstall(const std::string &name) {
@@ -342,6 +414,7 @@ CallResult<void> InstalledRepository::uninstall(const std::string &name) {
   remove_inside(root_, folders_.at(name));
   installed_.erase(it);
   folders_.erase(name);
+  drop_trial(name);
   return {};
 }
 

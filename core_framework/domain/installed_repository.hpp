@@ -9,6 +9,11 @@
 // loads (and, for a launch, only once nothing in it would make the launch refuse it); one that
 // fails at any point leaves the repository as it was (no staging folder, the previous install of
 // the same name intact).
+//
+// An install for a launch (`rsca launch SAD`) is on trial until that launch ends: what it replaced
+// is held aside, and comes back if the launch fails (settle), so that a SAD that passes the checks
+// but does not launch never replaces a good installation. Held is the last installation that was
+// not on trial; any install not for a launch ends a trial (it is final).
 #pragma once
 
 #include <filesystem>
@@ -49,6 +54,10 @@ public:
   control::CallResult<std::shared_ptr<const profile::ResolvedApplication>>
   read_aside(const InstallRequest &request) const;
   control::CallResult<void> uninstall(const std::string &name);
+  // Ends the trial of `name`'s install (nothing when it is on none): kept when its launch
+  // `launched`, else replaced again by what it replaced, or removed when it replaced nothing.
+  // What was done, for the launch's error ("" when nothing was).
+  std::string settle(const std::string &name, bool launched);
   std::optional<InstalledApplication> find(const std::string &name) const;
   std::vector<InstalledApplication> list() const;
 
@@ -61,13 +70,25 @@ private:
   control::CallResult<std::filesystem::path> stage(const InstallRequest &request) const;
   control::CallResult<InstalledApplication> replace(const std::string &name,
                                                     const std::filesystem::path &staged,
-                                                    const std::filesystem::path &sad_in_install);
+                                                    const std::filesystem::path &sad_in_install,
+                                                    bool on_trial);
+  // What an install on trial replaced: its files (moved aside to `held`) and where they were.
+  struct Trial {
+    std::filesystem::path held; // empty: it replaced nothing
+    std::filesystem::path folder;
+    std::optional<InstalledApplication> previous;
+  };
+  void begin_trial(const std::string &name, std::filesystem::path held,
+                   const std::filesystem::path &folder);
+  void drop_trial(const std::string &name);
+  std::string restore(const std::string &name, Trial trial);
 
   std::filesystem::path root_;
   DomainStore &store_;
   mutable std::mutex mutex_;
   std::map<std::string, InstalledApplication> installed_;
   std::map<std::string, std::filesystem::path> folders_; // where each one's files are
+  std::map<std::string, Trial> trials_;                  // installs for a launch not yet ended
 };
 
 } // namespace rsca::domain

@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include "profile/code_description.hpp"
 #include "profile/profile_loader.hpp"
 #include "profile/property_binding.hpp"
 
@@ -317,6 +318,8 @@ std::vector<Diagnostic> check_node(const ResolvedNode &node, std::vector<Diagnos
 std::vector<Diagnostic> launch_refusals(const ResolvedApplication &app) {
   if (auto missing = missing_files(app); !missing.empty())
     return missing;
+  if (auto misfits = code_refusals(app); !misfits.empty())
+    return misfits; // its component would exit at start, saying the same
   if (!app.warnings.empty()) {
     auto refused = app.warnings;
     for (auto &w : refused)

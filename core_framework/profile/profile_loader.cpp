@@ -7,6 +7,7 @@
 
 #include "common/install_layout.hpp"
 #include "profile/application_checks.hpp"
+#include "profile/code_description.hpp"
 
 namespace rsca::profile {
 
@@ -498,20 +499,28 @@ Expected<ValidatedDescriptor> ProfileLoader::validate(const fs::path &file) {
   };
   auto nothing_more = [](const auto &) { return std::vector<Diagnostic>{}; };
   switch (type_of(**descriptor)) {
-  case DescriptorType::SAD:
-    return keep(load_application(file), [](const ResolvedApplication &a) {
+  case DescriptorType::SAD: {
+    auto app = load_application(file);
+    if (auto misfits = app ? code_refusals(*app) : std::vector<Diagnostic>{}; !misfits.empty())
+      return tl::unexpected(Error(std::move(misfits))); // what a launch refuses too
+    return keep(std::move(app), [](const ResolvedApplication &a) {
       auto all = a.warnings;
       append_unique(all, a.tolerated);
       return all;
     });
+  }
   case DescriptorType::DCD:
     return keep(load_node(file), [](const ResolvedNode &n) {
       auto all = n.warnings;
       append_unique(all, n.tolerated);
       return all;
     });
-  case DescriptorType::SPD:
-    return keep(load_softpkg(file), [](const auto &pkg) { return pkg->warnings; });
+  case DescriptorType::SPD: {
+    auto pkg = load_softpkg(file);
+    if (auto misfits = pkg ? code_refusals(**pkg) : std::vector<Diagnostic>{}; !misfits.empty())
+      return tl::unexpected(Error(std::move(misfits)));
+    return keep(std::move(pkg), [](const auto &p) { return p->warnings; });
+  }
   case DescriptorType::DMD:
     return keep(load_domain(file), nothing_more);
   case DescriptorType::SCD:

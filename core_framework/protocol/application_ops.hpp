@@ -94,11 +94,15 @@ struct CreateRequest : PlanRequest {
   std::optional<std::string> name;      // the running application's; absent: the installed name
   std::optional<std::string> launch_id; // for app.progress and app.cancel; absent: the name
   bool start = true;                    // false: create and connect only
+  // The launch settles the install made for it (`rsca launch SAD`): kept when it launches, else
+  // what it replaced is put back (InstalledRepository::settle). Absent: false.
+  std::optional<bool> settles_install;
   static constexpr auto fields() {
     using R = CreateRequest;
-    return std::tuple_cat(PlanRequest::fields(), std::tuple{optional("name", &R::name),
-                                                            optional("launch_id", &R::launch_id),
-                                                            optional("start", &R::start)});
+    return std::tuple_cat(
+        PlanRequest::fields(),
+        std::tuple{optional("name", &R::name), optional("launch_id", &R::launch_id),
+                   optional("start", &R::start), optional("settles_install", &R::settles_install)});
   }
 };
 

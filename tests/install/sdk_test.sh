@@ -89,6 +89,17 @@ sed -e 's|Greeter/Greeter.spd.xml|Greeter/GreeterLib.spd.xml|' \
 step "validate the SDR root strictly"
 "$rsca" validate --strict "$sdr"
 
+step "a property the code binds and the PRF lacks is found by validate, before any launch"
+[ -f "$spd/Greeter.rsca-code.json" ] || fail "the code's description is not installed beside it"
+sed -i 's/property("length", length_)/property("lenght2", length_)/' "$work/src/Greeter/src/Greeter.cpp"
+cmake --build "$work/build" -j2 >/dev/null
+cmake --install "$work/build" --prefix "$work/sdr-misspelled" >/dev/null
+if "$rsca" validate "$work/sdr-misspelled" >"$work/misspelled.txt" 2>&1; then
+  fail "validate took a component whose code binds a property its PRF lacks"
+fi
+grep -F 'property "lenght2" is bound, but the PRF does not define it' "$work/misspelled.txt" >/dev/null ||
+  { cat "$work/misspelled.txt" >&2; fail "validate did not name the misspelled property"; }
+
 step "rsca new device Thermo: built against the installed SDK, installed into the SDR root"
 "$rsca" new device Thermo --dir "$work/src"
 cmake -S "$work/src/Thermo" -B "$work/build-thermo" -DCMAKE_PREFIX_PATH="$usr" \

@@ -96,7 +96,7 @@ TEST_CASE("a failed launch of a SAD file uninstalls what it installed, and only 
   INFO(out);
   CHECK(rc == 6); // failed, rolled back
   CHECK_THAT(out, Catch::Contains("failed at step 'execute'"));
-  CHECK_THAT(out, Catch::Contains("uninstalled MissingExecutable again"));
+  CHECK_THAT(out, Catch::Contains("MissingExecutable is uninstalled again"));
   // The file the error is about is the user's, not the domain's copy of it.
   CHECK_THAT(out, Catch::Contains((kTestSdr / "dom/components/Missing/Missing.spd.xml").string() +
                                   ": code file rsca-no-such-program"));
@@ -111,6 +111,43 @@ TEST_CASE("a failed launch of a SAD file uninstalls what it installed, and only 
   INFO(again);
   CHECK(again_rc == 6);
   CHECK_THAT(again, !Catch::Contains("uninstalled"));
+  CHECK_THAT(again, Catch::Contains("the installation of MissingExecutable it replaced is back"));
   CHECK(installed(domain) == before);
+  domain.require_clean({});
+}
+
+// The hole the launch checks leave: a SAD that passes them all but whose launch fails replaced
+// the good installation of its name. The install a launch makes is on trial until it ends.
+TEST_CASE("a SAD that passes the checks but fails to launch, launched from its file, leaves the "
+          "good installation of its name as it was",
+          "[integration][domain][install][failure]") {
+  TestDomain domain(1);
+  domain.install("Healthy");
+  const Json before = installed(domain);
+  const auto folders_before = repository_folders(domain);
+  const fs::path sad = kTestSdr / "dom/waveforms/HealthyUnlaunchable/HealthyUnlaunchable.sad.xml";
+
+  auto [rc, out] = domain.cli({"launch", "--sdrroot", kTestSdr.string(), sad.string()});
+  INFO(out);
+  CHECK(rc == 6); // failed, rolled back
+  CHECK_THAT(out, Catch::Contains("failed at step 'execute'"));
+  CHECK_THAT(out, Catch::Contains("the installation of Healthy it replaced is back"));
+  CHECK(installed(domain) == before);
+  CHECK(repository_folders(domain) == folders_before); // nothing held aside is left
+
+  // The installation that is back is the good one: it launches.
+  auto [good_rc, good] = domain.cli({"launch", "Healthy"});
+  INFO(good);
+  REQUIRE(good_rc == 0);
+  REQUIRE(domain.call("app.release", Json{{"app", "Healthy"}}).has_value());
+
+  // A launch from a file that succeeds keeps its install, and what it replaced goes.
+  auto [file_rc, file_out] =
+      domain.cli({"launch", "--sdrroot", kTestSdr.string(),
+                  (kTestSdr / "dom/waveforms/Healthy/Healthy.sad.xml").string()});
+  INFO(file_out);
+  REQUIRE(file_rc == 0);
+  CHECK(repository_folders(domain) == folders_before);
+  REQUIRE(domain.call("app.release", Json{{"app", "Healthy"}}).has_value());
   domain.require_clean({});
 }

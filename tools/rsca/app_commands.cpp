@@ -51,48 +51,20 @@ int send_install(const UserApplication &app, const DomainClient &client,
   return kOk;
 }
 
-// Whether the domain has an application installed under `name`; nullopt when it did not say.
-std::optional<bool> is_installed(const DomainClient &client, const std::string &name,
-                                 const GlobalOptions &global) {
-  auto listed =
-      client.call<protocol::domain::Installed>({}, std::chrono::milliseconds(global.timeout_ms));
-  if (!listed)
-    return std::nullopt;
-  return std::any_of(listed->applications.begin(), listed->applications.end(),
-                     [&](const auto &a) { return a.name == name; });
-}
-
-// What a launch launches: an installed name, or a SAD file installed first (`installed_now`: it
-// was not installed before, so a failed launch uninstalls it again). rc: an exit code.
+// What a launch launches: an installed name, or a SAD file installed first for it (the domain
+// keeps that install only if the launch succeeds: CreateRequest::settles_install). rc: an exit
+// code.
 struct LaunchTarget {
   std::string application;
-  bool installed_now = false;
+  bool installed_for_it = false;
 };
 
 LaunchTarget install_to_launch(const UserApplication &app, const DomainClient &client,
                                const GlobalOptions &global, int &rc) {
-  const auto &sad = *app.profile.sad;
-  const auto before = is_installed(client, sad.name.empty() ? sad.id : sad.name, global);
   LaunchTarget target;
   rc = send_install(app, client, global, &target.application, "launch");
-  target.installed_now = rc == kOk && before == false;
+  target.installed_for_it = rc == kOk;
   return target;
-}
-
-// A launch of what it had installed failed and the domain rolled it back: the install goes too,
-// so that a failed launch of a SAD leaves nothing behind.
-void uninstall_again(const DomainClient &client, const std::string &application,
-                     const GlobalOptions &global) {
-  auto removed = client.call<protocol::domain::Uninstall>(
-      {application}, std::chrono::milliseconds(global.timeout_ms) * 2);
-  if (global.json)
-    return;
-  if (removed)
-    fmt::print(stderr, "rsca launch: uninstalled {} again (this launch had installed it)\n",
-               application);
-  else
-    fmt::print(stderr, "rsca launch: {} stays installed ({})\n", application,
-               removed.error().message);
 }
 
 } // namespace
@@ -252,6 +224,8 @@ int launch(const std::string &what, const std::string &name, bool no_start,
   request.start = !no_start;
   request.assign = *assign;
   request.launch_id = launch_id;
+  if (target.installed_for_it)
+    request.settles_install = true;
   if (!strategy.empty())
     request.strategy = strategy;
   if (!name.empty())
@@ -266,8 +240,6 @@ int launch(const std::string &what, const std::string &name, bool no_start,
   auto reply = await_launch(*client, launch_id, future, show_progress, global);
   const bool timed_out = !reply && reply.error().status == control::Status::Timeout &&
                          std::chrono::steady_clock::now() - sent >= launch_timeout;
-  if (!reply && !timed_out && !reply.error().maybe_received && target.installed_now)
-    uninstall_again(*client, application, global);
   if (!reply && file)
     reply.error().message = as_user_paths(reply.error().message, application, *file);
   // The CLI's own deadline, not the domain's reply that a step timed out: the domain took the
