@@ -264,14 +264,19 @@ void Host::poll_ports() {
     if (port->direction() == profile::PortDirection::Provides)
       port->take_all(deliver);
   // Problems are looked for every kProblemCheck at most, not at every sample (ports.cpp says why).
+  // A stopped application's writers stop too: the gaps of a stop are no problem. What is counted
+  // while stopped, and the gap a start ends, is taken and dropped, at once on a start.
+  const bool resumed = deliver && !delivered_at_last_poll_;
+  delivered_at_last_poll_ = deliver;
   const auto now = std::chrono::steady_clock::now();
-  if (now - last_problem_check_ < kProblemCheck)
+  if (!resumed && now - last_problem_check_ < kProblemCheck)
     return;
   last_problem_check_ = now;
   std::vector<ConnectionProblem> problems;
   for (const auto &port : c().ports_)
     for (auto &p : port->take_problems())
-      problems.push_back(std::move(p));
+      if (deliver && !resumed)
+        problems.push_back(std::move(p));
   report_problems(std::move(problems));
 }
 

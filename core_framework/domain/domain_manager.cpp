@@ -226,7 +226,8 @@ DomainManager::Impl::create_installed(const app_ops::CreateRequest &wire) {
   }
   events->publish("application.created", {{"application", request.name},
                                           {"installed", request.installed},
-                                          {"components", (*app)->components.size()}});
+                                          {"components", (*app)->components.size()},
+                                          {"started", request.start}});
   app_ops::CreateReply reply{view_of(**app), {steps_of(steps), ms_since(began)}};
   applications.commit(*app);
   runtime_connections->endpoints_changed(); // connections waiting for it
@@ -360,6 +361,7 @@ DomainManager::Impl::start_or_stop(const app_ops::AppRequest &request, bool star
   auto done = start ? factory().start(*app, apply_to(name)) : factory().stop(*app, apply_to(name));
   if (!done)
     return tl::unexpected(done.error());
+  events->publish(start ? "application.started" : "application.stopped", {{"application", name}});
   // A release waits for the lifecycle lock held here: the application is still there.
   auto now = applications.snapshot(name);
   return view_of(now ? *now : *app);
