@@ -125,7 +125,7 @@ private:
   std::chrono::steady_clock::time_point last_problem_report_{};
   static constexpr std::chrono::milliseconds kProblemCheck{100};
   std::chrono::steady_clock::time_point last_problem_check_{}; // only the receive thread
-  bool delivered_at_last_poll_ = false;                         // only the receive thread
+  bool delivered_at_last_poll_ = false;                        // only the receive thread
 
   std::mutex service_mutex_;
   std::condition_variable service_wake_;

@@ -33,6 +33,16 @@ long dataview_find(const std::vector<Json> &events, const std::string &kind, con
   return -1;
 }
 
+// The lines of `text` that start with `prefix`.
+std::vector<std::string> dataview_lines(const std::string &text, const std::string &prefix) {
+  std::vector<std::string> out;
+  std::istringstream lines(text);
+  for (std::string line; std::getline(lines, line);)
+    if (line.rfind(prefix, 0) == 0)
+      out.push_back(line);
+  return out;
+}
+
 } // namespace
 
 TEST_CASE("rsca events shows an application's start and stop, and no deadline missed after the "
@@ -89,4 +99,36 @@ TEST_CASE("rsca events shows an application's start and stop, and no deadline mi
   }
   REQUIRE(domain.call("app.release", Json{{"app", name}}).has_value());
   domain.require_clean(pids_of(app));
+}
+
+TEST_CASE("rsca query summarises a long sequence; --full and --json print it whole",
+          "[integration][dataview]") {
+  TestDomain domain({TestDomain::shipped_nodes(1)[0],
+                     kSource / "profiles/dev/nodes/robot/DeviceManager.dcd.xml"});
+  // The Robot's trace grows as its world runs: a point every 10 ms.
+  std::size_t points = 0;
+  REQUIRE(TestDomain::wait_for([&] {
+    auto q = domain.call("app.query", Json{{"device", "robot:Robot_1"}, {"ids", {"trace_time"}}});
+    points = q ? q->at("properties").at("trace_time").size() : 0;
+    return points > 20;
+  }));
+  auto [rc, out] = domain.cli({"query", "robot:Robot_1", "trace_time"});
+  INFO(out);
+  REQUIRE(rc == 0);
+  const auto summary = dataview_lines(out, "trace_time = [");
+  REQUIRE(summary.size() == 1);
+  CHECK_THAT(
+      summary[0],
+      Catch::Matches(R"(trace_time = \[[-0-9.e]+, [-0-9.e]+, [-0-9.e]+, … [0-9]+ values\])"));
+  // Whole: every number, as many as the trace had then at least.
+  auto [full_rc, full] = domain.cli({"query", "robot:Robot_1", "trace_time", "--full"});
+  REQUIRE(full_rc == 0);
+  const auto whole = dataview_lines(full, "trace_time = [");
+  REQUIRE(whole.size() == 1);
+  CHECK(static_cast<std::size_t>(std::count(whole[0].begin(), whole[0].end(), ',')) + 1 >= points);
+  CHECK(whole[0].find("…") == std::string::npos);
+  auto [json_rc, json] = domain.cli({"--json", "query", "robot:Robot_1", "trace_time"});
+  INFO(json);
+  REQUIRE(json_rc == 0);
+  CHECK(Json::parse(json).at("properties").at("trace_time").size() >= points);
 }

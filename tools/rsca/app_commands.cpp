@@ -21,6 +21,7 @@
 #include "protocol/application_ops.hpp"
 #include "protocol/connection_ops.hpp"
 #include "protocol/domain_ops.hpp"
+#include "value_text.hpp"
 
 namespace rsca::cli {
 namespace {
@@ -335,10 +336,6 @@ std::optional<TextValues> parse_assignments(const std::vector<std::string> &args
   return values;
 }
 
-std::string scalar_text(const Json &v) {
-  return v.is_string() ? v.get<std::string>() : v.dump();
-}
-
 } // namespace
 
 // rsca channel create|destroy NAME.
@@ -536,15 +533,19 @@ void add_application_commands(CLI::App &app, const GlobalOptions &global, int &e
   auto ids = std::make_shared<std::vector<std::string>>();
   query_cmd->add_option("target", *query_target, "APP, APP/COMPONENT or NODE:DEVICE")->required();
   query_cmd->add_option("properties", *ids, "Property ids (default: all)");
+  auto full = std::make_shared<bool>(false);
+  query_cmd->add_flag("--full", *full,
+                      "Print long values whole (a sequence of more than 8 values, text of more "
+                      "than 200 characters is otherwise summarised; --json prints them whole)");
   query_cmd->callback([=, &global, &exit_code] {
     app_ops::QueryRequest request;
     set_target(*query_target, request);
     request.ids = *ids;
-    exit_code = simple_call<app_ops::Query>("query", request, global,
-                                            [](const protocol::component::QueryReply &r) {
-                                              for (const auto &[id, value] : r.properties.items())
-                                                fmt::print("{} = {}\n", id, scalar_text(value));
-                                            });
+    exit_code = simple_call<app_ops::Query>(
+        "query", request, global, [full](const protocol::component::QueryReply &r) {
+          for (const auto &[id, value] : r.properties.items())
+            fmt::print("{} = {}\n", id, value_text(value, *full));
+        });
   });
 }
 
