@@ -132,3 +132,28 @@ TEST_CASE("rsca query summarises a long sequence; --full and --json print it who
   REQUIRE(json_rc == 0);
   CHECK(Json::parse(json).at("properties").at("trace_time").size() >= points);
 }
+
+TEST_CASE("rsca top -n 2 prints two tables, one after the other when not on a terminal",
+          "[integration][top][dataview]") {
+  TestDomain domain;
+  const Json app = domain.launch_shipped("ProducerConsumer");
+  auto [rc, out] = domain.cli({"top", "-w", "--interval", "200ms", "-n", "2"});
+  INFO(out);
+  REQUIRE(rc == 0);
+  CHECK(dataview_lines(out, "HOST/NODE").size() == 2);
+  CHECK(dataview_lines(out, "\x1b[H").empty()); // a pipe is not redrawn
+  auto [json_rc, json] = domain.cli({"--json", "top", "ProducerConsumer", "-n", "2"});
+  INFO(json);
+  REQUIRE(json_rc == 0);
+  std::istringstream lines(json);
+  int tables = 0;
+  for (std::string line; std::getline(lines, line); ++tables)
+    CHECK(Json::parse(line).at("processes").size() == 2);
+  CHECK(tables == 2);
+  auto [bad_rc, bad] = domain.cli({"top", "-w", "--interval", "soon"});
+  INFO(bad);
+  CHECK(bad_rc == 2);
+  CHECK_THAT(bad, Catch::Contains("--interval soon"));
+  REQUIRE(domain.call("app.release", Json{{"app", "ProducerConsumer"}}).has_value());
+  domain.require_clean(pids_of(app));
+}

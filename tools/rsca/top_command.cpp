@@ -1,16 +1,21 @@
-// rsca top [APP]: CPU, resident memory and threads of the daemons and of every process the nodes
-// run, each node asked for its own (node.top) and the domain daemon for itself (domain.top), all at
-// once. A node that does not answer is listed as unreachable; the others are shown all the same.
-// So is a node the domain has lost (its DDS lease ran out): it is not asked, and not left out
-// either, since its devices and components are still the domain's.
+// rsca top [APP] [-w [--interval 1s] [-n K]]: CPU, resident memory and threads of the daemons and
+// of every process the nodes run, each node asked for its own (node.top) and the domain daemon for
+// itself (domain.top), all at once. A node that does not answer is listed as unreachable; the
+// others are shown all the same. So is a node the domain has lost (its DDS lease ran out): it is
+// not asked, and not left out either, since its devices and components are still the domain's.
+#include <unistd.h>
+
+#include <cstdio>
 #include <future>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <fmt/format.h>
 
 #include "commands.hpp"
+#include "common/units.hpp"
 #include "domain_client.hpp"
 #include "exit_codes.hpp"
 #include "protocol/application_ops.hpp"
@@ -106,26 +111,32 @@ void print_table(const Table &table) {
     fmt::print("{:<28} unreachable: {}\n", u.node, u.error);
 }
 
-int top(const std::string &app, const GlobalOptions &global) {
-  auto client = DomainClient::connect(global);
-  if (!client) {
-    fmt::print(stderr, "rsca top: {}\n", client.error().to_string());
-    return kFailed;
-  }
+// How rsca top runs: once, or again every `interval` (-w) until interrupted or `iterations` (-n)
+// tables were printed.
+struct TopOptions {
+  std::string app;
+  bool watch = false;
+  std::string interval = "1s";
+  int iterations = 0; // 0: until interrupted (one without -w)
+};
+
+// One table: every node asked at once. An error is an exit code.
+tl::expected<Table, int> gather(DomainClient &client, const std::string &app,
+                                const GlobalOptions &global) {
   const std::chrono::milliseconds timeout(global.timeout_ms);
   if (!app.empty())
-    if (auto shown = client->call<protocol::application::Show>({app}, timeout); !shown)
-      return report_failure(global, "top", shown.error());
-  auto nodes = client->call<domain_ops::Nodes>({}, timeout);
+    if (auto shown = client.call<protocol::application::Show>({app}, timeout); !shown)
+      return tl::unexpected(report_failure(global, "top", shown.error()));
+  auto nodes = client.call<domain_ops::Nodes>({}, timeout);
   if (!nodes)
-    return report_failure(global, "top", nodes.error());
+    return tl::unexpected(report_failure(global, "top", nodes.error()));
   // Every call is made before any is waited for: the slowest node sets the time, not their sum.
   std::optional<Pending> domain;
   if (app.empty())
-    domain = client->call_async<domain_ops::Top>({}, timeout);
+    domain = client.call_async<domain_ops::Top>({}, timeout);
   std::vector<Pending> pending;
   for (const auto &n : nodes->nodes)
-    pending.push_back(client->call_async_at<node_ops::Top>(n.address, {}, timeout));
+    pending.push_back(client.call_async_at<node_ops::Top>(n.address, {}, timeout));
   Table table;
   if (domain)
     add_domain(table, *domain);
@@ -134,10 +145,47 @@ int top(const std::string &app, const GlobalOptions &global) {
   for (const auto &n : nodes->lost)
     table.unreachable.push_back(
         {n.name, "lost: its DDS lease ran out; the domain keeps it until it is back", true});
-  if (global.json)
+  return table;
+}
+
+// Watching: --json prints one object a line; a terminal is cleared and redrawn; anything else
+// (a pipe, a file) gets one table after the other, a blank line between.
+void show(const Table &table, const TopOptions &options, const GlobalOptions &global) {
+  if (global.json && options.watch)
+    fmt::print("{}\n", json_of(table).dump());
+  else if (global.json)
     print_json(json_of(table));
-  else
+  else {
+    if (options.watch && isatty(STDOUT_FILENO))
+      fmt::print("\x1b[H\x1b[2J");
     print_table(table);
+    if (options.watch && !isatty(STDOUT_FILENO))
+      fmt::print("\n");
+  }
+  std::fflush(stdout); // a follower reads table by table
+}
+
+int top(const TopOptions &options, const GlobalOptions &global) {
+  auto interval = parse_duration(options.interval);
+  if (!interval || interval->infinite() || interval->value->count() <= 0) {
+    fmt::print(stderr, "rsca top: --interval {}: give a duration such as 1s or 500ms\n",
+               options.interval);
+    return kUsage;
+  }
+  auto client = DomainClient::connect(global);
+  if (!client) {
+    fmt::print(stderr, "rsca top: {}\n", client.error().to_string());
+    return kFailed;
+  }
+  const int iterations = options.iterations > 0 ? options.iterations : (options.watch ? 0 : 1);
+  for (int done = 0; iterations == 0 || done < iterations; ++done) {
+    if (done > 0)
+      std::this_thread::sleep_for(*interval->value); // the pace the user asked for
+    auto table = gather(*client, options.app, global);
+    if (!table)
+      return table.error();
+    show(*table, options, global);
+  }
   return kOk;
 }
 
@@ -147,9 +195,20 @@ void add_top_command(CLI::App &app, const GlobalOptions &global, int &exit_code)
   auto *cmd = app.add_subcommand(
       "top", "CPU %, resident memory and threads of the daemons and of each component process, "
              "from every node [APP: only its processes]");
-  auto of_app = std::make_shared<std::string>();
-  cmd->add_option("app", *of_app, "only this running application's processes");
-  cmd->callback([of_app, &global, &exit_code] { exit_code = top(*of_app, global); });
+  auto options = std::make_shared<TopOptions>();
+  cmd->add_option("app", options->app, "only this running application's processes");
+  cmd->add_flag("-w,--watch", options->watch,
+                "Refresh every --interval until interrupted (a terminal is redrawn; otherwise one "
+                "table per interval, with --json one object per line)");
+  cmd->add_option("--interval", options->interval, "The pace of -w (default 1s)");
+  cmd->add_option("-n,--iterations", options->iterations,
+                  "Stop after this many tables (implies -w)")
+      ->check(CLI::PositiveNumber);
+  cmd->callback([options, &global, &exit_code] {
+    if (options->iterations > 0)
+      options->watch = true;
+    exit_code = top(*options, global);
+  });
 }
 
 } // namespace rsca::cli
