@@ -1,5 +1,8 @@
 #include "common/names.hpp"
 
+#include <algorithm>
+#include <cctype>
+
 #include <fmt/format.h>
 
 namespace rsca {
@@ -59,6 +62,44 @@ Expected<void> check_name(std::string_view what, std::string_view name) {
       return refuse("it holds a control character");
   }
   return {};
+}
+
+namespace {
+
+// Levenshtein distance, letters compared without case (Freq and freq are one name to a reader).
+std::size_t edit_distance(std::string_view a, std::string_view b) {
+  const auto lower = [](char c) {
+    return static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  };
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j)
+    row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t above = row[j];
+      row[j] = std::min(
+          {row[j] + 1, row[j - 1] + 1, diagonal + (lower(a[i - 1]) == lower(b[j - 1]) ? 0 : 1)});
+      diagonal = above;
+    }
+  }
+  return row[b.size()];
+}
+
+} // namespace
+
+std::string closest_name(std::string_view name, const std::vector<std::string> &names) {
+  // A third of the name's length, at least one and at most three edits: more reads as another name.
+  const std::size_t most = std::clamp<std::size_t>(name.size() / 3, 1, 3);
+  std::string best;
+  std::size_t best_distance = most + 1;
+  for (const auto &candidate : names)
+    if (const auto d = edit_distance(name, candidate); d < best_distance) {
+      best_distance = d;
+      best = candidate;
+    }
+  return best;
 }
 
 } // namespace rsca

@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "common/diagnostic.hpp"
 
@@ -27,5 +28,9 @@ Expected<void> check_name(std::string_view what, std::string_view name);
 // `text` for a message: at most `max` bytes, control characters as \xNN, and when cut, "..." and
 // how long it was. Never splits a UTF-8 sequence.
 std::string excerpt(std::string_view text, std::size_t max = kExcerptLength);
+
+// The one of `names` a misspelling of which `name` likely is (a small edit distance, letter case
+// ignored), for a message's "did you mean"; empty when none is close.
+std::string closest_name(std::string_view name, const std::vector<std::string> &names);
 
 } // namespace rsca

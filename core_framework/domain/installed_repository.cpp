@@ -114,7 +114,9 @@ CallResult<void> write_files(const fs::path &dir, const std::vector<InstallFile>
     if (!rel)
       return control::call_error(
           Status::BadRequest,
-          fmt::format("file path \"{}\" is not inside an SDR root", excerpt(f.path)));
+          fmt::format("file path \"{}\" is not inside an SDR root (an install names each "
+                      "file relative to the SDR root it comes from)",
+                      excerpt(f.path, protocol::domain::kMaxInstallPath)));
     std::string decoded_bytes;
     std::string_view bytes = f.content;
     if (f.encoding.value_or(protocol::domain::FileEncoding::Text) ==
@@ -159,7 +161,9 @@ write_and_load(const fs::path &dir, const InstallRequest &request, fs::path &sad
   if (!relative)
     return control::call_error(
         Status::BadRequest,
-        fmt::format("the SAD's path \"{}\" is not inside an SDR root", excerpt(request.sad)));
+        fmt::format("the SAD's path \"{}\" is not inside an SDR root (an install names each "
+                    "file relative to the SDR root it comes from)",
+                    excerpt(request.sad, protocol::domain::kMaxInstallPath)));
   sad = *relative;
   if (request.name)
     if (auto named = checked_name(*request.name); !named)

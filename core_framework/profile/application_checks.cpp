@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include "common/names.hpp"
 #include "profile/code_description.hpp"
 #include "profile/profile_loader.hpp"
 #include "profile/property_binding.hpp"
@@ -23,6 +24,35 @@ std::string file_name(const std::filesystem::path &p) {
 // it and starts the device with its default; rsca's node skips it the same way).
 enum class BadValue : std::uint8_t { Refused, Ignored };
 
+// The ids of every property a package defines (its PRF's and its implementations').
+std::vector<std::string> property_ids(const ResolvedSoftPkg &pkg) {
+  std::vector<std::string> ids;
+  auto add = [&](const std::shared_ptr<const Properties> &prf) {
+    if (prf)
+      for (const auto &p : prf->properties)
+        ids.push_back(common_of(p).id);
+  };
+  add(pkg.properties);
+  for (const auto &impl : pkg.implementations)
+    add(impl.properties);
+  return ids;
+}
+
+// The override of a property the package lacks: a warning (REDHAWK ignores the override), which
+// a profile written for rsca, or --strict, refuses.
+Diagnostic unknown_property(const ResolvedSoftPkg &pkg, const PropertyRef &ref,
+                            std::string_view owner) {
+  const std::string close = closest_name(refid_of(ref), property_ids(pkg));
+  return {location_of(ref), "unknown-property",
+          fmt::format("{}: property \"{}\" is not defined by {}{}: the override is ignored "
+                      "(REDHAWK's way; a profile written for rsca, or --strict, refuses it)",
+                      owner, refid_of(ref),
+                      pkg.properties ? file_name(pkg.properties->file)
+                                     : file_name(pkg.spd_path) + " (it has no PRF)",
+                      close.empty() ? "" : fmt::format(" (did you mean \"{}\"?)", close)),
+          Severity::Warning};
+}
+
 // Each override must carry a value that fits its property; one that names no property of the
 // package is ignored with a warning, as REDHAWK does. A package whose files are missing is not
 // checked: its missing files are reported already.
@@ -34,13 +64,7 @@ void check_property_refs(const ResolvedSoftPkg &pkg, const std::vector<PropertyR
   for (const auto &ref : refs) {
     const PropertyDefinition *definition = pkg.find_property(refid_of(ref));
     if (definition == nullptr) {
-      tolerated.push_back(
-          {location_of(ref), "unknown-property",
-           fmt::format("{}: property \"{}\" is not defined by {}: the override is ignored", owner,
-                       refid_of(ref),
-                       pkg.properties ? file_name(pkg.properties->file)
-                                      : file_name(pkg.spd_path) + " (it has no PRF)"),
-           Severity::Warning});
+      tolerated.push_back(unknown_property(pkg, ref, owner));
       continue;
     }
     if (is_empty_override(*definition, ref)) {
@@ -320,13 +344,20 @@ std::vector<Diagnostic> launch_refusals(const ResolvedApplication &app) {
     return missing;
   if (auto misfits = code_refusals(app); !misfits.empty())
     return misfits; // its component would exit at start, saying the same
-  if (!app.warnings.empty()) {
-    auto refused = app.warnings;
-    for (auto &w : refused)
-      w.severity = Severity::Error;
-    return refused;
-  }
+  auto as_errors = [](std::vector<Diagnostic> findings) {
+    for (auto &d : findings)
+      d.severity = Severity::Error;
+    return findings;
+  };
+  if (!app.warnings.empty())
+    return as_errors(app.warnings);
+  if (is_strict(app) && !app.tolerated.empty())
+    return as_errors(app.tolerated);
   return unsupported_connections(*app.sad);
+}
+
+bool is_strict(const ResolvedApplication &app) {
+  return !app.sad->redhawk;
 }
 
 std::string connection_id(const Connection &c, std::size_t index) {

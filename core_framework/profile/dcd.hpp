@@ -21,6 +21,7 @@ struct DeviceConfiguration {
   std::vector<Connection> connections;
   std::string domain_manager;       // REDHAWK's naming-service name; rsca finds the domain by DDS
   std::vector<Diagnostic> warnings; // what reading it tolerated (see detail::ReadContext::warn)
+  bool redhawk = false; // written for REDHAWK (its SCA DOCTYPE): read leniently, see XmlDocument
 
   const ComponentFile *find_component_file(std::string_view id) const;
 };

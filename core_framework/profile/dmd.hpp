@@ -16,6 +16,7 @@ struct DomainManagerConfiguration {
   std::string description;
   LocalFile domain_manager_softpkg;
   std::vector<Diagnostic> warnings; // what reading it tolerated (see detail::ReadContext::warn)
+  bool redhawk = false; // written for REDHAWK (its SCA DOCTYPE): read leniently, see XmlDocument
 };
 
 } // namespace rsca::profile

@@ -33,6 +33,7 @@ struct DevicePkg {
   std::string description;
   HardwareDevice hardware;
   std::vector<Diagnostic> warnings; // what reading it tolerated (see detail::ReadContext::warn)
+  bool redhawk = false; // written for REDHAWK (its SCA DOCTYPE): read leniently, see XmlDocument
 };
 
 } // namespace rsca::profile

@@ -109,6 +109,7 @@ struct Properties {
   std::string file;
   std::vector<PropertyDefinition> properties;
   std::vector<Diagnostic> warnings; // what reading it tolerated (see detail::ReadContext::warn)
+  bool redhawk = false; // written for REDHAWK (its SCA DOCTYPE): read leniently, see XmlDocument
 
   const PropertyDefinition *find(std::string_view id) const;
 };

@@ -191,7 +191,8 @@ const ResolvedSoftPkg *ResolvedApplication::softpkg_of(const ComponentPlacement 
   return it == component_files.end() ? nullptr : it->second.get();
 }
 
-ProfileLoader::ProfileLoader(std::optional<fs::path> sdrroot) : sdrroot_(std::move(sdrroot)) {}
+ProfileLoader::ProfileLoader(std::optional<fs::path> sdrroot, std::optional<fs::path> fallback)
+    : sdrroot_(std::move(sdrroot)), fallback_(std::move(fallback)) {}
 
 Expected<SdrRoot> ProfileLoader::root_for(const fs::path &file) const {
   if (sdrroot_) {
@@ -204,11 +205,9 @@ Expected<SdrRoot> ProfileLoader::root_for(const fs::path &file) const {
       return SdrRoot(shipped);
     return given;
   }
-  if (auto root = SdrRoot::find_for(file))
+  if (auto root = SdrRoot::locate(file, std::nullopt, fallback_))
     return *root;
-  return make_error({file.string(), 0, 0}, "sdrroot",
-                    "no SDR root found: no folder above this file holds dom/ or dev/ "
-                    "(give one with --sdrroot)");
+  return make_error({file.string(), 0, 0}, "sdrroot", std::string(kNoSdrRoot));
 }
 
 Expected<std::shared_ptr<const Descriptor>>

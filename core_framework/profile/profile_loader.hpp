@@ -98,8 +98,10 @@ struct ValidatedDescriptor {
 // process that reads its profiles once (a node daemon, a component) lets its loader go.
 class ProfileLoader {
 public:
-  // `sdrroot`: where absolute profile paths resolve; when empty, found from each file's location.
-  explicit ProfileLoader(std::optional<std::filesystem::path> sdrroot = std::nullopt);
+  // `sdrroot`: where absolute profile paths resolve; when empty, found from each file's location
+  // (SdrRoot::locate, `fallback` standing for SDRROOT).
+  explicit ProfileLoader(std::optional<std::filesystem::path> sdrroot = std::nullopt,
+                         std::optional<std::filesystem::path> fallback = std::nullopt);
 
   Expected<ResolvedApplication> load_application(const std::filesystem::path &sad_file);
   Expected<ResolvedNode> load_node(const std::filesystem::path &dcd_file);
@@ -130,6 +132,7 @@ private:
                                             const SourceLocation &referenced_at);
 
   std::optional<std::filesystem::path> sdrroot_;
+  std::optional<std::filesystem::path> fallback_;
   std::map<std::filesystem::path, Expected<std::shared_ptr<const Descriptor>>> files_;
   std::map<std::filesystem::path, std::optional<FileStamp>> stamps_; // taken before each read
   std::map<std::filesystem::path, Expected<std::shared_ptr<const ResolvedSoftPkg>>> softpkgs_;

@@ -23,9 +23,10 @@ public:
   explicit ReadContext(std::string file) : file_(std::move(file)) {}
   // Reading `document`, whose own warnings (the XML reader's) come first.
   explicit ReadContext(const XmlDocument &document)
-      : file_(document.file), warnings_(document.warnings) {}
+      : file_(document.file), warnings_(document.warnings), redhawk_(document.redhawk) {}
 
   const std::string &file() const { return file_; }
+  bool redhawk() const { return redhawk_; }
   SourceLocation at(const XmlElement &e) const { return {file_, e.line, e.column}; }
 
   void fail(const XmlElement &e, std::string rule, std::string message) {
@@ -106,6 +107,7 @@ private:
   std::string file_;
   Error error_;
   std::vector<Diagnostic> warnings_;
+  bool redhawk_ = false;
 };
 
 // The descriptor read, with the warnings found reading it; or every error found.
@@ -114,6 +116,7 @@ Expected<R> finish(ReadContext &ctx, R &&result) {
   if (!ctx.ok())
     return tl::unexpected(ctx.take_error());
   result.warnings = ctx.take_warnings();
+  result.redhawk = ctx.redhawk();
   return std::forward<R>(result);
 }
 

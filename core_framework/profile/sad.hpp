@@ -52,6 +52,7 @@ struct SoftwareAssembly {
   std::vector<UsesDevice> uses_device_dependencies;
   std::vector<LatencyPath> latency_paths;
   std::vector<Diagnostic> warnings; // what reading it tolerated (see detail::ReadContext::warn)
+  bool redhawk = false; // written for REDHAWK (its SCA DOCTYPE): read leniently, see XmlDocument
 
   const ComponentFile *find_component_file(std::string_view id) const;
   // The instantiation with that id and the placement holding it; nullptr when none.

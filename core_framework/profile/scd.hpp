@@ -51,6 +51,7 @@ struct SoftwareComponent {
   std::vector<PortDefinition> ports;
   std::vector<InterfaceDefinition> interfaces;
   std::vector<Diagnostic> warnings; // what reading it tolerated (see detail::ReadContext::warn)
+  bool redhawk = false; // written for REDHAWK (its SCA DOCTYPE): read leniently, see XmlDocument
 
   const PortDefinition *find_port(std::string_view name, PortDirection direction) const;
   // True when `repid` names this component's own interface or one it supports or inherits.

@@ -19,6 +19,30 @@ std::optional<SdrRoot> SdrRoot::find_for(const fs::path &file) {
   return std::nullopt;
 }
 
+std::optional<SdrRoot> SdrRoot::project_of(const fs::path &file) {
+  std::error_code ec;
+  const fs::path dir = fs::absolute(file, ec).lexically_normal().parent_path();
+  if (ec || !fs::is_regular_file(dir / "CMakeLists.txt", ec))
+    return std::nullopt;
+  SdrRoot project(dir);
+  project.project_ = true;
+  return project;
+}
+
+std::optional<SdrRoot> SdrRoot::locate(const fs::path &file, const std::optional<fs::path> &given,
+                                       const std::optional<fs::path> &fallback) {
+  std::error_code ec;
+  if (given)
+    return SdrRoot(fs::absolute(*given, ec).lexically_normal());
+  if (auto root = find_for(file))
+    return root;
+  if (auto project = project_of(file))
+    return project;
+  if (fallback && !fallback->empty())
+    return SdrRoot(fs::absolute(*fallback, ec).lexically_normal());
+  return std::nullopt;
+}
+
 bool SdrRoot::contains(const fs::path &file) const {
   const auto rel = file.lexically_normal().lexically_relative(root_);
   return !rel.empty() && *rel.begin() != "..";
@@ -28,6 +52,8 @@ fs::path SdrRoot::resolve(std::string_view name, const fs::path &referencing_fil
                           SdrTree tree) const {
   if (!name.empty() && name.front() == '/') {
     name.remove_prefix(1);
+    if (project_) // the project's files lie side by side, its install lays them out
+      return (root_ / fs::path(name).filename()).lexically_normal();
     return (root_ / (tree == SdrTree::Dom ? "dom" : "dev") / fs::path(name)).lexically_normal();
   }
   return (referencing_file.parent_path() / fs::path(name)).lexically_normal();

@@ -100,6 +100,7 @@ struct SoftPkg {
   std::vector<Implementation> implementations;
   std::vector<UsesDevice> uses_devices;
   std::vector<Diagnostic> warnings; // what reading it tolerated (see detail::ReadContext::warn)
+  bool redhawk = false; // written for REDHAWK (its SCA DOCTYPE): read leniently, see XmlDocument
 
   const Implementation *find_implementation(std::string_view id) const;
 };

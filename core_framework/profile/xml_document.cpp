@@ -152,7 +152,10 @@ Expected<XmlDocument> read_xml_profile_text(std::string_view text, std::string f
     return make_error({file_name, line, column}, "xml",
                       "a DOCTYPE declaration here: a profile has at most one, at its start");
   }
-  return (*reader)->read(without_doctype, file_name);
+  auto document = (*reader)->read(without_doctype, file_name);
+  if (document)
+    document->redhawk = without_doctype != text; // a DOCTYPE was blanked
+  return document;
 }
 
 Expected<XmlDocument> read_xml_profile(const std::filesystem::path &file) {

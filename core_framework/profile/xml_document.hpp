@@ -40,6 +40,11 @@ struct XmlDocument {
   // What the schemas refuse but REDHAWK reads, read anyway (e.g. an attribute no schema declares,
   // which is ignored): `rsca validate` shows these, `--strict` refuses them.
   std::vector<Diagnostic> warnings;
+  // Whether the file carries a DOCTYPE: REDHAWK's tools (and SCA 2.2.2's) write the SCA DTD's,
+  // rsca's templates and profiles none. A profile written for REDHAWK is read as REDHAWK reads
+  // it (what REDHAWK tolerates only warns); one written for rsca is read strictly (what would
+  // only warn is an error), see docs/profiles.md.
+  bool redhawk = false;
 };
 
 // The largest profile accepted; a larger file is refused before parsing, since no descriptor

@@ -412,7 +412,7 @@ public:
       builder_.reset({});
       return tl::unexpected(collector.error());
     }
-    return XmlDocument{file, builder_.take_root(), collector.take_warnings()};
+    return XmlDocument{file, builder_.take_root(), collector.take_warnings(), false};
   }
 
 private:

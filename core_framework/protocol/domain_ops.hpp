@@ -100,6 +100,8 @@ namespace rsca::protocol::domain {
 // path. A request's frame on a node's control socket holds 16 MiB (kMaxLinkFrame); base64 adds a
 // third.
 inline constexpr std::uint64_t kMaxInstallBytes = 10ULL << 20U;
+// The longest path of an install's file (PATH_MAX): a refusal quotes one whole.
+inline constexpr std::size_t kMaxInstallPath = 4096;
 
 struct InstallFile {
   std::string path; // relative to the SDR root the profiles came from
@@ -108,7 +110,7 @@ struct InstallFile {
   std::optional<bool> executable;       // absent: false; the file is made executable
   static constexpr auto fields() {
     return std::tuple{
-        required("path", &InstallFile::path),
+        required("path", &InstallFile::path).at_most(kMaxInstallPath),
         // base64 makes 4 bytes of 3
         required("content", &InstallFile::content).at_most(kMaxInstallBytes / 3 * 4 + 4),
         optional("encoding", &InstallFile::encoding),
@@ -125,7 +127,7 @@ struct InstallRequest {
   // warnings.
   std::optional<bool> for_launch;
   static constexpr auto fields() {
-    return std::tuple{required("sad", &InstallRequest::sad),
+    return std::tuple{required("sad", &InstallRequest::sad).at_most(kMaxInstallPath),
                       required("files", &InstallRequest::files),
                       optional("name", &InstallRequest::name),
                       optional("for_launch", &InstallRequest::for_launch)};

@@ -206,7 +206,7 @@ int launch(const std::string &what, const std::string &name, bool no_start,
   int rc = kOk;
   std::optional<UserApplication> file;
   if (fs::is_regular_file(what))
-    if (file = launchable_file(what, global, rc); !file)
+    if (file = launchable_file(what, *assign, global, rc); !file)
       return rc;
   auto client = DomainClient::connect(global);
   if (!client) {

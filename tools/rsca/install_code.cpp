@@ -1,13 +1,17 @@
 #include "install_code.hpp"
 
 #include <algorithm>
+#include <cstdlib>
 #include <fstream>
 #include <optional>
 #include <sstream>
 #include <string>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
+#include "allocator/planner.hpp"
+#include "common/names.hpp"
 #include "content/base64.hpp"
 #include "exit_codes.hpp"
 #include "profile/application_checks.hpp"
@@ -25,23 +29,68 @@ std::string read_text(const fs::path &file) {
   return out.str();
 }
 
-std::optional<fs::path> sdrroot_of(const fs::path &file, const GlobalOptions &global) {
-  if (!global.sdrroot.empty())
-    return fs::absolute(global.sdrroot);
-  if (auto root = profile::SdrRoot::find_for(file))
-    return root->path();
-  return std::nullopt;
+// The SDR root of the user's SAD, as validate finds it (SdrRoot::locate); an error saying how to
+// give one when there is none, or when it is a project not installed yet.
+Expected<fs::path> sdrroot_of(const fs::path &sad, const GlobalOptions &global) {
+  auto root = profile::SdrRoot::locate(sad, given_sdrroot(global), environment_sdrroot());
+  if (!root)
+    return make_error({sad.string(), 0, 0}, "sdrroot", std::string(profile::kNoSdrRoot));
+  if (root->is_project())
+    return make_error(
+        {sad.string(), 0, 0}, "sdrroot",
+        fmt::format("{} is a project `rsca new` made: `rsca validate` reads it in place, but a "
+                    "launch needs it built and installed in an SDR root: cmake -B build && "
+                    "cmake --build build && cmake --install build --prefix \"$SDRROOT\", then "
+                    "rsca launch \"$SDRROOT/dom/waveforms/{}/{}\"",
+                    root->path().string(), sad.stem().stem().string(), sad.filename().string()));
+  return root->path();
+}
+
+// Where the SAD goes among the install's files: its place in the SDR root, or, for a SAD kept
+// outside it (its names are absolute, so resolve in the root all the same), where an install
+// into the root would put it.
+std::string install_path_of_sad(const fs::path &sad, const fs::path &root) {
+  if (profile::SdrRoot(root).contains(sad))
+    return sad.lexically_relative(root).string();
+  return (fs::path("dom/waveforms") / sad.stem().stem() / sad.filename()).string();
+}
+
+// Why `id` is no component of `sad`: its components, and the one meant if one is close.
+std::string not_a_component(const profile::SoftwareAssembly &sad, const std::string &id) {
+  std::vector<std::string> ids;
+  for (const auto &placement : sad.placements)
+    for (const auto &ci : placement.instantiations)
+      ids.push_back(ci.id);
+  const std::string close = closest_name(id, ids);
+  return fmt::format("{} has no component \"{}\"{} (its components: {})", sad.name, id,
+                     close.empty() ? "" : fmt::format(", did you mean \"{}\"?", close),
+                     fmt::join(ids, ", "));
 }
 
 } // namespace
+
+std::optional<fs::path> given_sdrroot(const GlobalOptions &global) {
+  if (global.sdrroot.empty())
+    return std::nullopt;
+  return fs::absolute(global.sdrroot).lexically_normal();
+}
+
+std::optional<fs::path> environment_sdrroot() {
+  const char *value = std::getenv("SDRROOT");
+  if (value == nullptr || *value == '\0')
+    return std::nullopt;
+  return fs::absolute(value).lexically_normal();
+}
+
+profile::ProfileLoader user_profile_loader(const GlobalOptions &global) {
+  return profile::ProfileLoader(given_sdrroot(global), environment_sdrroot());
+}
 
 Expected<UserApplication> read_user_application(const fs::path &sad, const GlobalOptions &global,
                                                 const std::string &name) {
   auto root = sdrroot_of(sad, global);
   if (!root)
-    return make_error(
-        {sad.string(), 0, 0}, "sdrroot",
-        "no SDR root found: no folder above this file holds dom/ or dev/ (give --sdrroot)");
+    return tl::unexpected(root.error());
   profile::ProfileLoader loader(*root);
   auto app = loader.load_application(sad);
   if (!app)
@@ -51,10 +100,11 @@ Expected<UserApplication> read_user_application(const fs::path &sad, const Globa
   user.warnings.insert(user.warnings.end(), user.profile.tolerated.begin(),
                        user.profile.tolerated.end());
   auto &request = user.request;
-  request.sad = user.profile.sad_path.lexically_relative(*root).string();
+  request.sad = install_path_of_sad(user.profile.sad_path, *root);
   for (const auto &f : user.profile.files())
     request.files.push_back(
-        {fs::path(f).lexically_relative(*root).string(), read_text(f), std::nullopt, std::nullopt});
+        {f == user.profile.sad_path ? request.sad : fs::path(f).lexically_relative(*root).string(),
+         read_text(f), std::nullopt, std::nullopt});
   if (auto carried = add_code_files(user.profile, *root, request); !carried)
     return tl::unexpected(carried.error());
   if (!name.empty())
@@ -95,12 +145,19 @@ Expected<void> add_code_files(const profile::ResolvedApplication &app, const fs:
   return {};
 }
 
-std::optional<UserApplication> launchable_file(const std::string &sad, const GlobalOptions &global,
-                                               int &rc) {
+std::optional<UserApplication> launchable_file(const std::string &sad,
+                                               const std::map<std::string, std::string> &assign,
+                                               const GlobalOptions &global, int &rc) {
   auto app = read_user_application(sad, global, "");
   if (!app) {
     fmt::print(stderr, "rsca launch: {}\n", app.error().to_string());
     rc = kInvalidProfile;
+    return std::nullopt;
+  }
+  if (auto stray = allocator::unknown_assignment(app->profile, assign)) {
+    fmt::print(stderr, "rsca launch: --assign {}: {}; nothing was installed\n", *stray,
+               not_a_component(*app->profile.sad, *stray));
+    rc = kUsage;
     return std::nullopt;
   }
   if (auto refused = profile::launch_refusals(app->profile); !refused.empty()) {

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -29,6 +30,13 @@ struct UserApplication {
 std::string as_user_paths(const std::string &text, const std::string &application,
                           const UserApplication &user);
 
+// The SDR root given with --sdrroot (absolute), and SDRROOT's (REDHAWK's variable, where a file
+// with no SDR root above it finds one; profile::SdrRoot::locate has the order); nullopt: none.
+std::optional<std::filesystem::path> given_sdrroot(const GlobalOptions &global);
+std::optional<std::filesystem::path> environment_sdrroot();
+// A loader of the user's profiles, each finding its SDR root so.
+profile::ProfileLoader user_profile_loader(const GlobalOptions &global);
+
 // The application of the SAD `sad` and the install request that carries it, named `name` (empty:
 // the SAD's name); an error located in the user's files. Read here and carried to the domain, so
 // that the CLI may run on another host than the domain daemon.
@@ -37,10 +45,12 @@ Expected<UserApplication> read_user_application(const std::filesystem::path &sad
                                                 const std::string &name);
 
 // A SAD file to launch, read and checked where it stands as the launch will check it
-// (profile::launch_refusals): a SAD no launch could run is refused naming the user's file, line
+// (profile::launch_refusals), with the --assign COMPONENT=DEVICE of the launch: a SAD no launch
+// could run, or an assignment of a component it lacks, is refused naming the user's file, line
 // and column, before anything is sent. nullopt, and rc an exit code, when it is refused.
-std::optional<UserApplication> launchable_file(const std::string &sad, const GlobalOptions &global,
-                                               int &rc);
+std::optional<UserApplication> launchable_file(const std::string &sad,
+                                               const std::map<std::string, std::string> &assign,
+                                               const GlobalOptions &global, int &rc);
 
 // Adds the application's code files to `request`, named relative to the SDR root `root`; an
 // error at the file that cannot be read or does not fit.

@@ -51,20 +51,28 @@ constexpr ProjectFile kDeviceFiles[] = {
 };
 
 // What `rsca new` makes: its files, and what to do next ({0}: the project, {1}: the name).
+// $SDRROOT is REDHAWK's variable, which rsca reads too: the hint says what it is.
 struct ProjectKind {
   std::string_view kind;
   std::span<const ProjectFile> files;
   std::string_view next;
 };
 
+constexpr std::string_view kSdrRootHint =
+    "(SDRROOT: your SDR root, the folder whose dom/ holds applications and components and whose "
+    "dev/ holds devices and nodes, e.g. export SDRROOT=$HOME/sdr; `rsca validate .` reads the "
+    "project's profiles in place, before any install)\n";
+
 constexpr ProjectKind kComponent{"component", kComponentFiles,
-                                 "next:\n  cd {0} && cmake -B build && cmake --build build\n"
+                                 "next:\n  cd {0} && rsca validate .\n"
+                                 "  cmake -B build && cmake --build build\n"
                                  "  cmake --install build --prefix \"$SDRROOT\"\n"
                                  "  rsca launch \"$SDRROOT/dom/waveforms/{1}/{1}.sad.xml\"\n"};
 
 constexpr ProjectKind kDevice{
     "device", kDeviceFiles,
-    "next:\n  cd {0} && cmake -B build && cmake --build build\n"
+    "next:\n  cd {0} && rsca validate .\n"
+    "  cmake -B build && cmake --build build\n"
     "  cmake --install build --prefix \"$SDRROOT\"\n"
     "  rsca domain up --node \"$SDRROOT/dev/nodes/{1}_node/DeviceManager.dcd.xml\"\n"
     "  rsca query {1}_node:{1}_1\n"};
@@ -211,6 +219,7 @@ int new_project(const ProjectKind &kind, const std::string &name, const std::str
   for (const auto &f : *files)
     fmt::print("  {}\n", f.lexically_relative(target).string());
   fmt::print(fmt::runtime(kind.next), target.string(), name);
+  fmt::print("{}", kSdrRootHint);
   return kOk;
 }
 

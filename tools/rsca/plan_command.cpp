@@ -98,9 +98,7 @@ Expected<allocator::DomainState> offline_domain(const std::vector<std::string> &
 
 int plan_offline(const PlanArgs &args, const std::map<std::string, std::string> &assign,
                  const GlobalOptions &global) {
-  const auto sdrroot =
-      global.sdrroot.empty() ? std::nullopt : std::optional<fs::path>(fs::absolute(global.sdrroot));
-  auto application = profile::ProfileLoader(sdrroot).load_application(args.what);
+  auto application = user_profile_loader(global).load_application(args.what);
   if (!application) {
     fmt::print(stderr, "rsca plan: {}\n", application.error().to_string());
     return kInvalidProfile;

@@ -2,12 +2,14 @@
 #include <algorithm>
 #include <filesystem>
 #include <iostream>
+#include <variant>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "commands.hpp"
 #include "exit_codes.hpp"
+#include "install_code.hpp"
 #include "profile/profile_loader.hpp"
 
 namespace rsca::cli {
@@ -57,9 +59,16 @@ struct Outcome {
   fs::path file;
   std::string type;
   Error error;                      // what makes the file invalid
-  std::vector<Diagnostic> warnings; // what does not, unless --strict
+  std::vector<Diagnostic> warnings; // what does not: a REDHAWK profile's, without --strict
   bool valid() const { return error.empty(); }
 };
+
+// A profile written for REDHAWK (its SCA DOCTYPE) is read as REDHAWK reads it, its findings
+// warnings; one written for rsca, or any under --strict, has them as errors: what a launch
+// refuses (profile::launch_refusals) and more.
+bool strict_for(const profile::ValidatedDescriptor &validated, bool strict) {
+  return strict || !std::visit([](const auto &d) { return d.redhawk; }, validated.descriptor);
+}
 
 nlohmann::json to_json(const Diagnostic &d) {
   return {{"file", d.where.file},
@@ -111,10 +120,7 @@ void print_text(const std::vector<Outcome> &outcomes, const std::vector<std::str
 int run(const std::vector<std::string> &paths, bool strict, const GlobalOptions &global) {
   std::vector<std::string> missing;
   auto files = collect(paths, missing);
-  std::optional<fs::path> sdrroot;
-  if (!global.sdrroot.empty())
-    sdrroot = global.sdrroot;
-  profile::ProfileLoader loader(sdrroot);
+  auto loader = user_profile_loader(global);
   std::vector<Outcome> outcomes;
   bool all_valid = true;
   for (const auto &file : files) {
@@ -124,12 +130,12 @@ int run(const std::vector<std::string> &paths, bool strict, const GlobalOptions 
     if (result) {
       o.type = profile::to_string(profile::type_of(result->descriptor));
       o.warnings = result->warnings;
+      if (strict_for(*result, strict))
+        for (auto &w : std::exchange(o.warnings, {}))
+          o.error.add({w.where, w.rule, w.message, Severity::Error});
     } else if (type) {
       o.type = profile::to_string(*type);
     }
-    if (strict)
-      for (auto &w : std::exchange(o.warnings, {}))
-        o.error.add({w.where, w.rule, w.message, Severity::Error});
     all_valid = all_valid && o.valid();
     outcomes.push_back(std::move(o));
   }
@@ -149,7 +155,9 @@ void add_validate_command(CLI::App &app, const GlobalOptions &global, int &exit_
   auto strict = std::make_shared<bool>(false);
   cmd->add_option("paths", *paths, "Profile files or folders")->required();
   cmd->add_flag("--strict", *strict,
-                "Treat warnings (e.g. a connection to a port the component lacks) as errors");
+                "Treat warnings (e.g. a connection to a port the component lacks) as errors in "
+                "REDHAWK's profiles too (those with the SCA DOCTYPE); a profile without it is "
+                "written for rsca and always validated so");
   cmd->callback([paths, strict, &global, &exit_code] { exit_code = run(*paths, *strict, global); });
 }
 
