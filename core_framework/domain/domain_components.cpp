@@ -1,8 +1,6 @@
-// The DomainManager's operations on running components: configure and query (a component of an
-// application, or a device), and what nodes and components report to the domain (processes that
-// exited, connection problems).
+// What nodes and components report to the DomainManager: processes that exited, connection
+// problems (configure and query are domain_properties.cpp's).
 #include <algorithm>
-#include <sstream>
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -10,38 +8,10 @@
 #include "common/names.hpp"
 #include "control/operation.hpp"
 #include "domain/domain_manager_impl.hpp"
-#include "profile/property_binding.hpp"
-#include "profile/property_json.hpp"
 #include "protocol/component_ops.hpp"
-#include "protocol/json_text.hpp"
 
 namespace rsca::domain {
 namespace {
-
-using control::Json;
-using control::Status;
-
-// Where configure/query go: the named component, or else the assembly controller (SCA).
-CallResult<const ComponentInstance *> target_of(const Application &app,
-                                                const std::string &component) {
-  for (const auto &c : app.components) {
-    if (!(component.empty() ? c.assembly_controller : c.id == component))
-      continue;
-    if (c.state == ComponentState::Exited)
-      return control::call_error(
-          Status::Failed, fmt::format("component {} of application {} has exited", c.id, app.name));
-    if (c.state == ComponentState::Unreachable)
-      return control::call_error(
-          Status::Unavailable,
-          fmt::format("component {} of application {} is unreachable: its node {} is lost", c.id,
-                      app.name, c.node));
-    return &c;
-  }
-  return control::call_error(
-      Status::NotFound,
-      fmt::format("application {} has no component {}", app.name,
-                  component.empty() ? "(assembly controller)" : excerpt(component)));
-}
 
 // `why` a process exited and the last lines of its log, each indented under it.
 std::string with_log_tail(const std::string &why, const std::string &tail) {
@@ -59,118 +29,7 @@ std::string with_log_tail(const std::string &why, const std::string &tail) {
   return out;
 }
 
-using TextValues = std::map<std::string, Json>;
-
-// Property values given as text (from the CLI), typed against the component's PRF.
-CallResult<Json> typed_values(const Application &app, const ComponentInstance &component,
-                              const TextValues &values) {
-  const profile::ComponentPlacement *placement = nullptr;
-  app.profile->sad->find_instantiation(component.id, &placement);
-  const auto *pkg = placement != nullptr ? app.profile->softpkg_of(*placement) : nullptr;
-  Json typed = Json::object();
-  for (const auto &[id, text] : values) {
-    const auto *definition = pkg != nullptr ? pkg->find_property(id) : nullptr;
-    if (definition == nullptr)
-      return control::call_error(Status::NotFound, fmt::format("component {} has no property {}",
-                                                               component.id, excerpt(id)));
-    const std::string value = text.is_string() ? text.get<std::string>() : text.dump();
-    profile::PropertyRef ref = profile::SimpleRef{id, value, {}};
-    if (std::holds_alternative<profile::SimpleSequenceProperty>(*definition)) {
-      profile::SimpleSequenceRef seq{id, {}, {}};
-      std::stringstream items(value);
-      for (std::string item; std::getline(items, item, ',');)
-        seq.values.push_back(item);
-      ref = seq;
-    }
-    auto bound = profile::bind_property(*definition, ref);
-    if (!bound)
-      return control::call_error(Status::BadRequest, bound.error());
-    typed[id] = profile::to_json(*bound);
-  }
-  return typed;
-}
-
-// Values given as text, for a device (whose PRF the domain does not hold): booleans and numbers
-// as such, the rest as text.
-Json json_values(const TextValues &values) {
-  Json out = Json::object();
-  for (const auto &[id, v] : values) {
-    const std::string text = v.is_string() ? v.get<std::string>() : v.dump();
-    const auto parsed = protocol::parse_json(text);
-    out[id] = parsed && (parsed->is_boolean() || parsed->is_number()) ? *parsed : Json(text);
-  }
-  return out;
-}
-
-// The running application a configure or query names ("app") and its component that the
-// request goes to ("component", else the assembly controller): copies.
-struct Target {
-  Application app;
-  ComponentInstance component;
-};
-
-CallResult<Target> target_in(ApplicationRegistry &applications, const app_ops::Target &request) {
-  if (!request.app)
-    return control::call_error(Status::BadRequest, "the request names no \"app\" (or \"device\")");
-  const std::string &name = *request.app;
-  auto app = applications.snapshot(name);
-  if (!app)
-    return control::call_error(Status::NotFound,
-                               fmt::format("no application {} is running", excerpt(name)));
-  auto target = target_of(*app, request.component.value_or(""));
-  if (!target)
-    return tl::unexpected(target.error());
-  return Target{*app, **target};
-}
-
 } // namespace
-
-CallResult<protocol::Empty> DomainManager::Impl::configure(const app_ops::ConfigureRequest &r) {
-  const TextValues none;
-  if (r.device) {
-    auto address = device_address(*r.device);
-    if (!address)
-      return tl::unexpected(address.error());
-    return configure_at(*address, json_values(r.values.value_or(none)));
-  }
-  auto target = target_in(applications, r);
-  if (!target)
-    return tl::unexpected(target.error());
-  Json properties(r.properties.value_or(none));
-  if (r.values) {
-    auto typed = typed_values(target->app, target->component, *r.values);
-    if (!typed)
-      return tl::unexpected(typed.error());
-    properties.update(*typed);
-  }
-  return configure_at(target->component.address, std::move(properties));
-}
-
-CallResult<protocol::Empty> DomainManager::Impl::configure_at(const std::string &address,
-                                                              Json properties) {
-  return control::call<protocol::component::Configure>(*endpoint, address, {std::move(properties)},
-                                                       options.call_timeout);
-}
-
-CallResult<protocol::component::QueryReply>
-DomainManager::Impl::query_at(const std::string &address, std::vector<std::string> ids) {
-  return control::call<protocol::component::Query>(*endpoint, address, {std::move(ids)},
-                                                   options.call_timeout);
-}
-
-CallResult<protocol::component::QueryReply>
-DomainManager::Impl::query(const app_ops::QueryRequest &r) {
-  if (r.device) {
-    auto address = device_address(*r.device);
-    if (!address)
-      return tl::unexpected(address.error());
-    return query_at(*address, r.ids);
-  }
-  auto target = target_in(applications, r);
-  if (!target)
-    return tl::unexpected(target.error());
-  return query_at(target->component.address, r.ids);
-}
 
 CallResult<protocol::Empty>
 DomainManager::Impl::component_exited(const protocol::domain::ComponentExitedReport &r) {

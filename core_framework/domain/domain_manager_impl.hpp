@@ -105,8 +105,10 @@ struct DomainManager::Impl {
   CallResult<app_ops::ReleaseReply> release(const app_ops::AppRequest &request);
   CallResult<app_ops::ApplicationView> start_or_stop(const app_ops::AppRequest &request,
                                                      bool start);
-  CallResult<protocol::Empty> configure(const app_ops::ConfigureRequest &request);
+  CallResult<app_ops::ConfigureReply> configure(const app_ops::ConfigureRequest &request);
   CallResult<protocol::component::QueryReply> query(const app_ops::QueryRequest &request);
+  CallResult<protocol::component::QueryReply>
+  query_application(const Application &app, const std::vector<std::string> &ids);
   CallResult<protocol::Empty> configure_at(const std::string &address, control::Json properties);
   CallResult<protocol::component::QueryReply> query_at(const std::string &address,
                                                        std::vector<std::string> ids);

@@ -309,6 +309,25 @@ struct ConfigureRequest : Target {
   }
 };
 
+// What a configure set: the id as the request named it (an external property's id, or the
+// component's own), the component it reached and its property id there, and the typed value.
+struct ConfiguredProperty {
+  std::string id;
+  std::string component; // empty for a device
+  std::string property;
+  Json value;
+  static constexpr auto fields() {
+    using C = ConfiguredProperty;
+    return std::tuple{required("id", &C::id), required("component", &C::component),
+                      required("property", &C::property), required("value", &C::value)};
+  }
+};
+
+struct ConfigureReply {
+  std::vector<ConfiguredProperty> set;
+  static constexpr auto fields() { return std::tuple{required("set", &ConfigureReply::set)}; }
+};
+
 struct QueryRequest : Target {
   std::vector<std::string> ids; // none: every property
   static constexpr auto fields() {
@@ -455,7 +474,7 @@ struct Stop {
 struct Configure {
   static constexpr std::string_view name = "app.configure";
   using Request = ConfigureRequest;
-  using Reply = Empty;
+  using Reply = ConfigureReply;
 };
 struct Query {
   static constexpr std::string_view name = "app.query";

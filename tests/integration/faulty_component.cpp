@@ -9,6 +9,7 @@
 #include <cstring>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "component/runtime.hpp"
 #include "control/link_socket.hpp"
@@ -51,6 +52,13 @@ void mark_signal(int signal) {
   std::raise(signal);
 }
 
+// An entry of "limits": a struct sequence with a sequence member, for the CLI's property syntax.
+struct Limit {
+  std::string name;
+  double max = 0;
+  std::vector<std::int32_t> steps;
+};
+
 class Faulty final : public Component {
 public:
   explicit Faulty(const Context &context) : Component(context) {
@@ -67,6 +75,11 @@ public:
       if (g_fault == "hang_at_configure")
         std::this_thread::sleep_for(std::chrono::hours(1)); // the fault itself: never answer
     });
+    property("gains", gains_);
+    struct_sequence_property("limits", limits_,
+                             {{"limit::name", &Limit::name},
+                              {"limit::max", &Limit::max},
+                              {"limit::steps", &Limit::steps}});
     provides_port<rsca::port::Samples>("samples_in",
                                        [this](const rsca::port::Samples &) { ++received_; });
   }
@@ -106,6 +119,8 @@ private:
 
   std::string fault_ = "none";
   std::uint32_t level_ = 1;
+  std::vector<double> gains_{1.0};
+  std::vector<Limit> limits_;
   std::uint32_t chatter_ = 0;
   std::uint32_t deep_frame_ = 0;
   std::uint64_t chattered_ = 0; // lines logged so far, numbering the next

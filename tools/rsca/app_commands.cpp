@@ -404,6 +404,57 @@ int show_application(const std::string &name, const GlobalOptions &global) {
       });
 }
 
+namespace {
+
+// What a configure set, each as `set ID (COMPONENT:PROPERTY) = VALUE`.
+void print_configured(const app_ops::ConfigureReply &reply) {
+  for (const auto &one : reply.set)
+    fmt::print("set {} ({}{}) = {}\n", one.id, one.component.empty() ? "" : one.component + ":",
+               one.property,
+               one.value.is_string() ? one.value.get<std::string>() : one.value.dump());
+}
+
+// rsca configure TARGET [COMPONENT] property=value...
+void add_configure_command(CLI::App &app, const GlobalOptions &global, int &exit_code) {
+  auto *cmd = app.add_subcommand(
+      "configure",
+      "Set properties of an application (its external properties, else its assembly "
+      "controller's), of one component (APP/COMPONENT or APP COMPONENT), or of a device "
+      "(NODE:DEVICE). Values: a simple as it is (rate=10); a sequence as [1,2,3] or 1,2,3; a "
+      "struct as {member=value,member2=[1,2]}; a sequence of structs as [{a=1},{a=2}]; quote an "
+      "item holding , [ ] { } = as \"...\"; or any value as JSON after json: (s=json:{\"a\":1}). "
+      "Prints what it set: ID (COMPONENT:PROPERTY) = VALUE");
+  auto target = std::make_shared<std::string>();
+  auto args = std::make_shared<std::vector<std::string>>();
+  cmd->add_option("target", *target, "APP, APP/COMPONENT or NODE:DEVICE")->required();
+  cmd->add_option("values", *args, "[COMPONENT] property=value ...")->required();
+  cmd->callback([=, &global, &exit_code] {
+    std::string where = *target;
+    std::vector<std::string> assignments = *args;
+    // APP COMPONENT prop=value: the component as its own word, as APP/COMPONENT.
+    const bool component_word = where.find_first_of("/:") == std::string::npos &&
+                                assignments.size() > 1 &&
+                                assignments.front().find('=') == std::string::npos;
+    if (component_word) {
+      where += "/" + assignments.front();
+      assignments.erase(assignments.begin());
+    }
+    auto values = parse_assignments(assignments);
+    if (!values) {
+      fmt::print(stderr, "rsca configure: give properties as property=value (rsca configure "
+                         "--help says how to write sequences and structs)\n");
+      exit_code = kUsage;
+      return;
+    }
+    app_ops::ConfigureRequest request;
+    set_target(where, request);
+    request.values.emplace(values->begin(), values->end());
+    exit_code = simple_call<app_ops::Configure>("configure", request, global, print_configured);
+  });
+}
+
+} // namespace
+
 void add_application_commands(CLI::App &app, const GlobalOptions &global, int &exit_code) {
   auto *install_cmd = app.add_subcommand(
       "install", "Install an application (its SAD and every profile it names) in the domain");
@@ -504,27 +555,7 @@ void add_application_commands(CLI::App &app, const GlobalOptions &global, int &e
                                                       exit_code);
   add_lifecycle_commands(app, global, exit_code);
 
-  auto *configure_cmd = app.add_subcommand(
-      "configure", "Set properties of an application's assembly controller, one component, or "
-                   "a device (NODE:DEVICE)");
-  auto configure_target = std::make_shared<std::string>();
-  auto assignments = std::make_shared<std::vector<std::string>>();
-  configure_cmd->add_option("target", *configure_target, "APP, APP/COMPONENT or NODE:DEVICE")
-      ->required();
-  configure_cmd->add_option("values", *assignments, "property=value ...")->required();
-  configure_cmd->callback([=, &global, &exit_code] {
-    auto values = parse_assignments(*assignments);
-    if (!values) {
-      fmt::print(stderr, "rsca configure: give properties as property=value\n");
-      exit_code = kUsage;
-      return;
-    }
-    app_ops::ConfigureRequest request;
-    set_target(*configure_target, request);
-    request.values.emplace(values->begin(), values->end());
-    exit_code = simple_call<app_ops::Configure>("configure", request, global,
-                                                [](const auto &) { fmt::print("configured\n"); });
-  });
+  add_configure_command(app, global, exit_code);
 
   auto *query_cmd = app.add_subcommand(
       "query", "Read properties of an application's assembly controller, one component, or a "
