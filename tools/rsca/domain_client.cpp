@@ -179,13 +179,21 @@ int report_failure(const GlobalOptions &global, const std::string &what,
     control::Json reported{{"status", control::to_string(error.status)}, {"message", message}};
     if (!error.details.empty())
       reported["details"] = error.details;
-    print_json({{"error", std::move(reported)}});
+    print_json({{"error", std::move(reported)}, {"exit", exit_code_of(error.status)}});
   } else {
     fmt::print(stderr, "rsca {}: {}\n", what, message);
     for (const auto &detail : error.details)
       fmt::print(stderr, "  {}\n", detail);
   }
   return exit_code_of(error.status);
+}
+
+int fail(const GlobalOptions &global, std::string_view what, int code, const std::string &message) {
+  if (global.json)
+    print_json({{"error", {{"status", exit_name(code)}, {"message", message}}}, {"exit", code}});
+  else
+    fmt::print(stderr, "rsca {}: {}\n", what, message);
+  return code;
 }
 
 void print_json(const control::Json &value) {

@@ -74,6 +74,9 @@ int exit_code_of(control::Status status);
 // Prints a failed call (text or JSON) and returns its exit code.
 int report_failure(const GlobalOptions &global, const std::string &what,
                    const control::CallError &error);
+// A failure the CLI finds itself: "rsca WHAT: MESSAGE" on stderr, or with --json the error
+// object every command prints, {"error": {"status", "message"}, "exit": CODE}. Returns `code`.
+int fail(const GlobalOptions &global, std::string_view what, int code, const std::string &message);
 // Prints a reply as JSON.
 void print_json(const control::Json &value);
 

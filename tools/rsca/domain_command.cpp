@@ -178,12 +178,13 @@ int stop_started(const std::vector<Started> &started, int rc) {
 }
 
 // A daemon `up` started stopped: every other one it started goes too.
-int abandon_up(const std::vector<Started> &started, const Started &stopped) {
-  fmt::print(stderr, "rsca domain up: a daemon (pid {}) stopped; its log ends:\n{}", stopped.pid,
-             tail(stopped.log));
-  fmt::print(stderr, "rsca domain up: the {} other daemon(s) it started are stopped\n",
-             started.size() - 1);
-  return stop_started(started, kFailed);
+int abandon_up(const std::vector<Started> &started, const Started &stopped,
+               const GlobalOptions &global) {
+  return stop_started(
+      started, fail(global, "domain up", kFailed,
+                    fmt::format("a daemon (pid {}) stopped; the {} other daemon(s) it started are "
+                                "stopped; its log ends:\n{}",
+                                stopped.pid, started.size() - 1, tail(stopped.log))));
 }
 
 // Whether every node daemon of `started` from `first_node` on is registered: a domain that lists
@@ -203,26 +204,22 @@ int wait_registered(const std::vector<Started> &started, std::size_t first_node,
                     const fs::path &run, const GlobalOptions &global,
                     protocol::domain::NodesReply &reply) {
   auto client = DomainClient::connect(global);
-  if (!client) {
-    fmt::print(stderr, "rsca domain up: {}\n", client.error().to_string());
-    return kFailed;
-  }
+  if (!client)
+    return fail(global, "domain up", kFailed, client.error().to_string());
   const auto deadline =
       std::chrono::steady_clock::now() + std::chrono::milliseconds(global.timeout_ms) * 4;
   for (;;) {
     for (const auto &s : started)
       if (has_exited(s.pid))
-        return abandon_up(started, s);
+        return abandon_up(started, s, global);
     auto listed = client->call<protocol::domain::Nodes>({}, 1s);
     if (listed && all_registered(*listed, started, first_node)) {
       reply = *listed;
       return kOk;
     }
-    if (std::chrono::steady_clock::now() > deadline) {
-      fmt::print(stderr, "rsca domain up: the nodes did not all register in time (see {})\n",
-                 run.string());
-      return kUnreachable;
-    }
+    if (std::chrono::steady_clock::now() > deadline)
+      return fail(global, "domain up", kUnreachable,
+                  fmt::format("the nodes did not all register in time (see {})", run.string()));
     std::this_thread::sleep_for(50ms); // pacing a poll of the domain, not a wait for a condition
   }
 }
@@ -231,10 +228,8 @@ int wait_registered(const std::vector<Started> &started, std::size_t first_node,
 int start_node(const fs::path &dcd, const std::string &name, const fs::path &run,
                const GlobalOptions &global, std::vector<Started> &started) {
   auto pid = spawn_node(dcd, name, run, global);
-  if (!pid) {
-    fmt::print(stderr, "rsca domain up: {}\n", pid.error().to_string());
-    return kFailed;
-  }
+  if (!pid)
+    return fail(global, "domain up", kFailed, pid.error().to_string());
   started.push_back({*pid, run / (name + ".log"), run / (name + ".pid")});
   return kOk;
 }
@@ -244,11 +239,9 @@ int spawn_extra_nodes(const std::vector<std::string> &dcds, const fs::path &run,
                       const GlobalOptions &global, std::vector<Started> &started) {
   for (const auto &dcd : dcds) {
     const std::string name = fs::path(dcd).parent_path().filename().string();
-    if (auto pid = read_pid(run / (name + ".pid")); pid && alive(*pid)) {
-      fmt::print(stderr, "rsca domain up: a node {} is already up in {} (pid {})\n", name,
-                 run.string(), *pid);
-      return kRejected;
-    }
+    if (auto pid = read_pid(run / (name + ".pid")); pid && alive(*pid))
+      return fail(global, "domain up", kRejected,
+                  fmt::format("a node {} is already up in {} (pid {})", name, run.string(), *pid));
     if (int rc = start_node(fs::absolute(dcd), name, run, global, started); rc != kOk)
       return rc;
   }
@@ -289,36 +282,29 @@ int up(int nodes, bool nodes_given, const std::vector<std::string> &extra_dcds, 
   if (auto pid = read_pid(run / "domaind.pid"); pid && alive(*pid)) {
     if (!extra_dcds.empty() && !nodes_given)
       return add_nodes(extra_dcds, run, global);
-    fmt::print(stderr,
-               "rsca domain up: a domain is already up in {} (domaind pid {}); `rsca domain down` "
-               "first, or `rsca domain up --node DCD` to add a node to it\n",
-               run.string(), *pid);
-    return kRejected;
+    return fail(global, "domain up", kRejected,
+                fmt::format("a domain is already up in {} (domaind pid {}); `rsca domain down` "
+                            "first, or `rsca domain up --node DCD` to add a node to it",
+                            run.string(), *pid));
   }
-  if (auto held = domain_held(global.domain)) {
-    fmt::print(stderr,
-               "rsca domain up: {}; nothing started (stop that domain first, or use another DDS "
-               "domain or tag: RSCA_DDS_DOMAIN, RSCA_DDS_TAG)\n",
-               *held);
-    return kRejected;
-  }
+  if (auto held = domain_held(global.domain))
+    return fail(global, "domain up", kRejected,
+                fmt::format("{}; nothing started (stop that domain first, or use another DDS "
+                            "domain or tag: RSCA_DDS_DOMAIN, RSCA_DDS_TAG)",
+                            *held));
   const fs::path bin = own_folder();
   const fs::path sdrroot = default_sdrroot(global);
   auto domaind = spawn_daemon(bin / "rsca-domaind",
                               {"--dmd", (sdrroot / "dom/domain/DomainManager.dmd.xml").string(),
                                "--repository", (run / "repository").string()},
                               run / "domaind.log", run / "domaind.pid");
-  if (!domaind) {
-    fmt::print(stderr, "rsca domain up: {}\n", domaind.error().to_string());
-    return kFailed;
-  }
+  if (!domaind)
+    return fail(global, "domain up", kFailed, domaind.error().to_string());
   std::vector<Started> started{{*domaind, run / "domaind.log", run / "domaind.pid"}};
   for (int i = 1; i <= nodes; ++i) {
     auto dcd = node_dcd(i, sdrroot, run);
-    if (!dcd) {
-      fmt::print(stderr, "rsca domain up: {}\n", dcd.error().to_string());
-      return stop_started(started, kFailed);
-    }
+    if (!dcd)
+      return stop_started(started, fail(global, "domain up", kFailed, dcd.error().to_string()));
     if (int rc = start_node(*dcd, fmt::format("node{}", i), run, global, started); rc != kOk)
       return stop_started(started, rc);
   }

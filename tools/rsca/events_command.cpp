@@ -7,6 +7,7 @@
 
 #include "commands.hpp"
 #include "control/domain_events.hpp"
+#include "durations.hpp"
 #include "exit_codes.hpp"
 
 namespace rsca::cli {
@@ -39,8 +40,9 @@ void add_events_command(CLI::App &app, const GlobalOptions &global, int &exit_co
   auto count = std::make_shared<int>(0);
   auto wait_ms = std::make_shared<int>(0);
   cmd->add_option("--count", *count, "Stop after this many events");
-  cmd->add_option("--wait-ms", *wait_ms,
-                  "Stop when no event came for this long (counted from when the domain is found)");
+  add_duration_option(*cmd, "wait", *wait_ms,
+                      "Stop when no event came for this long (counted from when the domain is "
+                      "found)");
   cmd->callback([count, wait_ms, &global, &exit_code] {
     auto settings = dds::DdsSettings::from_environment();
     settings.trace = "none";

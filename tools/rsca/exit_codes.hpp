@@ -13,4 +13,11 @@ enum ExitCode : int {
   kFailed = 6,         // the operation was tried and failed (e.g. a launch, rolled back)
 };
 
+// The code's name, as a JSON error's "status" gives it.
+constexpr const char *exit_name(int code) {
+  constexpr const char *names[] = {"ok",          "invalid",  "usage", "not found",
+                                   "unreachable", "rejected", "failed"};
+  return code >= 0 && code <= kFailed ? names[code] : "failed";
+}
+
 } // namespace rsca::cli

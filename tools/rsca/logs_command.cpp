@@ -18,8 +18,8 @@
 #include <fmt/format.h>
 
 #include "commands.hpp"
-#include "common/units.hpp"
 #include "domain_client.hpp"
+#include "durations.hpp"
 #include "exit_codes.hpp"
 #include "protocol/application_ops.hpp"
 #include "protocol/domain_ops.hpp"
@@ -279,15 +279,11 @@ int logs(const LogsOptions &options, const GlobalOptions &global) {
   }
   std::string stamp;
   if (!options.since.empty()) {
-    auto ago = parse_duration(options.since);
-    if (!ago || ago->infinite()) {
-      fmt::print(stderr, "rsca logs: --since {}: {}\n", options.since,
-                 ago ? "a duration, not infinite" : ago.error());
-      return kUsage;
-    }
-    stamp =
-        local_stamp(std::chrono::system_clock::now() -
-                    std::chrono::duration_cast<std::chrono::system_clock::duration>(*ago->value));
+    auto ago = parse_cli_duration(options.since);
+    if (!ago)
+      return fail(global, "logs", kUsage, fmt::format("--since: {}", ago.error()));
+    stamp = local_stamp(std::chrono::system_clock::now() -
+                        std::chrono::duration_cast<std::chrono::system_clock::duration>(*ago));
   }
   int rc = kOk;
   auto sources = sources_of(*client, options, global, rc);
@@ -323,7 +319,7 @@ void add_logs_command(CLI::App &app, const GlobalOptions &global, int &exit_code
                 "which its rollback ended: the domain remembers the last 16 failed launches, a "
                 "node keeps the log files (docs/architecture.md)");
   cmd->add_option("--since", options->since,
-                  "only the lines logged in the last T (a duration: 90s, 3600s)");
+                  "only the lines logged in the last T (a duration: 90s, 5m, 1h)");
   cmd->add_flag("-f,--follow", options->follow, "go on printing what is logged, until Ctrl-C");
   cmd->callback([options, lines, &global, &exit_code] {
     if (options->target.empty() && !options->failed) {

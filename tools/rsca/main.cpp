@@ -1,9 +1,20 @@
 // rsca: the command-line front end of the rsca domain.
+//
+// One name per idea across the commands: -o/--out is where a command writes what it makes (a
+// picture, a project; --output and --dir stay as aliases); --run-dir is the folder a local domain
+// lives in (its pid files, logs, sockets), which `domain up` makes and `domain down` reads, not an
+// output. A duration is a number and a unit (500ms, 5s, 5m, 1h: durations.hpp) under the idea's
+// name (--timeout, --wait, --since); an option of the old spelling, --NAME-ms, stays as an alias.
+// --json makes every command print JSON, and its failures {"error": {...}, "exit": CODE}.
+#include <algorithm>
+#include <cstring>
 #include <string>
 
 #include <CLI/CLI.hpp>
 
 #include "commands.hpp"
+#include "domain_client.hpp"
+#include "durations.hpp"
 #include "exit_codes.hpp"
 
 int main(int argc, char **argv) {
@@ -17,11 +28,13 @@ int main(int argc, char **argv) {
                  "SDR root where absolute profile paths resolve (default: the nearest folder "
                  "above each file that holds dom/ or dev/)");
   app.add_option("--domain", global.domain, "The domain's name")->capture_default_str();
-  app.add_option("--timeout-ms", global.timeout_ms, "Timeout of each request to the domain")
-      ->capture_default_str();
+  rsca::cli::add_duration_option(app, "timeout", global.timeout_ms,
+                                 "Timeout of each request to the domain (default 5s)");
   app.footer(
-      "Exit codes: 0 ok, 1 invalid profile or request, 2 usage error, 3 not found,\n"
-      "4 domain unreachable, 5 rejected by the domain, 6 failed (e.g. a launch, rolled back).\n"
+      "Exit codes: 0 ok, 1 invalid profile or request, 2 usage error (also a local file error,\n"
+      "e.g. `new` over an existing folder), 3 not found, 4 domain unreachable, 5 rejected by\n"
+      "the domain, 6 failed (e.g. a launch, rolled back). With --json a failure prints\n"
+      "{\"error\": {\"status\", \"message\"}, \"exit\": CODE}.\n"
       "The DDS domain is chosen with RSCA_DDS_DOMAIN (default 0).");
 
   int exit_code = rsca::cli::kOk;
@@ -39,8 +52,16 @@ int main(int argc, char **argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError &e) {
-    int code = app.exit(e);
-    return code == 0 ? rsca::cli::kOk : rsca::cli::kUsage;
+    // --json may not have been read yet when the parse failed: looked for among the words.
+    const bool json = global.json || std::any_of(argv + 1, argv + argc, [](const char *word) {
+                        return std::strcmp(word, "--json") == 0;
+                      });
+    if (e.get_exit_code() == 0 || !json) {
+      const int code = app.exit(e);
+      return code == 0 ? rsca::cli::kOk : rsca::cli::kUsage;
+    }
+    global.json = true;
+    return rsca::cli::fail(global, "", rsca::cli::kUsage, e.what());
   }
   return exit_code;
 }

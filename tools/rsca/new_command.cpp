@@ -20,6 +20,7 @@
 
 #include "commands.hpp"
 #include "common/text.hpp"
+#include "domain_client.hpp"
 #include "exit_codes.hpp"
 
 namespace rsca::cli {
@@ -188,26 +189,24 @@ write_project(const ProjectKind &kind, const std::string &name, const fs::path &
 
 int new_project(const ProjectKind &kind, const std::string &name, const std::string &dir,
                 const GlobalOptions &global) {
-  if (!valid_name(name)) {
-    fmt::print(stderr,
-               "rsca new {}: \"{}\" is not a name: a letter, then letters, digits or _ "
-               "(at most 64), and not a C++ keyword nor a name the project's code or CMake "
-               "keeps for itself\n",
-               kind.kind, name);
-    return kUsage;
-  }
+  if (!valid_name(name))
+    return fail(global, fmt::format("new {}", kind.kind), kUsage,
+                fmt::format("\"{}\" is not a name: a letter, then letters, digits or _ (at most "
+                            "64), and not a C++ keyword nor a name the project's code or CMake "
+                            "keeps for itself",
+                            name));
   const fs::path target = fs::absolute(fs::path(dir) / name).lexically_normal();
   std::error_code ec;
-  if (fs::exists(target, ec)) {
-    fmt::print(stderr, "rsca new {}: {} already exists; nothing written\n", kind.kind,
-               target.string());
-    return kRejected;
-  }
+  // A local file error, as a usage error is: the domain is not asked (it was exit code 5, the
+  // domain's refusal).
+  if (fs::exists(target, ec))
+    return fail(global, fmt::format("new {}", kind.kind), kUsage,
+                fmt::format("{} already exists; nothing written (give another NAME, or another "
+                            "folder with -o/--out)",
+                            target.string()));
   auto files = write_project(kind, name, target);
-  if (!files) {
-    fmt::print(stderr, "rsca new {}: {}\n", kind.kind, files.error());
-    return kFailed;
-  }
+  if (!files)
+    return fail(global, fmt::format("new {}", kind.kind), kFailed, files.error());
   if (global.json) {
     nlohmann::json out{{std::string(kind.kind), name}, {"project", target.string()}, {"files", {}}};
     for (const auto &f : *files)
@@ -230,7 +229,8 @@ void add_project_command(CLI::App &parent, const ProjectKind &kind, std::string 
   auto dir = std::make_shared<std::string>(".");
   cmd->add_option("name", *name, fmt::format("The {}'s name (a C++ identifier)", kind.kind))
       ->required();
-  cmd->add_option("--dir", *dir, "Where the project's folder NAME is made")->capture_default_str();
+  cmd->add_option("-o,--out,--dir", *dir, "Where the project's folder NAME is made")
+      ->capture_default_str();
   cmd->callback([&kind, name, dir, &global, &exit_code] {
     exit_code = new_project(kind, *name, *dir, global);
   });

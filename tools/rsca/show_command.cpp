@@ -1,11 +1,14 @@
 // rsca show PATH: the resolved model of one profile as a readable tree.
+#include <algorithm>
 #include <filesystem>
 #include <iostream>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
+#include <nlohmann/json.hpp>
 
 #include "commands.hpp"
+#include "domain_client.hpp"
 #include "exit_codes.hpp"
 #include "profile/profile_loader.hpp"
 #include "profile/property_binding.hpp"
@@ -23,16 +26,30 @@ struct Overloaded : Ts... {
 template <class... Ts>
 Overloaded(Ts...) -> Overloaded<Ts...>;
 
-// Writes indented lines.
+// Writes indented lines, and keeps them for --json.
 class Tree {
 public:
   void line(int depth, const std::string &text) {
     out_ += std::string(static_cast<std::size_t>(depth) * 2, ' ') + text + '\n';
+    lines_.emplace_back(static_cast<std::size_t>(std::max(depth, 0)), text);
   }
   const std::string &str() const { return out_; }
+  // The lines nested as they are indented: [{"text": ..., "children": [...]}, ...].
+  nlohmann::json json() const {
+    nlohmann::json root = nlohmann::json::array();
+    std::vector<nlohmann::json *> open{&root}; // open[d]: where a line of depth d goes
+    for (const auto &[depth, text] : lines_) {
+      open.resize(std::min(depth, open.size() - 1) + 1);
+      auto &node = open.back()->emplace_back(
+          nlohmann::json{{"text", text}, {"children", nlohmann::json::array()}});
+      open.push_back(&node["children"]);
+    }
+    return root;
+  }
 
 private:
   std::string out_;
+  std::vector<std::pair<std::size_t, std::string>> lines_;
 };
 
 std::string type_name(TypeSpec spec) {
@@ -242,28 +259,45 @@ void show_node(Tree &t, const ResolvedNode &node) {
   }
 }
 
+// A running application's name: a folder of that name here is no profile (a profile is a file),
+// so the application is shown, and the note says so.
+int show_running(const std::string &name, const GraphOptions &graph, const GlobalOptions &global) {
+  std::error_code ec;
+  if (fs::is_directory(name, ec) && !global.json)
+    fmt::print(stderr,
+               "rsca show: showing the running application {}, not the folder {} here (a "
+               "profile is a file)\n",
+               name, name);
+  if (!graph.format.empty())
+    return show_application_graph(name, graph, global);
+  return show_application(name, global);
+}
+
 int run(const std::string &path, const GraphOptions &graph, const GlobalOptions &global) {
-  const bool profile = fs::exists(path);
-  if (!profile && !graph.format.empty())
-    return show_application_graph(path, graph, global);
-  if (!profile)
-    return show_application(path, global); // not a profile: a running application's name
-  if (!graph.format.empty()) {
-    fmt::print(stderr, "rsca show: --graph draws a running application, and {} is a file\n", path);
-    return kUsage;
-  }
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec))
+    return show_running(path, graph, global);
+  if (!graph.format.empty())
+    return fail(global, "show", kUsage,
+                fmt::format("--graph draws a running application, and {} is a file", path));
   std::optional<fs::path> sdrroot;
   if (!global.sdrroot.empty())
     sdrroot = global.sdrroot;
   ProfileLoader loader(sdrroot);
   auto descriptor = loader.validate(path);
   if (!descriptor) {
+    if (global.json)
+      return fail(global, "show", kInvalidProfile, descriptor.error().to_string());
     fmt::print(stderr, "{}\n", descriptor.error().to_string());
     return kInvalidProfile;
   }
   Tree t;
-  for (const auto &w : descriptor->warnings)
-    fmt::print(stderr, "{}\n", to_string(w));
+  nlohmann::json warnings = nlohmann::json::array();
+  for (const auto &w : descriptor->warnings) {
+    warnings.push_back(to_string(w));
+    if (!global.json)
+      fmt::print(stderr, "{}\n", to_string(w));
+  }
   switch (type_of(descriptor->descriptor)) {
   case DescriptorType::SAD:
     show_application(t, *loader.load_application(path));
@@ -292,7 +326,11 @@ int run(const std::string &path, const GraphOptions &graph, const GlobalOptions 
     break;
   }
   }
-  std::cout << t.str();
+  if (global.json)
+    std::cout << nlohmann::json{{"path", path}, {"warnings", warnings}, {"tree", t.json()}}.dump(2)
+              << '\n';
+  else
+    std::cout << t.str();
   return kOk;
 }
 
@@ -310,7 +348,7 @@ void add_show_command(CLI::App &app, const GlobalOptions &global, int &exit_code
                                  "A running application's picture: dot (Graphviz's text) or svg "
                                  "(drawn by Graphviz's dot, of the Debian package graphviz)")
                      ->check(CLI::IsMember({"dot", "svg"}));
-  cmd->add_option("-o,--output", graph->output, "Write the picture to this file, not stdout")
+  cmd->add_option("-o,--out,--output", graph->output, "Write the picture to this file, not stdout")
       ->needs(format);
   cmd->callback([path, graph, &global, &exit_code] { exit_code = run(*path, *graph, global); });
 }
