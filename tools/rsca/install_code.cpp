@@ -69,6 +69,14 @@ std::string not_a_component(const profile::SoftwareAssembly &sad, const std::str
 
 } // namespace
 
+std::optional<std::string> stray_assignment(const profile::ResolvedApplication &app,
+                                            const std::map<std::string, std::string> &assign) {
+  auto stray = allocator::unknown_assignment(app, assign);
+  if (!stray)
+    return std::nullopt;
+  return fmt::format("--assign {}: {}", *stray, not_a_component(*app.sad, *stray));
+}
+
 std::optional<fs::path> given_sdrroot(const GlobalOptions &global) {
   if (global.sdrroot.empty())
     return std::nullopt;
@@ -154,9 +162,8 @@ std::optional<UserApplication> launchable_file(const std::string &sad,
     rc = kInvalidProfile;
     return std::nullopt;
   }
-  if (auto stray = allocator::unknown_assignment(app->profile, assign)) {
-    fmt::print(stderr, "rsca launch: --assign {}: {}; nothing was installed\n", *stray,
-               not_a_component(*app->profile.sad, *stray));
+  if (auto stray = stray_assignment(app->profile, assign)) {
+    fmt::print(stderr, "rsca launch: {}; nothing was installed\n", *stray);
     rc = kUsage;
     return std::nullopt;
   }

@@ -37,6 +37,11 @@ std::optional<std::filesystem::path> environment_sdrroot();
 // A loader of the user's profiles, each finding its SDR root so.
 profile::ProfileLoader user_profile_loader(const GlobalOptions &global);
 
+// Why `assign` (--assign COMPONENT=DEVICE) names a component `app` lacks, with the one meant if
+// one is close; nullopt when each names one of its components.
+std::optional<std::string> stray_assignment(const profile::ResolvedApplication &app,
+                                            const std::map<std::string, std::string> &assign);
+
 // The application of the SAD `sad` and the install request that carries it, named `name` (empty:
 // the SAD's name); an error located in the user's files. Read here and carried to the domain, so
 // that the CLI may run on another host than the domain daemon.

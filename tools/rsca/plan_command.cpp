@@ -103,6 +103,11 @@ int plan_offline(const PlanArgs &args, const std::map<std::string, std::string> 
     fmt::print(stderr, "rsca plan: {}\n", application.error().to_string());
     return kInvalidProfile;
   }
+  // The domain's plan refuses it too; offline, an assignment of no component went unnoticed.
+  if (auto stray = stray_assignment(*application, assign)) {
+    fmt::print(stderr, "rsca plan: {}\n", *stray);
+    return kUsage;
+  }
   auto domain = offline_domain(args.nodes);
   if (!domain) {
     fmt::print(stderr, "rsca plan: {}\n", domain.error().to_string());
