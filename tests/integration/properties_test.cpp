@@ -1,6 +1,8 @@
 // Properties from the CLI (issue 39, item 6): an application's external properties configured and
 // queried under the application's name, reaching the component the SAD maps them to; and struct
 // and sequence properties written in the CLI's syntax (`rsca configure --help`).
+#include <filesystem>
+
 #include <catch2/catch.hpp>
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -121,4 +123,38 @@ TEST_CASE("struct, sequence and struct sequence properties set from the CLI's sy
   CHECK(queried_property(domain, "Healthy", "Victim_1", "gains") == Json::array());
   CHECK(queried_property(domain, "Healthy", "Victim_1", "limits").size() == 2);
   CHECK(queried_property(domain, "Healthy", "Producer_1", "stream").at("stream_id") == "j");
+}
+
+namespace {
+
+// A folder made for a test in the working folder, removed when it ends (if the test made it).
+struct ShowNameFolder {
+  std::filesystem::path path;
+  bool made = false;
+  explicit ShowNameFolder(std::filesystem::path where) : path(std::move(where)) {
+    std::error_code ec;
+    made = std::filesystem::create_directory(path, ec);
+  }
+  ~ShowNameFolder() {
+    std::error_code ec;
+    if (made)
+      std::filesystem::remove(path, ec);
+  }
+  ShowNameFolder(const ShowNameFolder &) = delete;
+  ShowNameFolder &operator=(const ShowNameFolder &) = delete;
+};
+
+} // namespace
+
+TEST_CASE("rsca show NAME shows the running application NAME, not a folder NAME in the working "
+          "folder, and says which it showed",
+          "[integration][cli]") {
+  TestDomain domain;
+  domain.launch_shipped("ProducerConsumer");
+  const ShowNameFolder folder(std::filesystem::current_path() / "ProducerConsumer");
+  REQUIRE(std::filesystem::is_directory(folder.path));
+  const std::string out = property_cli(domain, 0, {"show", "ProducerConsumer"});
+  CHECK_THAT(out, Catch::Contains("application ProducerConsumer"));
+  CHECK_THAT(out, Catch::Contains("Producer_1"));
+  CHECK_THAT(out, Catch::Contains("not the folder ProducerConsumer here"));
 }
