@@ -3,6 +3,8 @@
 // allocation); reading fills a value whose buffers are reused from sample to sample.
 #pragma once
 
+#include <memory>
+
 #include "component/port_types.hpp"
 #include "ports.h" // generated from dds/ports.idl
 
@@ -35,6 +37,21 @@ inline const dds_topic_descriptor_t *descriptor(PortType type) {
     return Traits<PropertyEvent>::descriptor();
   case PortType::Command:
     return Traits<Command>::descriptor();
+  }
+  return nullptr;
+}
+
+// One `Of<T>` for the value type T that `type` carries, as a `Base`: a conversion per port type
+// (component/record_relay.hpp, component/sample_view.hpp).
+template <typename Base, template <typename> class Of>
+std::unique_ptr<Base> make_for(PortType type) {
+  switch (type) {
+  case PortType::Samples:
+    return std::make_unique<Of<Samples>>();
+  case PortType::PropertyEvent:
+    return std::make_unique<Of<PropertyEvent>>();
+  case PortType::Command:
+    return std::make_unique<Of<Command>>();
   }
   return nullptr;
 }

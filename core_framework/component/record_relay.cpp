@@ -76,15 +76,7 @@ private:
 } // namespace
 
 std::unique_ptr<RecordRelay> RecordRelay::of(port::PortType type) {
-  switch (type) {
-  case port::PortType::Samples:
-    return std::make_unique<RecordRelayOf<port::Samples>>();
-  case port::PortType::PropertyEvent:
-    return std::make_unique<RecordRelayOf<port::PropertyEvent>>();
-  case port::PortType::Command:
-    return std::make_unique<RecordRelayOf<port::Command>>();
-  }
-  return nullptr;
+  return port::wire::make_for<RecordRelay, RecordRelayOf>(type);
 }
 
 } // namespace rsca::component

@@ -154,6 +154,7 @@ struct DeviceManager::Impl {
   op::StatusReply status() const;
   std::vector<op::ProcessRecord> running() const;
   CallResult<op::TopReply> top();
+  CallResult<op::TapReply> tap(const op::TapRequest &request);
   void rotate_logs() const;
   void sweep_logs() const;
 };
@@ -423,6 +424,18 @@ CallResult<op::TopReply> DeviceManager::Impl::top() {
   return reply;
 }
 
+// A viewer's tap of a same-host topic (rsca echo, rsca hz), opened or renewed.
+CallResult<op::TapReply> DeviceManager::Impl::tap(const op::TapRequest &request) {
+  if (!host_data)
+    return control::call_error(Status::Unavailable,
+                               "this node has no shared memory: its topics go over DDS");
+  auto tapped = host_data->tap(
+      {request.topic, 0, request.repid, std::chrono::milliseconds(request.lease_ms)});
+  if (!tapped)
+    return control::call_error(Status::NotFound, tapped.error());
+  return op::TapReply{std::move(*tapped)};
+}
+
 void DeviceManager::Impl::rotate_logs() const {
   for (const auto &p : running())
     if (auto rotated = rotate_if_over(p.log, options.log_max_bytes); !rotated)
@@ -453,6 +466,8 @@ void DeviceManager::Impl::serve() {
   control::serve<op::DaemonLogs>(*endpoint, [this](const auto &request, const auto &) {
     return read_daemon_log(options.log_dir, dcd->name, request);
   });
+  control::serve<op::Tap>(*endpoint,
+                          [this](const auto &request, const auto &) { return tap(request); });
 }
 
 DeviceManager::DeviceManager(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -529,6 +544,13 @@ DeviceManager::create(std::shared_ptr<dds::Participant> participant, NodeOptions
         });
     if (!relayed)
       return tl::unexpected(relayed.error());
+    auto tapped = impl->host_data->start_taps(
+        [participant](const shm::Arena &arena,
+                      std::uint64_t doorbell) -> Expected<std::unique_ptr<TopicTaps>> {
+          return TopicTaps::start(participant, arena, doorbell);
+        });
+    if (!tapped)
+      return tl::unexpected(tapped.error());
   }
   auto links = ProcessLinks::start(*impl->endpoint, impl->host_data.get());
   if (!links)

@@ -23,20 +23,55 @@ Expected<std::unique_ptr<HostData>> HostData::create(shm::RingLimits rings, std:
   return std::unique_ptr<HostData>(new HostData(std::move(*arena), rings));
 }
 
-Expected<void> HostData::start_relay(const MakeRelay &make) {
-  std::lock_guard lock(mutex_);
+// The relay's thread and the taps' sleep each on a doorbell of their own: it goes again when
+// `make` fails.
+template <typename Make>
+auto HostData::with_doorbell_locked(const Make &make, const char *what) {
+  using Made = std::decay_t<decltype(*make(arena_, std::uint64_t{0}))>;
+  using Result = Expected<std::pair<Made, std::uint64_t>>;
   auto doorbell = allocator_.allocate(sizeof(shm::Doorbell));
   if (!doorbell)
-    return make_error({"node", 0, 0}, "relay", "the host's arena has no room for a doorbell");
+    return Result(make_error({"node", 0, 0}, what, "the host's arena has no room for a doorbell"));
   new (arena_.at(*doorbell, sizeof(shm::Doorbell))) shm::Doorbell();
-  auto relay = make(arena_, *doorbell);
-  if (!relay) {
+  auto made = make(arena_, *doorbell);
+  if (!made) {
     allocator_.release(*doorbell);
-    return tl::unexpected(relay.error());
+    return Result(tl::unexpected(made.error()));
   }
-  relay_doorbell_ = *doorbell;
-  relay_ = std::move(*relay);
+  return Result(std::pair{std::move(*made), *doorbell});
+}
+
+Expected<void> HostData::start_relay(const MakeRelay &make) {
+  std::lock_guard lock(mutex_);
+  auto relay = with_doorbell_locked(make, "relay");
+  if (!relay)
+    return tl::unexpected(relay.error());
+  std::tie(relay_, relay_doorbell_) = std::move(*relay);
   return {};
+}
+
+Expected<void> HostData::start_taps(const MakeTaps &make) {
+  std::lock_guard lock(mutex_);
+  auto taps = with_doorbell_locked(make, "tap");
+  if (!taps)
+    return tl::unexpected(taps.error());
+  taps_ = std::move(taps->first);
+  return {};
+}
+
+tl::expected<std::string, std::string> HostData::tap(TapRoute route) {
+  std::lock_guard lock(mutex_);
+  if (!taps_)
+    return tl::unexpected(
+        std::string("this node has no taps (no shared memory for its host's data)"));
+  auto ring = rings_.find(route.topic);
+  if (ring == rings_.end())
+    return tl::unexpected(
+        fmt::format("no same-host ring of topic {} on this node (its writer is not here, or the "
+                    "connection is gone)",
+                    route.topic));
+  route.ring = ring->second.offset;
+  return taps_->open(route, ring->second.owner);
 }
 
 std::optional<std::pair<std::uint64_t, std::string>> HostData::reserve_page() {
@@ -154,6 +189,8 @@ void HostData::free_ring_locked(const std::string &topic) {
   auto ring = rings_.find(topic);
   if (ring == rings_.end())
     return;
+  if (taps_) // it reads the ring: it goes first
+    taps_->close(topic);
   allocator_.release(ring->second.offset);
   spdlog::debug("host data: the ring of topic {} is freed", topic);
   rings_.erase(ring);

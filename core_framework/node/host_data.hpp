@@ -23,6 +23,7 @@
 
 #include "common/diagnostic.hpp"
 #include "node/topic_bridge.hpp"
+#include "node/topic_tap.hpp"
 #include "protocol/component_ops.hpp"
 #include "shm/arena.hpp"
 #include "shm/ring.hpp"
@@ -49,6 +50,14 @@ public:
   using MakeRelay = std::function<Expected<std::unique_ptr<TopicRelay>>(const shm::Arena &arena,
                                                                         std::uint64_t doorbell)>;
   Expected<void> start_relay(const MakeRelay &make);
+  // Taps rings for viewers (node.tap) through the taps `make` returns for this arena and a
+  // doorbell of their own in it (node/topic_tap.hpp). Without them, a tap is refused.
+  using MakeTaps = std::function<Expected<std::unique_ptr<TopicTaps>>(const shm::Arena &arena,
+                                                                      std::uint64_t doorbell)>;
+  Expected<void> start_taps(const MakeTaps &make);
+  // A viewer's tap of `route.topic`'s ring, opened or renewed: its DDS topic. An error when this
+  // host has no ring of that topic.
+  tl::expected<std::string, std::string> tap(TapRoute route);
   // A page for a process about to start, and the value of shm::kArenaVariable that tells it
   // (the arena at shm::kArenaFd); adopt() binds it to the process once it runs.
   std::optional<std::pair<std::uint64_t, std::string>> reserve_page();
@@ -98,6 +107,9 @@ private:
   using EndKey = std::tuple<pid_t, std::string, std::string, std::string>;
 
   HostData(shm::Arena arena, shm::RingLimits rings);
+  // What `make` makes with a doorbell of its own in the arena, and the doorbell's offset.
+  template <typename Make>
+  auto with_doorbell_locked(const Make &make, const char *what);
   tl::expected<Ring *, std::string> ring_of_locked(const std::string &topic);
   void release_locked(const End &end, bool lost);
   void free_ring_locked(const std::string &topic);
@@ -117,6 +129,7 @@ private:
   std::map<pid_t, std::uint64_t> pages_;
   std::uint64_t relay_doorbell_ = 0;
   // Declared last: destroyed first, while the arena and its rings are still there.
+  std::unique_ptr<TopicTaps> taps_;
   std::unique_ptr<TopicRelay> relay_;
 };
 

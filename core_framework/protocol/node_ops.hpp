@@ -386,6 +386,51 @@ struct LogsReply {
   }
 };
 
+// rsca echo / rsca hz: a lossy copy of a same-host topic's records (node/topic_tap.hpp), on a
+// topic of its own (protocol::tap_topic) with the QoS kTapQos, for as long as the viewer renews
+// it: a viewer that stops reading, or dies, never slows the topic's writers or changes the
+// connection.
+struct TapRequest {
+  static constexpr std::size_t kMaxTopic = 512;
+  static constexpr std::uint32_t kMaxLeaseMs = 60'000;
+  std::string topic; // the connection's topic, which the node's ring carries
+  std::string repid; // its port type (component/port_types.hpp)
+  std::uint32_t lease_ms = 0;
+  static constexpr auto fields() {
+    using R = TapRequest;
+    return std::tuple{required("topic", &R::topic), required("repid", &R::repid),
+                      required("lease_ms", &R::lease_ms)};
+  }
+  std::optional<DecodeError> check() const {
+    if (topic.empty() || topic.size() > kMaxTopic)
+      return DecodeError{"topic", fmt::format("empty or longer than {}", kMaxTopic)};
+    if (repid.size() > kMaxTopic)
+      return DecodeError{"repid", fmt::format("longer than {}", kMaxTopic)};
+    if (lease_ms == 0 || lease_ms > kMaxLeaseMs)
+      return DecodeError{"lease_ms", fmt::format("not within 1-{}", kMaxLeaseMs)};
+    return std::nullopt;
+  }
+};
+
+struct TapReply {
+  std::string tap_topic;
+  static constexpr auto fields() { return std::tuple{required("tap_topic", &TapReply::tap_topic)}; }
+  std::optional<DecodeError> check() const {
+    if (tap_topic.empty() || tap_topic.size() > TapRequest::kMaxTopic * 2)
+      return DecodeError{"tap_topic", "empty or too long"};
+    return std::nullopt;
+  }
+};
+
+// The QoS of a tap's writer and its viewers' readers (dds/port_qos.hpp's JSON form): best effort,
+// volatile, the newest few: dropped, never waited for, when a viewer is slow.
+inline nlohmann::json tap_qos() {
+  return {{"reliability", "besteffort"},
+          {"durability", "volatile"},
+          {"history", "keeplast"},
+          {"depth", 64}};
+}
+
 struct Execute {
   static constexpr std::string_view name = "node.execute";
   using Request = ExecuteRequest;
@@ -415,6 +460,11 @@ struct DaemonLogs {
   static constexpr std::string_view name = "node.daemon_logs";
   using Request = DaemonLogsRequest;
   using Reply = LogsReply;
+};
+struct Tap {
+  static constexpr std::string_view name = "node.tap";
+  using Request = TapRequest;
+  using Reply = TapReply;
 };
 
 } // namespace rsca::protocol::node

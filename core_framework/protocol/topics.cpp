@@ -25,4 +25,10 @@ std::string channel_topic(std::string_view domain, std::string_view channel) {
   return fmt::format("rsca_{}_channel_{}", dds_name(domain), dds_name(channel));
 }
 
+// A prefix of its own beside the domains' rsca_<domain>_ (only a domain named "_tap_" would
+// share it), so that a viewer's topic is not a connection's.
+std::string tap_topic(std::string_view topic) {
+  return fmt::format("rsca__tap__{}", dds_name(topic));
+}
+
 } // namespace rsca::protocol

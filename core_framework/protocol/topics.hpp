@@ -28,5 +28,7 @@ std::string connection_topic(std::string_view domain, std::string_view applicati
 std::string runtime_connection_topic(std::string_view domain, std::string_view connection);
 // An event channel.
 std::string channel_topic(std::string_view domain, std::string_view channel);
+// A node's lossy copy of the records of `topic` for a viewer (rsca echo, rsca hz).
+std::string tap_topic(std::string_view topic);
 
 } // namespace rsca::protocol

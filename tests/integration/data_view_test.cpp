@@ -3,8 +3,10 @@
 // rsca top -w refreshing.
 #include <catch2/catch.hpp>
 
+#include <csignal>
 #include <sstream>
 
+#include "child_process.hpp"
 #include "domain_fixture.hpp"
 #include "wait_for.hpp"
 
@@ -155,5 +157,106 @@ TEST_CASE("rsca top -n 2 prints two tables, one after the other when not on a te
   CHECK(bad_rc == 2);
   CHECK_THAT(bad, Catch::Contains("--interval soon"));
   REQUIRE(domain.call("app.release", Json{{"app", "ProducerConsumer"}}).has_value());
+  domain.require_clean(pids_of(app));
+}
+
+namespace {
+
+// The sequence numbers of `rsca --json echo` lines.
+std::vector<long> dataview_sequences(const std::string &out) {
+  std::vector<long> sequences;
+  std::istringstream lines(out);
+  for (std::string line; std::getline(lines, line);)
+    sequences.push_back(Json::parse(line).at("sequence").get<long>());
+  return sequences;
+}
+
+long dataview_property(TestDomain &domain, const std::string &app, const std::string &component,
+                       const std::string &id) {
+  auto q = domain.call("app.query", Json{{"app", app}, {"component", component}, {"ids", {id}}});
+  REQUIRE(q.has_value());
+  return q->at("properties").at(id).get<long>();
+}
+
+} // namespace
+
+TEST_CASE("rsca echo prints the producer's samples as they flow and rsca hz their rate, without "
+          "disturbing the connection",
+          "[integration][echo][dataview]") {
+  // Through the node's ring (ProducerConsumer, one node) and direct DDS (DirectPair).
+  const std::string name = GENERATE(as<std::string>{}, "ProducerConsumer", "DirectPair");
+  INFO(name);
+  TestDomain domain;
+  Json app;
+  if (name == "ProducerConsumer") {
+    app = domain.launch_shipped(name);
+  } else {
+    domain.install(name);
+    auto [rc, out] = domain.cli({"launch", name});
+    INFO(out);
+    REQUIRE(rc == 0);
+    app = *domain.call("app.show", Json{{"app", name}});
+  }
+  REQUIRE(TestDomain::wait_for([&] { return received(domain, name) > 5; }));
+  const long before = dataview_property(domain, name, "Producer_1", "last_sequence");
+  auto [rc, out] = domain.cli({"--json", "echo", name + "/Producer_1.samples_out", "-n", "5"});
+  INFO(out);
+  REQUIRE(rc == 0);
+  const long after = dataview_property(domain, name, "Producer_1", "last_sequence");
+  const auto sequences = dataview_sequences(out);
+  REQUIRE(sequences.size() == 5);
+  for (std::size_t i = 0; i < sequences.size(); ++i) {
+    CHECK(sequences[i] >= before); // the producer's, as it wrote them meanwhile
+    CHECK(sequences[i] <= after);
+    if (i > 0)
+      CHECK(sequences[i] > sequences[i - 1]);
+  }
+  // The port named from the reader's side, in text: summarised samples.
+  auto [text_rc, text] = domain.cli({"echo", name + ".samples_in", "-n", "1"});
+  INFO(text);
+  REQUIRE(text_rc == 0);
+  CHECK_THAT(text, Catch::Contains("\"sequence\": "));
+
+  // A viewer attached for a while: the consumer keeps receiving, and after it has gone.
+  const long received_before = received(domain, name);
+  auto [hz_rc, hz] =
+      domain.cli({"--json", "hz", name + "/Producer_1.samples_out", "-w", "2s", "-n", "1"});
+  INFO(hz);
+  REQUIRE(hz_rc == 0);
+  const Json rate = Json::parse(hz);
+  // The producer writes at 50 Hz (ProducerConsumer) or 100 Hz (DirectPair's default): a broad
+  // functional range, not a speed goal.
+  CHECK(rate.at("rate_hz").get<double>() > 10);
+  CHECK(rate.at("rate_hz").get<double>() < 200);
+  CHECK(rate.at("gap_min_ms").get<double>() > 0);
+  CHECK(rate.at("gap_max_ms").get<double>() >= rate.at("gap_mean_ms").get<double>());
+  const long received_during = received(domain, name);
+  CHECK(received_during > received_before + 10);
+  REQUIRE(TestDomain::wait_for([&] { return received(domain, name) > received_during + 10; }));
+
+  // A viewer that stops reading (frozen) holds nothing back either, nor one that dies.
+  const fs::path viewer_out = domain.run_dir() / "viewer.out";
+  ChildProcess viewer((kBin / "rsca").string(), {"echo", name + "/Producer_1.samples_out"},
+                      domain.env(), viewer_out);
+  REQUIRE(TestDomain::wait_for(
+      [&] { return read_file(viewer_out).find("\"sequence\": ") != std::string::npos; }));
+  viewer.signal(SIGSTOP);
+  const long received_frozen = received(domain, name);
+  CHECK(TestDomain::wait_for([&] { return received(domain, name) > received_frozen + 100; }));
+  viewer.signal(SIGKILL);
+  REQUIRE(viewer.wait_exit(5s).has_value());
+  const long received_killed = received(domain, name);
+  CHECK(TestDomain::wait_for([&] { return received(domain, name) > received_killed + 20; }));
+
+  // Stopped, nothing flows: the viewer says so within its wait, and fails.
+  REQUIRE(domain.cli({"stop", name}).first == 0);
+  auto [quiet_rc, quiet] = domain.cli({"echo", name + "/Producer_1.samples_out", "--wait", "1s"});
+  INFO(quiet);
+  CHECK(quiet_rc == 6);
+  CHECK_THAT(quiet, Catch::Contains("no sample on connection samples for 1s"));
+  auto [bad_rc, bad] = domain.cli({"echo", name + "/Producer_1.no_such_port"});
+  CHECK(bad_rc == 3);
+  CHECK_THAT(bad, Catch::Contains("has no data connection of port Producer_1.no_such_port"));
+  REQUIRE(domain.call("app.release", Json{{"app", name}}).has_value());
   domain.require_clean(pids_of(app));
 }

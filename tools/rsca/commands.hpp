@@ -28,6 +28,8 @@ void add_events_command(CLI::App &app, const GlobalOptions &global, int &exit_co
 void add_new_command(CLI::App &app, const GlobalOptions &global, int &exit_code);
 void add_top_command(CLI::App &app, const GlobalOptions &global, int &exit_code);
 void add_logs_command(CLI::App &app, const GlobalOptions &global, int &exit_code);
+// rsca echo and rsca hz: a port's samples as they flow, and their rate (echo_command.cpp).
+void add_echo_commands(CLI::App &app, const GlobalOptions &global, int &exit_code);
 // rsca completion bash|zsh: made from `app`'s commands, so register it after them.
 void add_completion_command(CLI::App &app, const GlobalOptions &global, int &exit_code);
 

@@ -47,6 +47,8 @@ const std::map<std::string, std::string> &positional_kinds() {
       {"rsca:ls:app", "apps"},
       {"rsca:top:app", "apps"},
       {"rsca:logs:target", "apps nodes"},
+      {"rsca:echo:port", "apps"},
+      {"rsca:hz:port", "apps"},
       {"rsca:new:component:name", ""},
       {"rsca:new:device:name", ""},
       {"rsca:completion:shell", "=bash zsh"},

@@ -46,6 +46,7 @@ int main(int argc, char **argv) {
   rsca::cli::add_ls_command(app, global, exit_code);
   rsca::cli::add_top_command(app, global, exit_code);
   rsca::cli::add_logs_command(app, global, exit_code);
+  rsca::cli::add_echo_commands(app, global, exit_code);
   rsca::cli::add_domain_command(app, global, exit_code);
   rsca::cli::add_new_command(app, global, exit_code);
   rsca::cli::add_completion_command(app, global, exit_code);
