@@ -132,6 +132,10 @@ step "launch both forms"
 "$rsca" launch "$sdr/dom/waveforms/GreeterLib/GreeterLib.sad.xml"
 wait_ticks Greeter
 wait_ticks GreeterLib
+step "the data a new user looks at: rsca echo shows what Greeter_1 sends Greeter_2"
+"$rsca" echo Greeter/Greeter_1.out -n 3 --wait 10s >"$work/echo.txt" 2>&1 ||
+  { cat "$work/echo.txt" >&2; fail "rsca echo saw no sample of the generated connection"; }
+[ "$(grep -c . "$work/echo.txt")" -ge 3 ] || { cat "$work/echo.txt" >&2; fail "rsca echo printed fewer than 3 samples"; }
 "$rsca" --json show GreeterLib | grep '"state": "running"' >/dev/null || fail "GreeterLib is not running"
 
 step "the device runs in the installed rsca-noded, and its properties answer"
