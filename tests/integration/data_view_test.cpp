@@ -103,7 +103,7 @@ TEST_CASE("rsca events shows an application's start and stop, and no deadline mi
   domain.require_clean(pids_of(app));
 }
 
-TEST_CASE("rsca query summarises a long sequence; --full and --json print it whole",
+TEST_CASE("rsca query summarises a long sequence, --full and --json print it whole",
           "[integration][dataview]") {
   TestDomain domain({TestDomain::shipped_nodes(1)[0],
                      kSource / "profiles/dev/nodes/robot/DeviceManager.dcd.xml"});
