@@ -74,18 +74,15 @@ int install(const std::string &sad, const std::string &name, const GlobalOptions
             std::string *installed_name) {
   if (!name.empty())
     if (auto named = check_name("--name", name); !named) {
-      fmt::print(stderr, "rsca install: {}\n", named.error().diagnostics().front().message);
-      return kUsage;
+      return fail(global, "install", kUsage, named.error().diagnostics().front().message);
     }
   auto app = read_user_application(sad, global, name);
   if (!app) {
-    fmt::print(stderr, "rsca install: {}\n", app.error().to_string());
-    return kInvalidProfile;
+    return fail(global, "install", kInvalidProfile, app.error().to_string());
   }
   auto client = DomainClient::connect(global);
   if (!client) {
-    fmt::print(stderr, "rsca install: {}\n", client.error().to_string());
-    return kFailed;
+    return fail(global, "install", kFailed, client.error().to_string());
   }
   return send_install(*app, *client, global, installed_name, "install");
 }
@@ -210,8 +207,7 @@ int launch(const std::string &what, const std::string &name, bool no_start,
       return rc;
   auto client = DomainClient::connect(global);
   if (!client) {
-    fmt::print(stderr, "rsca launch: {}\n", client.error().to_string());
-    return kFailed;
+    return fail(global, "launch", kFailed, client.error().to_string());
   }
   LaunchTarget target{what, false};
   if (file)

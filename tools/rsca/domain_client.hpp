@@ -88,8 +88,7 @@ int call_and_print(const GlobalOptions &global, const std::string &what,
                    const std::function<void(const typename Op::Reply &)> &print_text) {
   auto client = DomainClient::connect(global);
   if (!client) {
-    fmt::print(stderr, "rsca {}: {}\n", what, client.error().to_string());
-    return kFailed;
+    return fail(global, what, kFailed, client.error().to_string());
   }
   auto reply = client->call<Op>(request, timeout);
   if (!reply)

@@ -13,6 +13,7 @@
 #include "allocator/planner.hpp"
 #include "common/names.hpp"
 #include "content/base64.hpp"
+#include "domain_client.hpp"
 #include "exit_codes.hpp"
 #include "profile/application_checks.hpp"
 
@@ -158,20 +159,18 @@ std::optional<UserApplication> launchable_file(const std::string &sad,
                                                const GlobalOptions &global, int &rc) {
   auto app = read_user_application(sad, global, "");
   if (!app) {
-    fmt::print(stderr, "rsca launch: {}\n", app.error().to_string());
-    rc = kInvalidProfile;
+    rc = fail(global, "launch", kInvalidProfile, app.error().to_string());
     return std::nullopt;
   }
   if (auto stray = stray_assignment(app->profile, assign)) {
-    fmt::print(stderr, "rsca launch: {}; nothing was installed\n", *stray);
-    rc = kUsage;
+    rc = fail(global, "launch", kUsage, *stray + "; nothing was installed");
     return std::nullopt;
   }
   if (auto refused = profile::launch_refusals(app->profile); !refused.empty()) {
-    fmt::print(stderr, "rsca launch: {} cannot be launched; nothing was installed:\n", sad);
+    std::string why = fmt::format("{} cannot be launched; nothing was installed:", sad);
     for (const auto &r : refused)
-      fmt::print(stderr, "  {}\n", to_string(r));
-    rc = kInvalidProfile;
+      why += "\n  " + to_string(r);
+    rc = fail(global, "launch", kInvalidProfile, why);
     return std::nullopt;
   }
   app->request.for_launch = true; // the domain checks it again before it replaces anything

@@ -274,8 +274,7 @@ int read_once(const DomainClient &client, std::vector<Source> &sources, std::siz
 int logs(const LogsOptions &options, const GlobalOptions &global) {
   auto client = DomainClient::connect(global);
   if (!client) {
-    fmt::print(stderr, "rsca logs: {}\n", client.error().to_string());
-    return kFailed;
+    return fail(global, "logs", kFailed, client.error().to_string());
   }
   std::string stamp;
   if (!options.since.empty()) {

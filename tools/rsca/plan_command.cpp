@@ -100,18 +100,15 @@ int plan_offline(const PlanArgs &args, const std::map<std::string, std::string> 
                  const GlobalOptions &global) {
   auto application = user_profile_loader(global).load_application(args.what);
   if (!application) {
-    fmt::print(stderr, "rsca plan: {}\n", application.error().to_string());
-    return kInvalidProfile;
+    return fail(global, "plan", kInvalidProfile, application.error().to_string());
   }
   // The domain's plan refuses it too; offline, an assignment of no component went unnoticed.
   if (auto stray = stray_assignment(*application, assign)) {
-    fmt::print(stderr, "rsca plan: {}\n", *stray);
-    return kUsage;
+    return fail(global, "plan", kUsage, *stray);
   }
   auto domain = offline_domain(args.nodes);
   if (!domain) {
-    fmt::print(stderr, "rsca plan: {}\n", domain.error().to_string());
-    return kInvalidProfile;
+    return fail(global, "plan", kInvalidProfile, domain.error().to_string());
   }
   const allocator::PlanOptions options{
       allocator::parse_strategy(args.strategy).value_or(allocator::Strategy::Pack)};
@@ -128,8 +125,7 @@ int plan_online(const PlanArgs &args, const std::map<std::string, std::string> &
   if (fs::is_regular_file(args.what)) {
     auto app = read_user_application(args.what, global, "");
     if (!app) {
-      fmt::print(stderr, "rsca plan: {}\n", app.error().to_string());
-      return kInvalidProfile;
+      return fail(global, "plan", kInvalidProfile, app.error().to_string());
     }
     files = std::move(*app);
     if (!global.json)
@@ -138,8 +134,7 @@ int plan_online(const PlanArgs &args, const std::map<std::string, std::string> &
   }
   auto client = DomainClient::connect(global);
   if (!client) {
-    fmt::print(stderr, "rsca plan: {}\n", client.error().to_string());
-    return kFailed;
+    return fail(global, "plan", kFailed, client.error().to_string());
   }
   const std::optional<std::string> strategy =
       args.strategy.empty() ? std::nullopt : std::optional(args.strategy);

@@ -105,13 +105,11 @@ int show_application_graph(const std::string &name, const GraphOptions &options,
   if (options.format == "svg")
     dot = find_dot(); // before the domain is asked: a missing dot is known at once
   if (!dot) {
-    fmt::print(stderr, "rsca show: {}\n", dot.error().to_string());
-    return kFailed;
+    return fail(global, "show", kFailed, dot.error().to_string());
   }
   auto client = DomainClient::connect(global);
   if (!client) {
-    fmt::print(stderr, "rsca show: {}\n", client.error().to_string());
-    return kFailed;
+    return fail(global, "show", kFailed, client.error().to_string());
   }
   auto app = client->call<protocol::application::Show>(
       {name}, std::chrono::milliseconds(global.timeout_ms) * 2);
@@ -126,8 +124,7 @@ int show_application_graph(const std::string &name, const GraphOptions &options,
   else
     fmt::print("{}", text);
   if (!done) {
-    fmt::print(stderr, "rsca show: {}\n", done.error().to_string());
-    return kFailed;
+    return fail(global, "show", kFailed, done.error().to_string());
   }
   return kOk;
 }

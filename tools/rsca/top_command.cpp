@@ -174,8 +174,7 @@ int top(const TopOptions &options, const GlobalOptions &global) {
   }
   auto client = DomainClient::connect(global);
   if (!client) {
-    fmt::print(stderr, "rsca top: {}\n", client.error().to_string());
-    return kFailed;
+    return fail(global, "top", kFailed, client.error().to_string());
   }
   const int iterations = options.iterations > 0 ? options.iterations : (options.watch ? 0 : 1);
   for (int done = 0; iterations == 0 || done < iterations; ++done) {
