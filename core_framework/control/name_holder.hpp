@@ -54,13 +54,11 @@ public:
 
   // Something was discovered at `now`: the quiet starts again.
   void heard(Clock::time_point now) { last_heard_ = now; }
-  bool over(Clock::time_point now) const {
-    return now >= deadline_ || (now >= earliest_ && now >= last_heard_ + kQuiet);
-  }
-  // The moment to look again if nothing is heard before.
+  // The moment to look again if nothing is heard before; the look is over from then on.
   Clock::time_point next_look() const {
     return std::min(deadline_, std::max(earliest_, last_heard_ + kQuiet));
   }
+  bool over(Clock::time_point now) const { return now >= next_look(); }
 
 private:
   Clock::time_point earliest_;
